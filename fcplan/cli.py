@@ -1,0 +1,195 @@
+"""The ``fcplan`` command line.
+
+Commands::
+
+    fcplan scenarios                         list the shipped scenarios
+    fcplan scenario validate FILE [FILE...]  check scenario files; list manual limits exceeded
+    fcplan run SCENARIO [--scheduler NAME] [--seed N] [--replan-period S] [--time-limit S] [--json]
+
+Bad input (an unknown scenario or scheduler, a malformed file, an out-of-range argument) prints one
+line naming the problem and exits with status 2; ``--debug`` shows the traceback instead.
+
+Examples
+--------
+>>> from fcplan.cli import main
+>>> main(["scenarios"])  # doctest: +ELLIPSIS
+name ...
+0
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Sequence
+
+from fcplan.errors import FcplanError
+
+__all__ = ["main"]
+
+
+class _ArgumentError(FcplanError):
+    pass
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, exit 2 (handled in main)
+        raise _ArgumentError(f"{self.prog}: {message}")
+
+
+def _positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return v
+
+
+def _seed(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}")
+    return v
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="fcplan", description="FireCommander multi-robot task assignment testbed")
+    p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    sub.add_parser("scenarios", help="list the shipped scenarios")
+
+    sc = sub.add_parser("scenario", help="scenario file tools")
+    scs = sc.add_subparsers(dest="scenario_command", required=True, parser_class=_Parser)
+    v = scs.add_parser("validate", help="validate scenario files and list manual limits exceeded")
+    v.add_argument("files", nargs="+", help="TOML files or shipped scenario names")
+
+    r = sub.add_parser("run", help="run one episode and print the manual's metrics")
+    r.add_argument("scenario", help="practice, 1..24, or a TOML file")
+    r.add_argument("--scheduler", "-s", default="greedy", help="registered scheduler name")
+    r.add_argument("--seed", type=_seed, default=0, help="random seed (integer >= 0)")
+    r.add_argument("--replan-period", type=_positive_float, default=1.0,
+                   help="simulated seconds between replans (default 1.0)")
+    r.add_argument("--time-limit", type=_positive_float, default=None,
+                   help="seconds per scheduler call (default: the scheduler's own)")
+    r.add_argument("--json", action="store_true", help="print the results as JSON")
+    return p
+
+
+def _cmd_scenarios() -> int:
+    from fcplan.scenario import list_scenarios, load_scenario
+
+    print(f"{'name':<22} {'difficulty':<10} {'team':<9} fire regions (fronts, delay)")
+    for name in list_scenarios():
+        s = load_scenario(name)
+        team = "/".join(
+            f"{n}{r[0].upper()}" for r, n in s.team_counts.items() if n
+        )
+        regions = ", ".join(
+            f"{r.cell or tuple(int(c) for c in r.center)}({r.fronts}f"
+            + (f", +{r.delay_s:g}s)" if r.delay_s else ")")
+            for r in s.regions
+        )
+        label = name if s.number is None else s.name
+        print(f"{label:<22} {s.difficulty:<10} {team:<9} {regions}")
+    return 0
+
+
+def _cmd_validate(files: Sequence[str]) -> int:
+    from fcplan.scenario import load_scenario
+
+    for f in files:
+        s = load_scenario(f)
+        over = s.manual_limit_violations()
+        if over:
+            print(f"{f}: valid; exceeds {len(over)} manual limit(s):")
+            for line in over:
+                print(f"  - {line}")
+        else:
+            print(f"{f}: valid, within the manual's limits")
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from fcplan.episode import run_episode
+    from fcplan.metrics import format_metrics
+    from fcplan.scenario import load_scenario
+    from fcplan.scheduling import make_scheduler
+
+    scenario = load_scenario(args.scenario)
+    scheduler = make_scheduler(args.scheduler)
+    res = run_episode(
+        scenario,
+        scheduler,
+        seed=args.seed,
+        replan_period=args.replan_period,
+        time_limit=args.time_limit,
+    )
+    if args.json:
+        out = {
+            "scenario": res.scenario,
+            "scheduler": res.scheduler,
+            "seed": res.seed,
+            "metrics": {k: m.as_dict() for k, m in res.metrics.items()},
+            "ticks": res.ticks,
+            "simulated_s": res.trace.duration_s,
+            "wall_time_s": res.wall_time_s,
+            "replans": len(res.solves),
+            "fallbacks": res.fallbacks,
+        }
+        print(json.dumps(out, indent=2))
+        return 0
+    st = res.solve_times_s * 1e3
+    print(
+        f"scenario {res.scenario} ({scenario.difficulty}), scheduler {res.scheduler}, "
+        f"seed {res.seed}"
+    )
+    print(
+        f"{res.ticks} ticks = {res.trace.duration_s:g} s simulated at "
+        f"{scenario.ticks_per_second} Hz; wall time {res.wall_time_s:.2f} s; "
+        f"{len(res.solves)} replans (solve p50 {_pct(st, 50):.2f} ms, p95 {_pct(st, 95):.2f} ms), "
+        f"{res.fallbacks} fallbacks"
+    )
+    print()
+    print(format_metrics(res.metrics))
+    return 0
+
+
+def _pct(a, q) -> float:
+    import numpy as np
+
+    return float(np.percentile(a, q)) if len(a) else 0.0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``fcplan`` console script; returns the exit status."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv
+    try:
+        args = _build_parser().parse_args(argv)
+        if args.command == "scenarios":
+            return _cmd_scenarios()
+        if args.command == "scenario":
+            return _cmd_validate(args.files)
+        if args.command == "run":
+            return _cmd_run(args)
+        raise _ArgumentError(f"unknown command {args.command!r}")  # pragma: no cover
+    except FcplanError as exc:
+        if debug:
+            raise
+        print(f"fcplan: error: {exc}".replace("\n", " "), file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("fcplan: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

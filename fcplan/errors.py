@@ -1,0 +1,73 @@
+"""Exceptions raised at fcplan's boundaries.
+
+Every error that bad input can cause is a subclass of :class:`FcplanError`. Its message is one line
+that names where the problem is (file, field) and what is allowed, so the CLI can print it as is and
+exit with status 2.
+
+Examples
+--------
+>>> from fcplan.errors import ScenarioError
+>>> str(ScenarioError("team.action.tank", "must be an integer in 1..15", got=0, source="my.toml"))
+'my.toml: team.action.tank: must be an integer in 1..15 (got 0)'
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["FcplanError", "ScenarioError", "PlanError", "UnknownNameError"]
+
+_MISSING = object()
+
+
+class FcplanError(Exception):
+    """Base class of every error fcplan raises for bad input."""
+
+
+class ScenarioError(FcplanError, ValueError):
+    """A scenario file or `Scenario` value is malformed or physically invalid.
+
+    Parameters
+    ----------
+    field : str
+        Dotted path of the offending field, e.g. ``"fire.regions[2].fuel"``.
+    problem : str
+        What is wrong and what is allowed, e.g. ``"must be a number in 2..20"``.
+    got : Any, optional
+        The offending value, shown in the message when given.
+    source : str, optional
+        The file (or scenario name) the value came from.
+    """
+
+    def __init__(self, field: str, problem: str, *, got: Any = _MISSING, source: str | None = None):
+        self.field = field
+        self.problem = problem
+        self.got = None if got is _MISSING else got
+        self.source = source
+        msg = f"{field}: {problem}"
+        if got is not _MISSING:
+            msg += f" (got {got!r})"
+        if source:
+            msg = f"{source}: {msg}"
+        super().__init__(msg)
+
+    def with_source(self, source: str) -> ScenarioError:
+        """Return the same error attributed to ``source`` (a file path or scenario name)."""
+        if self.source:
+            return self
+        err = ScenarioError.__new__(ScenarioError)
+        FcplanError.__init__(err, f"{source}: {self.args[0]}")
+        err.field, err.problem, err.got, err.source = self.field, self.problem, self.got, source
+        return err
+
+
+class PlanError(FcplanError, ValueError):
+    """A plan does not fit the task graph it was made for (unknown agent or task, wrong role,
+    infeasible battery)."""
+
+
+class UnknownNameError(FcplanError, KeyError):
+    """A scenario or scheduler name is not known. The message lists the known names."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0])

@@ -1,0 +1,293 @@
+"""FARSITE wildfire: propagating fronts over a 1-px cell grid, vectorised over all fronts.
+
+Each fire region starts with ``fronts`` ignition points drawn uniformly (integer pixels) in its
+ignition box. Every tick every live front takes one FARSITE step (FIRECOMMANDER.md 1.4)::
+
+    U ~ N(U_avg, 2)          Theta ~ N(theta_avg, 2 rad)      (fresh draws per front per tick)
+    R = fuel * terrain[round(x), round(y)]                    (terrain ~ U(0, 1), fixed per episode)
+    LB = 0.936 exp(0.2566 U) + 0.461 exp(-0.1548 U) - 0.397
+    HB = (LB + sqrt|LB^2 - 1|) / (LB - sqrt|LB^2 - 1|)
+    C = 0.5 (R - R / HB)
+    x += C sin(Theta) dt,   y += C cos(Theta) dt              (dt = 10 / ticks_per_second)
+
+so a front moves about ``0.24 * fuel`` px per tick at wind 5 on its first tick, drifting weakly
+along the wind azimuth (theta = 0 is +y, screen down; 90 degrees is +x).
+
+What fcplan keeps and fixes (ARCHITECTURE.md "Fire"):
+
+* There is no branching: each front is one point; the fire grows as the trail of cells the fronts
+  visit. Every cell a front lands in burns; the ignition cells burn as soon as their region
+  activates (after its delay), which the 2020 code forgot.
+* A front standing in a pruned cell is frozen forever; pruned cells never re-ignite.
+* A front leaving the map dies (the 2020 code kept a phantom front at (0, 0)).
+* One terrain field is shared by all regions (it is the map's fuel pattern); each region scales it
+  by its fuel coefficient.
+* Random numbers: two normals are drawn for *every* front every tick, live or not, so the fire's
+  random stream never depends on what the agents do (common random numbers across schedulers).
+* Intensity is not used by any rule. It is kept as a grid of front visits (``visits``); the
+  Gaussian heat field of the manual is computed on demand by :meth:`Fire.intensity`.
+
+Cells are indexed ``[x, y]``; a flat cell index is ``x * W + y``.
+
+Examples
+--------
+>>> import numpy as np
+>>> from fcplan.fire import Fire, FireRegionParams
+>>> region = FireRegionParams(center=(350, 350), fronts=10, delay_s=0, fuel=10, wind_speed=5,
+...                           wind_dir_deg=45)
+>>> fire = Fire([region], world_size=1200, ticks_per_second=10, rng=np.random.default_rng(0))
+>>> for _ in range(50):
+...     _ = fire.step()
+>>> int(fire.n_burning) > 10
+True
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "Fire",
+    "FireRegionParams",
+    "spread_rate_ratio",
+    "INTENSITY_COEFF",
+    "UNBURNT",
+    "BURNING",
+    "PRUNED",
+]
+
+#: ``259.833 (h / cos(alpha))^2.174 / 1000`` with h = 3 m, alpha = pi/3 (manual Eq. intensity).
+INTENSITY_COEFF = 259.833 * (3.0 / math.cos(math.pi / 3)) ** 2.174 / 1000.0
+WIND_SPEED_SD = 2.0
+WIND_DIR_SD_RAD = 2.0
+REFERENCE_TPS = 10
+#: Cell states in :attr:`Fire.state`.
+UNBURNT, BURNING, PRUNED = 0, 1, 2
+
+
+@dataclass(frozen=True, slots=True)
+class FireRegionParams:
+    """The fire parameters of one region (duck-type compatible with ``fcplan.scenario.FireRegion``)."""
+
+    center: tuple[float, float]
+    fronts: int
+    delay_s: float
+    fuel: float
+    wind_speed: float
+    wind_dir_deg: float
+    half_width: float = 50.0
+
+
+def spread_rate_ratio(wind_speed: np.ndarray | float) -> np.ndarray:
+    """FARSITE ``C / R`` as a function of wind speed ``U`` (0 at U = 0, about 0.487 at U = 5).
+
+    Examples
+    --------
+    >>> round(float(spread_rate_ratio(5.0)), 3)
+    0.487
+    """
+    u = np.asarray(wind_speed, dtype=np.float64)
+    lb = 0.936 * np.exp(0.2566 * u) + 0.461 * np.exp(-0.1548 * u) - 0.397
+    s = np.sqrt(np.abs(lb * lb - 1.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv_hb = np.where(lb - s != 0.0, (lb - s) / (lb + s), 1.0)
+    return 0.5 * (1.0 - inv_hb)
+
+
+class Fire:
+    """All fire regions of one episode.
+
+    Parameters
+    ----------
+    regions : sequence of region parameters
+        Objects with ``center``, ``fronts``, ``delay_s``, ``fuel``, ``wind_speed``,
+        ``wind_dir_deg`` and ``half_width`` (e.g. :class:`fcplan.scenario.FireRegion`).
+    world_size : int
+        Map side ``W`` in px (cells).
+    ticks_per_second : int
+        Simulation rate; per-tick motion is rescaled so that motion per second is rate-free.
+    rng : numpy.random.Generator
+        The fire's own random stream.
+
+    Attributes
+    ----------
+    x, y : ndarray, (n,) float64
+        Front positions.
+    region : ndarray, (n,) int16
+        Region index of each front.
+    alive : ndarray, (n,) bool
+        False once the front left the map.
+    state : ndarray, (W, W) uint8
+        ``UNBURNT`` (0), ``BURNING`` (1) or ``PRUNED`` (2) per cell. Pruned cells never burn
+        again and freeze fronts standing in them.
+    visits : ndarray, (W, W) uint32
+        Front-ticks spent in each cell (the accumulation behind :meth:`intensity`).
+    """
+
+    def __init__(
+        self,
+        regions: Sequence,
+        world_size: int,
+        ticks_per_second: int,
+        rng: np.random.Generator,
+    ) -> None:
+        w = int(world_size)
+        self.world_size = w
+        self.ticks_per_second = int(ticks_per_second)
+        self.dt = REFERENCE_TPS / self.ticks_per_second
+        self.rng = rng
+        self.tick = 0
+        n_per = np.array([int(r.fronts) for r in regions], dtype=np.int64)
+        self.region = np.repeat(np.arange(len(regions), dtype=np.int16), n_per)
+        n = int(n_per.sum())
+        self.n_fronts = n
+        # Ignition points: integers in [c - hw, c + hw - 1] per axis, as the reference draws them.
+        lo = np.array([[r.center[0] - r.half_width, r.center[1] - r.half_width] for r in regions])
+        hi = np.array([[r.center[0] + r.half_width, r.center[1] + r.half_width] for r in regions])
+        lo_f, hi_f = np.repeat(lo, n_per, axis=0), np.repeat(hi, n_per, axis=0)
+        pts = rng.integers(lo_f.astype(np.int64), hi_f.astype(np.int64), size=(n, 2))
+        self.x = pts[:, 0].astype(np.float64)
+        self.y = pts[:, 1].astype(np.float64)
+        self.alive = (self.x >= 0) & (self.x < w) & (self.y >= 0) & (self.y < w)
+        per = np.array(
+            [[r.fuel, r.wind_speed, math.radians(r.wind_dir_deg)] for r in regions], np.float64
+        )
+        self._fuel = per[self.region, 0]
+        self._wind = per[self.region, 1]
+        self._theta = per[self.region, 2]
+        self.delay_ticks = np.array(
+            [math.ceil(r.delay_s * self.ticks_per_second - 1e-9) for r in regions], np.int64
+        )
+        self.region_active = np.zeros(len(regions), dtype=bool)
+        # One terrain field for the map, padded by one cell so rounded positions never overflow.
+        self.terrain = rng.random((w + 1, w + 1), dtype=np.float32)
+        #: (W, W) uint8 cell state: UNBURNT, BURNING or PRUNED.
+        self.state = np.zeros((w, w), dtype=np.uint8)
+        self.visits = np.zeros((w, w), dtype=np.uint32)
+        self._state_flat = self.state.reshape(-1)
+        self._visits_flat = self.visits.reshape(-1)
+        #: (n,) int64 flat index of each front's current cell (valid while alive).
+        self.cell = np.where(
+            self.alive,
+            np.clip(self.x, 0, w - 1).astype(np.int64) * w + np.clip(self.y, 0, w - 1).astype(np.int64),
+            0,
+        )
+        #: (n,) bool: the front stands in a pruned cell and never moves again.
+        self.frozen = np.zeros(n, dtype=bool)
+        self.n_burning = 0
+        self.n_pruned = 0
+        self.n_ignited = 0
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def live(self) -> np.ndarray:
+        """(n,) bool: fronts that move this tick (alive and their region active)."""
+        return self.alive & self.region_active[self.region]
+
+    @property
+    def burning(self) -> np.ndarray:
+        """(W, W) bool: burning cells (a fresh array; scans the grid, not for the hot path)."""
+        return self.state == BURNING
+
+    @property
+    def pruned(self) -> np.ndarray:
+        """(W, W) bool: pruned cells (a fresh array; scans the grid, not for the hot path)."""
+        return self.state == PRUNED
+
+    def burning_cells(self) -> np.ndarray:
+        """(k, 2) int64 ``[x, y]`` of every burning cell (scans the grid: not for the hot path)."""
+        return np.argwhere(self.state == BURNING)
+
+    def intensity(self, sigma: float = 9.5, radius: float = 10.0) -> np.ndarray:
+        """(W, W) heat field in kW/m: Gaussian radiation of every front visit, linearly summed.
+
+        This is the manual's "Gaussian heat radiation with linear summation" evaluated on the
+        grid (``sigma`` about the reference's ``randint(9, 11) + N(0, 1)``, truncated at
+        ``radius`` px). No rule reads it; it is for display and analysis.
+        """
+        from scipy.signal import fftconvolve
+
+        r = int(math.floor(radius))
+        off = np.arange(-r, r + 1, dtype=np.float64)
+        d2 = off[:, None] ** 2 + off[None, :] ** 2
+        kernel = np.where(d2 <= radius**2, np.exp(-0.5 * d2 / sigma**2), 0.0)
+        kernel /= 2.0 * math.pi * sigma**2
+        field = fftconvolve(self.visits.astype(np.float64), kernel, mode="same")
+        return 1000.0 * INTENSITY_COEFF * field
+
+    # ------------------------------------------------------------------ dynamics
+    def _ignite(self, flat: np.ndarray) -> np.ndarray:
+        """Set unburnt cells burning; return the newly burning ones (unique)."""
+        fresh = flat[self._state_flat[flat] == UNBURNT]
+        if fresh.size > 1:
+            fresh = np.unique(fresh)
+        self._state_flat[fresh] = BURNING
+        self.n_burning += int(fresh.size)
+        self.n_ignited += int(fresh.size)
+        return fresh
+
+    def step(self) -> np.ndarray:
+        """Advance one tick; return the flat indices of the cells that started burning.
+
+        Regions whose delay has passed activate first (their ignition cells burn); then every
+        live, unfrozen front takes one FARSITE step.
+        """
+        w = self.world_size
+        self.tick += 1
+        new = _EMPTY
+        if not self.region_active.all():
+            waking = (~self.region_active) & (self.delay_ticks <= self.tick)
+            if waking.any():
+                self.region_active |= waking
+                new = self._ignite(self.cell[self.alive & waking[self.region]])
+        z = self.rng.standard_normal((2, self.n_fronts))
+        idx = np.flatnonzero(self.alive & self.region_active[self.region] & ~self.frozen)
+        if idx.size == 0:
+            return new
+        np.add.at(self._visits_flat, self.cell[idx], _ONE)
+        xm, ym = self.x[idx], self.y[idx]
+        u = self._wind[idx] + WIND_SPEED_SD * z[0, idx]
+        theta = self._theta[idx] + WIND_DIR_SD_RAD * z[1, idx]
+        fuel = self.terrain[np.rint(xm).astype(np.int64), np.rint(ym).astype(np.int64)]
+        c = np.maximum(self._fuel[idx] * fuel, 1e-15) * spread_rate_ratio(u) * self.dt
+        xm += c * np.sin(theta)
+        ym += c * np.cos(theta)
+        self.x[idx] = xm
+        self.y[idx] = ym
+        inside = (xm >= 0.0) & (xm < w) & (ym >= 0.0) & (ym < w)
+        if not inside.all():
+            self.alive[idx[~inside]] = False
+            idx, xm, ym = idx[inside], xm[inside], ym[inside]
+        flat = xm.astype(np.int64) * w + ym.astype(np.int64)
+        self.cell[idx] = flat
+        # A front that stepped into a pruned cell freezes there (and does not burn it).
+        into_pruned = self._state_flat[flat] == PRUNED
+        if into_pruned.any():
+            self.frozen[idx[into_pruned]] = True
+        fresh = self._ignite(flat)
+        return fresh if new.size == 0 else np.concatenate([new, fresh])
+
+    def prune(self, flat: np.ndarray) -> np.ndarray:
+        """Put out burning cells; return the flat indices actually pruned (they were burning).
+
+        Fronts standing in a pruned cell freeze for good.
+        """
+        flat = np.asarray(flat, dtype=np.int64)
+        hit = flat[self._state_flat[flat] == BURNING]
+        if hit.size > 1:
+            hit = np.unique(hit)
+        if hit.size == 0:
+            return hit
+        self._state_flat[hit] = PRUNED
+        self.n_burning -= int(hit.size)
+        self.n_pruned += int(hit.size)
+        self.frozen |= self.alive & (self._state_flat[self.cell] == PRUNED)
+        return hit
+
+
+_EMPTY = np.zeros(0, dtype=np.int64)
+_ONE = np.uint32(1)

@@ -1,0 +1,194 @@
+"""The scheduling contract: the ``Scheduler`` protocol, solve statistics and the name registry.
+
+A scheduler turns a :class:`fcplan.taskgraph.TaskGraph` into a :class:`fcplan.plan.Plan`::
+
+    class Scheduler(Protocol):
+        name: str
+        def plan(self, graph, *, time_limit, rng) -> Plan: ...
+
+It may attach a :class:`SolveStats` to the plan (``plan.with_stats(...)``). :func:`solve` is how
+the episode loop calls a scheduler: it measures the wall time, validates the plan, and if the
+scheduler raises, returns something that is not a valid plan, it falls back to ``greedy`` for that
+replan and records why in the stats (``status="fallback"``). An episode never dies because a
+solver did.
+
+Schedulers are found by name: built-ins and third-party packages register a factory in the
+``fcplan.schedulers`` entry-point group (``name = "module:Factory"``); :func:`register_scheduler`
+adds one at run time (handy in notebooks).
+
+Examples
+--------
+>>> from fcplan.scheduling import make_scheduler, available_schedulers
+>>> {"greedy", "idle", "random"} <= set(available_schedulers())
+True
+>>> make_scheduler("greedy").name
+'greedy'
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field, replace
+from importlib.metadata import entry_points
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+from fcplan.errors import FcplanError, UnknownNameError
+from fcplan.plan import Plan, validate_plan
+from fcplan.taskgraph import TaskGraph
+
+__all__ = [
+    "Scheduler",
+    "SolveStats",
+    "STATUSES",
+    "make_scheduler",
+    "register_scheduler",
+    "available_schedulers",
+    "solve",
+]
+
+#: Possible :attr:`SolveStats.status` values.
+STATUSES = ("optimal", "feasible", "time_limit", "fallback", "heuristic")
+
+#: Built-in schedulers, used when the package's entry points are not installed (source checkout).
+_BUILTIN = {
+    "greedy": "solvers.greedy:GreedyScheduler",
+    "idle": "solvers.baselines:IdleScheduler",
+    "random": "solvers.baselines:RandomScheduler",
+}
+_RUNTIME: dict[str, Callable[..., Any]] = {}
+
+
+@dataclass(frozen=True, slots=True)
+class SolveStats:
+    """How one replan's plan was found.
+
+    Attributes
+    ----------
+    status : str
+        ``optimal`` (proved), ``feasible`` (stopped early with a plan), ``time_limit`` (the limit
+        stopped the solver), ``heuristic`` (a method that proves nothing, e.g. greedy), or
+        ``fallback`` (the scheduler failed; greedy's plan was used).
+    objective, bound, gap : float
+        Objective of the plan, best proven bound and relative gap (NaN when not applicable).
+    wall_time_s : float
+        Wall time of the whole call, measured by :func:`solve`.
+    size : dict
+        Model size (e.g. variables, constraints, agents, tasks).
+    message : str
+        Why a fallback happened, or solver remarks.
+    """
+
+    status: str = "heuristic"
+    objective: float = float("nan")
+    bound: float = float("nan")
+    gap: float = float("nan")
+    wall_time_s: float = 0.0
+    size: dict = field(default_factory=dict)
+    message: str = ""
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain dict (for tables and JSON)."""
+        return asdict(self)
+
+
+@runtime_checkable
+class Scheduler(Protocol):
+    """What the episode loop needs from a scheduler."""
+
+    name: str
+
+    def plan(
+        self, graph: TaskGraph, *, time_limit: float | None, rng: np.random.Generator
+    ) -> Plan:  # pragma: no cover - protocol
+        """Return a plan for ``graph`` within ``time_limit`` seconds (None: no limit)."""
+        ...
+
+
+def _entry_points() -> dict[str, Any]:
+    return {ep.name: ep for ep in entry_points(group="fcplan.schedulers")}
+
+
+def available_schedulers() -> list[str]:
+    """Names of every known scheduler (entry points, built-ins and run-time registrations)."""
+    return sorted(set(_BUILTIN) | set(_entry_points()) | set(_RUNTIME))
+
+
+def register_scheduler(name: str, factory: Callable[..., Scheduler]) -> None:
+    """Register ``factory(**settings) -> Scheduler`` under ``name`` for this process."""
+    _RUNTIME[name] = factory
+
+
+def _load(target: str) -> Callable[..., Scheduler]:
+    from importlib import import_module
+
+    module, _, attr = target.partition(":")
+    return getattr(import_module(module), attr)
+
+
+def make_scheduler(name: str, **settings: Any) -> Scheduler:
+    """Create a scheduler by registered name, passing ``settings`` to its factory.
+
+    Raises
+    ------
+    fcplan.errors.UnknownNameError
+        If no scheduler has that name (the message lists the known ones).
+    """
+    if name in _RUNTIME:
+        factory = _RUNTIME[name]
+    else:
+        eps = _entry_points()
+        if name in eps:
+            factory = eps[name].load()
+        elif name in _BUILTIN:
+            factory = _load(_BUILTIN[name])
+        else:
+            raise UnknownNameError(
+                f"unknown scheduler {name!r}; known schedulers: {', '.join(available_schedulers())}"
+            )
+    try:
+        return factory(**settings)
+    except TypeError as exc:
+        raise FcplanError(f"scheduler {name!r}: bad settings {settings}: {exc}") from None
+
+
+_FALLBACK: Scheduler | None = None
+
+
+def _fallback_scheduler() -> Scheduler:
+    global _FALLBACK
+    if _FALLBACK is None:
+        _FALLBACK = make_scheduler("greedy")
+    return _FALLBACK
+
+
+def solve(
+    scheduler: Scheduler,
+    graph: TaskGraph,
+    *,
+    time_limit: float | None,
+    rng: np.random.Generator,
+) -> Plan:
+    """Run ``scheduler`` on ``graph``; always return a valid plan carrying :class:`SolveStats`.
+
+    A scheduler that raises or returns an invalid plan is replaced by ``greedy`` for this
+    replan (``status="fallback"``, the reason in ``message``).
+    """
+    t0 = time.perf_counter()
+    message = ""
+    try:
+        plan = scheduler.plan(graph, time_limit=time_limit, rng=rng)
+        validate_plan(plan, graph)
+    except Exception as exc:  # noqa: BLE001 - an episode must survive any solver failure
+        message = f"{type(exc).__name__}: {exc}"
+        plan = None
+    if plan is None:
+        plan = _fallback_scheduler().plan(graph, time_limit=None, rng=rng)
+        validate_plan(plan, graph)
+        stats = SolveStats(status="fallback", message=message)
+    else:
+        stats = plan.stats if isinstance(plan.stats, SolveStats) else SolveStats()
+    stats = replace(stats, wall_time_s=time.perf_counter() - t0)
+    return plan.with_stats(stats)

@@ -1,0 +1,453 @@
+"""The task graph: what there is to do, built from the team's belief at a replan tick.
+
+Node kinds:
+
+* ``agent``: every UAV, with its role, position, altitude, speed, remaining range and tank;
+* ``depot``: where agents recharge and refill;
+* ``fire``: a *dump-sized* cluster of known burning cells. Known cells are binned into tiles no
+  larger than an action agent's field of view, so one dump at the task's position can reach every
+  cell of the task. Attributes: centroid position, cell count, staleness (seconds since any of its
+  cells was last sensed), threat (penalty-weighted closeness to facilities), the connected fire
+  (``cluster``) it belongs to;
+* ``search``: a grid block (100 px by default) to (re)explore, valued by how long ago the team's
+  cameras last covered it, more when known fire is near;
+* ``facility``: houses, hospitals, power stations and the depot footprint, with their penalties.
+
+Edges: ``requires`` (fire -> the search block containing it: putting a fire out needs it sensed,
+so that block must be kept fresh), ``threatens`` (fire -> facility within ``threat_radius_px``,
+with an estimated time to reach it from the fastest spread rate of the scenario's fuel), and
+``can_do`` (agent -> task its role can serve, with travel time).
+
+Solvers should use the numpy views (``agent_*``, ``task_*``, :attr:`TaskGraph.agent_task_distance`,
+:attr:`TaskGraph.task_distance`); the networkx view (:attr:`TaskGraph.graph`) is built on first
+use, for inspection, drawing and teaching.
+
+Examples
+--------
+>>> from fcplan import World, load_scenario
+>>> from fcplan.belief import Belief
+>>> from fcplan.taskgraph import build_task_graph
+>>> world = World().reset(load_scenario(1), seed=0)
+>>> belief = Belief(world.scenario)
+>>> for _ in range(10):
+...     belief.update(world.step())
+>>> g = build_task_graph(world.scenario, world.team, belief)
+>>> g.n_agents, g.n_tasks > 0
+(4, True)
+>>> sorted({d["kind"] for _, d in g.graph.nodes(data=True)})
+['agent', 'depot', 'facility', 'search']
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+from functools import cached_property
+
+import numpy as np
+
+from fcplan.team import DRAIN_PER_PX, Mode, fov_half_extent
+
+__all__ = ["TaskKind", "TaskGraph", "TaskGraphParams", "build_task_graph", "grid_block_name"]
+
+
+class TaskKind(IntEnum):
+    """Kinds of task nodes."""
+
+    FIRE = 0
+    SEARCH = 1
+
+
+@dataclass(frozen=True, slots=True)
+class TaskGraphParams:
+    """How the belief is turned into tasks.
+
+    Parameters
+    ----------
+    tile_px : (float, float), optional
+        Fire tile size (x, y). Default: 90 % of the smallest action/hybrid field of view at its
+        working altitude, so a dump centred on a tile covers all of it.
+    search_block_px : int
+        Side of a search block.
+    threat_radius_px : float
+        Fires closer than this to a facility footprint threaten it.
+    search_value_cap_s : float
+        Coverage age beyond which a search block is not worth more.
+    """
+
+    tile_px: tuple[float, float] | None = None
+    search_block_px: int = 100
+    threat_radius_px: float = 250.0
+    search_value_cap_s: float = 60.0
+
+
+def grid_block_name(bx: int, by: int) -> str:
+    """Chess-style name of a 100-px block, e.g. ``(3, 4) -> "D-05"``."""
+    letters = ""
+    n = bx + 1
+    while n:
+        n, r = divmod(n - 1, 26)
+        letters = chr(65 + r) + letters
+    return f"{letters}-{by + 1:02d}"
+
+
+@dataclass(frozen=True, eq=False)
+class TaskGraph:
+    """Tasks, agents and facilities at one replan tick, as numpy arrays plus a networkx view.
+
+    ``A`` agents, ``K`` tasks (fires first, then search blocks), ``F`` scored facilities.
+    """
+
+    tick: int
+    time_s: float
+    world_size: int
+    depot_pos: np.ndarray  # (2,) float64
+    agent_ids: tuple[str, ...]
+    agent_role: np.ndarray  # (A,) int8 Role value
+    agent_pos: np.ndarray  # (A, 2) float64
+    agent_z: np.ndarray  # (A,) float64
+    agent_alt_range: np.ndarray  # (A, 2) float64 (lo, hi)
+    agent_speed: np.ndarray  # (A,) float64 px per second
+    agent_range: np.ndarray  # (A,) float64 px it can still fly out and back home
+    agent_full_range: np.ndarray  # (A,) float64 px of flight on a full battery
+    agent_battery: np.ndarray  # (A,) float64 remaining battery
+    agent_tank: np.ndarray  # (A,) int64 remaining dumps
+    agent_tank_capacity: np.ndarray  # (A,) int64
+    agent_mode: np.ndarray  # (A,) int8 fcplan.team.Mode value
+    agent_home: np.ndarray  # (A, 2) float64 depot slot
+    agent_can_sense: np.ndarray  # (A,) bool
+    agent_can_act: np.ndarray  # (A,) bool
+    task_ids: tuple[str, ...]
+    task_kind: np.ndarray  # (K,) int8 TaskKind
+    task_pos: np.ndarray  # (K, 2) float64 where to fly (tile centre / block centre)
+    task_value: np.ndarray  # (K,) float64 fire: cells * (1 + threat); search: age-based
+    task_cells: np.ndarray  # (K,) int64 known burning cells (0 for search)
+    task_staleness: np.ndarray  # (K,) float64 s since last sensed / covered
+    task_threat: np.ndarray  # (K,) float64 sum of PC_f * closeness to facility f
+    task_cluster: np.ndarray  # (K,) int64 connected-fire id (-1 for search)
+    task_block: np.ndarray  # (K,) int64 index (into tasks) of the search block holding the task
+    facility_kinds: tuple[str, ...]
+    facility_pos: np.ndarray  # (F, 2) float64
+    facility_rect: np.ndarray  # (F, 4) float64 open footprint x0, x1, y0, y1
+    facility_penalty: np.ndarray  # (F,) float64
+    threat_time_s: np.ndarray  # (K, F) float64 estimated time for fire k to reach f (inf: none)
+    tile_px: tuple[float, float]
+    known_cells: int = 0
+    _extra: dict = field(default_factory=dict, repr=False)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_agents(self) -> int:
+        """Number of agents ``A``."""
+        return len(self.agent_ids)
+
+    @property
+    def n_tasks(self) -> int:
+        """Number of tasks ``K`` (fires and search blocks)."""
+        return len(self.task_ids)
+
+    @property
+    def fire_tasks(self) -> np.ndarray:
+        """(k,) indices of the fire tasks."""
+        return np.flatnonzero(self.task_kind == TaskKind.FIRE)
+
+    @property
+    def search_tasks(self) -> np.ndarray:
+        """(k,) indices of the search tasks."""
+        return np.flatnonzero(self.task_kind == TaskKind.SEARCH)
+
+    @cached_property
+    def task_index(self) -> dict[str, int]:
+        """Task id -> row."""
+        return {t: i for i, t in enumerate(self.task_ids)}
+
+    @cached_property
+    def agent_index(self) -> dict[str, int]:
+        """Agent id -> row."""
+        return {a: i for i, a in enumerate(self.agent_ids)}
+
+    # ------------------------------------------------------------------ distances
+    @cached_property
+    def agent_task_distance(self) -> np.ndarray:
+        """(A, K) straight-line px from each agent to each task."""
+        return _pairwise(self.agent_pos, self.task_pos)
+
+    @cached_property
+    def task_distance(self) -> np.ndarray:
+        """(K, K) px between tasks."""
+        return _pairwise(self.task_pos, self.task_pos)
+
+    @cached_property
+    def task_home_distance(self) -> np.ndarray:
+        """(A, K) px from each task back to each agent's depot slot."""
+        return _pairwise(self.agent_home, self.task_pos)
+
+    @cached_property
+    def agent_task_time(self) -> np.ndarray:
+        """(A, K) seconds of flight from each agent to each task."""
+        return self.agent_task_distance / self.agent_speed[:, None]
+
+    @cached_property
+    def can_do(self) -> np.ndarray:
+        """(A, K) bool: the agent's role can serve the task (fires: anyone; search: sensors)."""
+        fire = self.task_kind == TaskKind.FIRE
+        return fire[None, :] | (self.agent_can_sense[:, None] & ~fire[None, :])
+
+    @cached_property
+    def node_ids(self) -> tuple[str, ...]:
+        """All node ids in the order of :attr:`positions`: agents, depot, tasks, facilities."""
+        fac = tuple(f"facility:{i}:{k}" for i, k in enumerate(self.facility_kinds))
+        return self.agent_ids + ("depot",) + self.task_ids + fac
+
+    @cached_property
+    def positions(self) -> np.ndarray:
+        """(N, 2) positions of all nodes in :attr:`node_ids` order."""
+        return np.concatenate(
+            [self.agent_pos, self.depot_pos[None, :], self.task_pos, self.facility_pos]
+        )
+
+    @cached_property
+    def distance(self) -> np.ndarray:
+        """(N, N) straight-line travel distance between all nodes (px)."""
+        return _pairwise(self.positions, self.positions)
+
+    # ------------------------------------------------------------------ networkx
+    @cached_property
+    def graph(self):
+        """The task graph as a :class:`networkx.DiGraph` (built on first access)."""
+        import networkx as nx
+
+        g = nx.DiGraph(tick=self.tick, time_s=self.time_s, world_size=self.world_size)
+        from fcplan.scenario import Role
+
+        for i, a in enumerate(self.agent_ids):
+            g.add_node(
+                a,
+                kind="agent",
+                role=Role(int(self.agent_role[i])).name.lower(),
+                pos=tuple(self.agent_pos[i]),
+                z=float(self.agent_z[i]),
+                speed=float(self.agent_speed[i]),
+                range_px=float(self.agent_range[i]),
+                battery=float(self.agent_battery[i]),
+                tank=int(self.agent_tank[i]),
+                mode=Mode(int(self.agent_mode[i])).name.lower(),
+            )
+        g.add_node("depot", kind="depot", pos=tuple(self.depot_pos))
+        for k, t in enumerate(self.task_ids):
+            fire = self.task_kind[k] == TaskKind.FIRE
+            g.add_node(
+                t,
+                kind="fire" if fire else "search",
+                pos=tuple(self.task_pos[k]),
+                value=float(self.task_value[k]),
+                cells=int(self.task_cells[k]),
+                staleness_s=float(self.task_staleness[k]),
+                threat=float(self.task_threat[k]),
+                cluster=int(self.task_cluster[k]),
+            )
+        fac_ids = self.node_ids[len(self.agent_ids) + 1 + len(self.task_ids) :]
+        for f, fid in enumerate(fac_ids):
+            g.add_node(
+                fid,
+                kind="facility",
+                facility=self.facility_kinds[f],
+                pos=tuple(self.facility_pos[f]),
+                penalty=float(self.facility_penalty[f]),
+            )
+        for k in self.fire_tasks:
+            t = self.task_ids[k]
+            b = int(self.task_block[k])
+            if b >= 0:
+                g.add_edge(t, self.task_ids[b], kind="requires")
+            for f in np.flatnonzero(np.isfinite(self.threat_time_s[k])):
+                g.add_edge(
+                    t, fac_ids[f], kind="threatens", time_s=float(self.threat_time_s[k, f])
+                )
+        times = self.agent_task_time
+        can = self.can_do
+        for i, a in enumerate(self.agent_ids):
+            for k in np.flatnonzero(can[i]):
+                g.add_edge(a, self.task_ids[k], kind="can_do", time_s=float(times[i, k]))
+        return g
+
+
+def _pairwise(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    d = a[:, None, :] - b[None, :, :]
+    return np.sqrt(np.einsum("ijk,ijk->ij", d, d))
+
+
+def _rect_distance(points: np.ndarray, rects: np.ndarray) -> np.ndarray:
+    """(P, F) distance from points to axis-aligned rectangles (0 inside)."""
+    dx = np.maximum(np.maximum(rects[None, :, 0] - points[:, None, 0], 0.0),
+                    points[:, None, 0] - rects[None, :, 1])
+    dy = np.maximum(np.maximum(rects[None, :, 2] - points[:, None, 1], 0.0),
+                    points[:, None, 1] - rects[None, :, 3])
+    return np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+
+
+def default_tile(team) -> tuple[float, float]:
+    """90 % of the smallest dump field of view among action/hybrid agents."""
+    from fcplan.team import ACTION_ALTITUDE
+
+    acting = np.flatnonzero(team.can_act)
+    if acting.size == 0:
+        return (54.0, 31.0)
+    z = np.where(team.role[acting] == 1, ACTION_ALTITUDE, team.alt_lo[acting])
+    hx, hy = fov_half_extent(z.min())
+    return (float(np.floor(1.8 * hx)), float(np.floor(1.8 * hy)))
+
+
+def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = None) -> TaskGraph:
+    """Build the task graph from the scenario, the team's own state and the belief.
+
+    Parameters
+    ----------
+    scenario : fcplan.scenario.Scenario
+    team : fcplan.team.Team
+        The agents' own states (the team always knows where it is and what it has left).
+    belief : fcplan.belief.Belief
+        What the team knows about the fire and what it has covered.
+    params : TaskGraphParams, optional
+    """
+    p = params or TaskGraphParams()
+    w = scenario.world_size
+    tps = scenario.ticks_per_second
+    tick = belief.tick
+    tile = p.tile_px or default_tile(team)
+    tw, th = float(tile[0]), float(tile[1])
+
+    facilities = scenario.scored_facilities
+    fac_pos = np.array([f.center for f in facilities], dtype=np.float64).reshape(-1, 2)
+    fac_rect = np.array([f.footprint for f in facilities], dtype=np.float64).reshape(-1, 4)
+    fac_pen = np.array([f.penalty for f in facilities], dtype=np.float64)
+
+    # ---- search blocks
+    blk = int(p.search_block_px)
+    nb = -(-w // blk)
+    age = belief.coverage_age_s(blk)  # (nb, nb) indexed [bx, by]
+    bx, by = np.meshgrid(np.arange(nb), np.arange(nb), indexing="ij")
+    bx, by = bx.ravel(), by.ravel()
+    search_pos = np.stack(
+        [np.minimum((bx + 0.5) * blk, w - 1.0), np.minimum((by + 0.5) * blk, w - 1.0)], axis=1
+    )
+    search_age = age.ravel()
+
+    # ---- fire tiles from known cells
+    xy = belief.known_xy()
+    if len(xy):
+        ntx = int(np.ceil(w / tw))
+        tx = (xy[:, 0] // tw).astype(np.int64)
+        ty = (xy[:, 1] // th).astype(np.int64)
+        key = tx * (int(np.ceil(w / th)) + 1) + ty
+        order = np.argsort(key, kind="stable")
+        ks = key[order]
+        starts = np.flatnonzero(np.r_[True, ks[1:] != ks[:-1]])
+        xs, ys = xy[order, 0].astype(np.float64), xy[order, 1].astype(np.float64)
+        seen = belief.last_seen[xy[order, 0], xy[order, 1]]
+        x0 = np.minimum.reduceat(xs, starts)
+        x1 = np.maximum.reduceat(xs, starts)
+        y0 = np.minimum.reduceat(ys, starts)
+        y1 = np.maximum.reduceat(ys, starts)
+        last = np.maximum.reduceat(seen, starts)
+        counts = np.diff(np.r_[starts, len(ks)])
+        fire_pos = np.stack([(x0 + x1) / 2.0, (y0 + y1) / 2.0], axis=1)
+        fire_stale = (tick - last) / tps
+        tile_x, tile_y = tx[order][starts], ty[order][starts]
+        cluster = _clusters(tile_x, tile_y, ntx, int(np.ceil(w / th)) + 1)
+    else:
+        fire_pos = np.zeros((0, 2))
+        fire_stale = np.zeros(0)
+        counts = np.zeros(0, dtype=np.int64)
+        cluster = np.zeros(0, dtype=np.int64)
+
+    n_fire = len(fire_pos)
+    # threat: penalty-weighted closeness of each fire tile to each facility footprint
+    if n_fire and len(fac_pos):
+        d_fac = _rect_distance(fire_pos, fac_rect)
+        close = np.clip(1.0 - d_fac / p.threat_radius_px, 0.0, 1.0)
+        threat = close @ fac_pen
+        fuel = max((r.fuel for r in scenario.regions), default=1.0)
+        speed = max(0.24 * fuel * 10.0, 1e-9)  # px/s, first-tick spread at wind 5 (fastest)
+        threat_time = np.where(d_fac < p.threat_radius_px, d_fac / speed, np.inf)
+    else:
+        threat = np.zeros(n_fire)
+        threat_time = np.full((n_fire, len(fac_pos)), np.inf)
+
+    # search value: age (capped) times (1 + nearby known fire)
+    near_fire = np.zeros(nb * nb)
+    if n_fire:
+        fb = (np.minimum(fire_pos[:, 0] // blk, nb - 1) * nb + np.minimum(fire_pos[:, 1] // blk, nb - 1)).astype(np.int64)
+        near = np.bincount(fb, weights=counts, minlength=nb * nb).reshape(nb, nb)
+        # spread to the 8 neighbours: fire grows across block borders
+        padded = np.pad(near, 1)
+        near_fire = sum(
+            padded[1 + dx : 1 + dx + nb, 1 + dy : 1 + dy + nb]
+            for dx in (-1, 0, 1)
+            for dy in (-1, 0, 1)
+        ).ravel()
+        fire_block = n_fire + fb
+    else:
+        fire_block = np.zeros(0, dtype=np.int64)
+    search_value = np.minimum(search_age, p.search_value_cap_s) * (1.0 + np.minimum(near_fire, 50) / 10.0)
+
+    fire_ids = tuple(
+        f"fire:{int(x)}:{int(y)}" for x, y in zip(fire_pos[:, 0], fire_pos[:, 1], strict=True)
+    )
+    search_ids = tuple(f"search:{grid_block_name(int(a), int(b))}" for a, b in zip(bx, by, strict=True))
+    # keep ids unique when two tiles round to the same point
+    if len(set(fire_ids)) != len(fire_ids):
+        fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))
+
+    k_total = n_fire + len(search_pos)
+    task_kind = np.r_[np.full(n_fire, TaskKind.FIRE), np.full(len(search_pos), TaskKind.SEARCH)]
+    zeros_s = np.zeros(len(search_pos))
+
+    range_px = team.range_px()
+    return TaskGraph(
+        tick=tick,
+        time_s=tick / tps,
+        world_size=w,
+        depot_pos=np.asarray(scenario.depot.center, dtype=np.float64),
+        agent_ids=team.ids,
+        agent_role=team.role.copy(),
+        agent_pos=team.pos.copy(),
+        agent_z=team.z.copy(),
+        agent_alt_range=np.stack([team.alt_lo, team.alt_hi], axis=1),
+        agent_speed=team.speed * tps,
+        agent_range=range_px,
+        agent_full_range=team.battery_capacity / DRAIN_PER_PX,
+        agent_battery=team.battery.copy(),
+        agent_tank=team.tank.copy(),
+        agent_tank_capacity=team.tank_capacity.copy(),
+        agent_mode=team.mode.copy(),
+        agent_home=team.home.copy(),
+        agent_can_sense=team.can_sense.copy(),
+        agent_can_act=team.can_act.copy(),
+        task_ids=fire_ids + search_ids,
+        task_kind=task_kind.astype(np.int8),
+        task_pos=np.concatenate([fire_pos, search_pos]).reshape(k_total, 2),
+        task_value=np.r_[counts * (1.0 + threat), search_value],
+        task_cells=np.r_[counts, np.zeros(len(search_pos), dtype=np.int64)].astype(np.int64),
+        task_staleness=np.r_[fire_stale, search_age],
+        task_threat=np.r_[threat, zeros_s],
+        task_cluster=np.r_[cluster, np.full(len(search_pos), -1)].astype(np.int64),
+        task_block=np.r_[fire_block, np.full(len(search_pos), -1)].astype(np.int64),
+        facility_kinds=tuple(f.kind for f in facilities),
+        facility_pos=fac_pos,
+        facility_rect=fac_rect,
+        facility_penalty=fac_pen,
+        threat_time_s=threat_time,
+        tile_px=(tw, th),
+        known_cells=int(counts.sum()),
+    )
+
+
+def _clusters(tx: np.ndarray, ty: np.ndarray, nx_: int, ny_: int) -> np.ndarray:
+    """Connected-fire labels of occupied tiles (8-connectivity)."""
+    from scipy.ndimage import label
+
+    grid = np.zeros((nx_ + 1, ny_ + 1), dtype=bool)
+    grid[tx, ty] = True
+    labels, _ = label(grid, structure=np.ones((3, 3), dtype=bool))
+    return labels[tx, ty].astype(np.int64) - 1

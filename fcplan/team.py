@@ -1,0 +1,369 @@
+"""The composite team: motion, altitude and field of view, battery, tank, depot, and agent commands.
+
+Agents are held as arrays (one row per agent, scenario order: perception, action, hybrid) so a tick
+moves the whole team with a few numpy operations. Only agents that *arrive* somewhere (a goal, the
+depot) are handled one by one, which happens a few times per second at most.
+
+Rules (ARCHITECTURE.md "Agents", FIRECOMMANDER.md section 4, rescaled to ``ticks_per_second``):
+
+* **Motion.** An agent flies straight at its own speed (scenario px per tick at 10 Hz) to its
+  current goal; when closer than one step it snaps onto the goal and takes the next one. After the
+  last goal it hovers, unless its route is a patrol loop, which repeats.
+* **Altitude.** Perception and hybrid agents climb or descend toward their commanded altitude at
+  5 m per 0.1 s, within their altitude bounds; action agents fly at 30 m.
+* **Field of view.** A rectangle centred on the agent, ``2 z`` wide (x) and ``2 tan(pi/6) z``
+  (about ``1.1547 z``) high (y); cell ``(i, j)`` is inside when ``|i - x| <= z`` and
+  ``|j - y| <= 0.57735 z`` (inclusive, as the reference).
+* **Battery.** Flying drains 0.1 per px and hovering 0.05 per 0.1 s. An active agent heads home
+  (and later resumes its route) as soon as its remaining battery would no longer cover the flight
+  home after one more step, so the battery never goes negative.
+* **Tank and dumps.** Arriving at a goal arms one dump. An armed action or hybrid agent dumps as
+  soon as a dump can do something (see :mod:`fcplan.world`): one tank unit per dump, so tank ``T``
+  gives ``T`` dumps (the 2020 code gave ``T + 1``). An empty tank sends the agent home.
+* **Depot.** At home the agent recharges and refills at once; after a forced return it resumes
+  its route, after a commanded return (or the 3-second rule) it stays idle.
+* **3-second rule.** An action agent hovering at its last goal for 3 s goes home and idles.
+
+Examples
+--------
+>>> from fcplan.scenario import load_scenario
+>>> from fcplan.team import Team, Command
+>>> team = Team(load_scenario("practice"))
+>>> team.apply({"A1": Command(route=((400.0, 400.0),))})
+>>> team.move()  # doctest: +ELLIPSIS
+array([...])
+>>> bool(team.pos[team.index("A1"), 0] > 60)
+True
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from enum import IntEnum
+
+import numpy as np
+
+from fcplan.errors import PlanError
+
+__all__ = ["Mode", "Command", "Team", "fov_half_extent", "sensing_confidence"]
+
+FOV_TAN_X = math.tan(math.pi / 4)  # half-width per metre of altitude
+FOV_TAN_Y = math.tan(math.pi / 6)  # half-height per metre of altitude
+DRAIN_PER_PX = 0.1
+DRAIN_PER_HOVER_TICK = 0.05  # at 10 ticks/s
+ACTION_ALTITUDE = 30.0
+CLIMB_PER_TICK = 5.0  # m per tick at 10 ticks/s
+ACTION_IDLE_LIMIT_S = 3.0
+
+
+class Mode(IntEnum):
+    """What an agent is doing."""
+
+    IDLE = 0  #: at its depot slot with nothing to do
+    ACTIVE = 1  #: following its route (or hovering at its last goal)
+    RETURNING = 2  #: forced home (battery or tank); resumes its route after recharging
+    HOMING = 3  #: sent home (command or 3-second rule); stays idle there
+
+
+@dataclass(frozen=True, slots=True)
+class Command:
+    """An instruction to one agent, applied at the start of a tick.
+
+    Parameters
+    ----------
+    route : sequence of (x, y), optional
+        New goals, replacing the current ones (``None`` keeps the route). An empty route stops
+        the agent where it is (it hovers).
+    patrol : bool
+        Repeat the route as a loop.
+    altitude : float, optional
+        Target altitude for perception and hybrid agents (clipped to the agent's bounds).
+    home : bool
+        Fly home and stay idle there.
+    """
+
+    route: Sequence[tuple[float, float]] | None = None
+    patrol: bool = False
+    altitude: float | None = None
+    home: bool = False
+
+
+def fov_half_extent(z: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+    """Half width (x) and half height (y) of the field of view at altitude ``z``.
+
+    Examples
+    --------
+    >>> hx, hy = fov_half_extent(30.0)
+    >>> float(2 * hx), round(float(2 * hy), 1)
+    (60.0, 34.6)
+    """
+    z = np.asarray(z, dtype=np.float64)
+    return FOV_TAN_X * z, FOV_TAN_Y * z
+
+
+def sensing_confidence(z: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Probability to sense a burning cell in view: 1 at the lowest altitude, 0.4 at the highest.
+
+    ``c = 1 - 0.6 (z - lo) / (hi - lo)``, or 1 when ``lo == hi``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sensing_confidence(np.array([10.0, 55.0, 100.0]), 10.0, 100.0).round(2).tolist()
+    [1.0, 0.7, 0.4]
+    """
+    z, lo, hi = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (z, lo, hi)))
+    span = hi - lo
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = np.where(span > 0, 1.0 - 0.6 * (z - lo) / np.where(span > 0, span, 1.0), 1.0)
+    return np.clip(c, 0.4, 1.0)
+
+
+class Team:
+    """State of every agent, as arrays.
+
+    Parameters
+    ----------
+    scenario : fcplan.scenario.Scenario
+        Supplies the agents (role, start, altitude bounds, battery, speed, tank, confidence).
+
+    Attributes
+    ----------
+    ids : tuple of str
+        Agent ids (``"P1"``, ``"A1"``, ``"H1"`` ...), one per row.
+    role : ndarray, (N,) int8
+        :class:`fcplan.scenario.Role` values.
+    pos : ndarray, (N, 2) float64
+        Planar position (px).
+    z : ndarray, (N,) float64
+        Altitude (m).
+    speed : ndarray, (N,) float64
+        Px per tick at this scenario's tick rate.
+    battery : ndarray, (N,) float64
+        Remaining battery; never negative.
+    tank : ndarray, (N,) int64
+        Remaining dumps (0 for perception agents).
+    mode : ndarray, (N,) int8
+        :class:`Mode` values.
+    """
+
+    def __init__(self, scenario) -> None:
+        from fcplan.scenario import Role
+
+        agents = scenario.agents
+        self.ids = tuple(a.id for a in agents)
+        self._index = {a: i for i, a in enumerate(self.ids)}
+        n = len(agents)
+        self.n = n
+        self.tick_scale = 10.0 / scenario.ticks_per_second  # 10 Hz quantities -> this rate
+        self.dt_s = 1.0 / scenario.ticks_per_second
+        self.role = np.array([int(a.role) for a in agents], dtype=np.int8)
+        self.can_sense = np.isin(self.role, (int(Role.PERCEPTION), int(Role.HYBRID)))
+        self.can_act = np.isin(self.role, (int(Role.ACTION), int(Role.HYBRID)))
+        self.home = np.array([a.start for a in agents], dtype=np.float64).reshape(n, 2)
+        self.alt_lo = np.array([a.altitude[0] for a in agents], dtype=np.float64)
+        self.alt_hi = np.array([a.altitude[1] for a in agents], dtype=np.float64)
+        self.z_start = np.array([a.start_altitude for a in agents], dtype=np.float64)
+        self.speed = np.array([a.speed for a in agents], dtype=np.float64) * self.tick_scale
+        self.battery_capacity = np.array([a.battery for a in agents], dtype=np.float64)
+        self.tank_capacity = np.array([a.tank for a in agents], dtype=np.int64)
+        self.prune_confidence = np.array([a.prune_confidence for a in agents], dtype=np.float64)
+        self.reset()
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Every agent at its depot slot, full battery and tank, idle."""
+        n = self.n
+        self.pos = self.home.copy()
+        self.z = self.z_start.copy()
+        self.z_target = self.z_start.copy()
+        self.battery = self.battery_capacity.copy()
+        self.tank = self.tank_capacity.copy()
+        self.mode = np.full(n, Mode.IDLE, dtype=np.int8)
+        self.goal = self.home.copy()
+        self.has_goal = np.zeros(n, dtype=bool)
+        self.armed = np.zeros(n, dtype=bool)
+        self.hover_s = np.zeros(n, dtype=np.float64)
+        self.distance = np.zeros(n, dtype=np.float64)
+        self.dumps = np.zeros(n, dtype=np.int64)
+        self.sorties = np.zeros(n, dtype=np.int64)
+        self.routes: list[np.ndarray] = [np.zeros((0, 2)) for _ in range(n)]
+        self.goal_index = np.zeros(n, dtype=np.int64)
+        self.patrol = np.zeros(n, dtype=bool)
+
+    def index(self, agent: str | int) -> int:
+        """Row of an agent given its id (``"P1"``) or row number."""
+        if isinstance(agent, (int, np.integer)):
+            if not 0 <= int(agent) < self.n:
+                raise PlanError(f"agent index {agent} is out of range 0..{self.n - 1}")
+            return int(agent)
+        try:
+            return self._index[agent]
+        except KeyError:
+            raise PlanError(
+                f"unknown agent {agent!r}; this team has {', '.join(self.ids)}"
+            ) from None
+
+    @property
+    def at_home(self) -> np.ndarray:
+        """(N,) bool: standing on its depot slot."""
+        return np.all(self.pos == self.home, axis=1)
+
+    def fov_rects(self) -> np.ndarray:
+        """(N, 4) float64 ``[x0, x1, y0, y1]`` inclusive field-of-view bounds of every agent."""
+        hx, hy = fov_half_extent(self.z)
+        x, y = self.pos[:, 0], self.pos[:, 1]
+        return np.stack([x - hx, x + hx, y - hy, y + hy], axis=1)
+
+    def sensing_confidence(self) -> np.ndarray:
+        """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""
+        c = sensing_confidence(self.z, self.alt_lo, self.alt_hi)
+        return np.where(self.can_sense, c, 0.0)
+
+    def return_cost(self) -> np.ndarray:
+        """(N,) battery needed to fly straight home from where each agent is."""
+        return DRAIN_PER_PX * np.hypot(*(self.home - self.pos).T)
+
+    # ------------------------------------------------------------------ commands
+    def apply(self, commands: Mapping[str | int, Command] | None) -> None:
+        """Apply commands (by agent id or row). A forced return keeps going; the new route is
+        what the agent resumes after recharging."""
+        if not commands:
+            return
+        for key, cmd in commands.items():
+            i = self.index(key)
+            if cmd.altitude is not None and self.can_sense[i]:
+                self.z_target[i] = float(np.clip(cmd.altitude, self.alt_lo[i], self.alt_hi[i]))
+            if cmd.home:
+                if self.mode[i] != Mode.IDLE or not self.at_home[i]:
+                    self.mode[i] = Mode.HOMING
+                self.routes[i] = np.zeros((0, 2))
+                self.goal_index[i] = 0
+                self.patrol[i] = False
+                self.has_goal[i] = False
+                continue
+            if cmd.route is None:
+                continue
+            route = np.asarray(cmd.route, dtype=np.float64).reshape(-1, 2)
+            if not np.isfinite(route).all():
+                raise PlanError(f"agent {self.ids[i]}: route has a non-finite coordinate")
+            self.routes[i] = route
+            self.goal_index[i] = 0
+            self.patrol[i] = bool(cmd.patrol) and len(route) > 1
+            self.hover_s[i] = 0.0
+            if self.mode[i] == Mode.RETURNING:
+                continue
+            if len(route) == 0:
+                self.has_goal[i] = False
+                if self.mode[i] == Mode.HOMING:
+                    continue
+                self.mode[i] = Mode.ACTIVE if not self.at_home[i] else Mode.IDLE
+                continue
+            self.mode[i] = Mode.ACTIVE
+            self.has_goal[i] = True
+            self.goal[i] = route[0]
+
+    # ------------------------------------------------------------------ dynamics
+    def move(self) -> np.ndarray:
+        """Move every agent one tick; return the rows that arrived at a route goal this tick."""
+        mode = self.mode
+        active = mode == Mode.ACTIVE
+        going_home = (mode == Mode.RETURNING) | (mode == Mode.HOMING)
+        target = np.where(going_home[:, None], self.home, self.goal)
+        flying = going_home | (active & self.has_goal)
+        d = target - self.pos
+        dist = np.hypot(d[:, 0], d[:, 1])
+        arrive = flying & (dist <= self.speed)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            unit = np.where(dist[:, None] > 0, d / dist[:, None], 0.0)
+        step = np.where(arrive, dist, np.where(flying, self.speed, 0.0))
+        self.pos = np.where(arrive[:, None], target, self.pos + unit * step[:, None])
+        self.distance += step
+        hovering = active & ~flying
+        self.battery -= DRAIN_PER_PX * step + DRAIN_PER_HOVER_TICK * self.tick_scale * hovering
+        self.hover_s = np.where(hovering, self.hover_s + self.dt_s, 0.0)
+        # altitude
+        climb = CLIMB_PER_TICK * self.tick_scale
+        dz = np.clip(self.z_target - self.z, -climb, climb)
+        self.z = self.z + np.where(self.can_sense, dz, 0.0)
+
+        arrived_goal = np.flatnonzero(arrive & active)
+        for i in np.flatnonzero(arrive & going_home):
+            self._dock(int(i))
+        for i in arrived_goal:
+            self._next_goal(int(i))
+        self._rules()
+        return arrived_goal
+
+    def _next_goal(self, i: int) -> None:
+        if self.can_act[i] and self.tank[i] > 0:
+            self.armed[i] = True
+        route = self.routes[i]
+        k = self.goal_index[i] + 1
+        if k >= len(route):
+            if self.patrol[i]:
+                k = 0
+            else:
+                self.goal_index[i] = len(route)
+                self.has_goal[i] = False
+                return
+        self.goal_index[i] = k
+        self.goal[i] = route[k]
+
+    def _dock(self, i: int) -> None:
+        self.battery[i] = self.battery_capacity[i]
+        self.tank[i] = self.tank_capacity[i]
+        self.sorties[i] += 1
+        route = self.routes[i]
+        k = self.goal_index[i]
+        if self.mode[i] == Mode.RETURNING and k < len(route):
+            self.mode[i] = Mode.ACTIVE
+            self.has_goal[i] = True
+            self.goal[i] = route[k]
+        else:
+            self.mode[i] = Mode.IDLE
+            self.has_goal[i] = False
+            self.routes[i] = np.zeros((0, 2))
+            self.goal_index[i] = 0
+            self.patrol[i] = False
+        self.armed[i] = False
+
+    def _rules(self) -> None:
+        """Battery reserve, and the 3-second rule for action agents."""
+        active = self.mode == Mode.ACTIVE
+        if not active.any():
+            return
+        # Reserve: after one more step (which can also lengthen the way home by one step) the
+        # agent must still afford the flight home, plus one hover tick of margin.
+        reserve = (
+            self.return_cost()
+            + 2.0 * DRAIN_PER_PX * self.speed
+            + 2.0 * DRAIN_PER_HOVER_TICK * self.tick_scale
+        )
+        low = active & (self.battery <= reserve)
+        self.mode[low] = Mode.RETURNING
+        from fcplan.scenario import Role
+
+        idle_action = (
+            (self.mode == Mode.ACTIVE)
+            & (self.role == int(Role.ACTION))
+            & (self.hover_s >= ACTION_IDLE_LIMIT_S - 1e-9)
+        )
+        if idle_action.any():
+            self.mode[idle_action] = Mode.HOMING
+            self.has_goal[idle_action] = False
+
+    def record_dump(self, i: int) -> None:
+        """Spend one tank unit for a dump by agent ``i``; an empty tank sends it home."""
+        self.tank[i] -= 1
+        self.dumps[i] += 1
+        self.armed[i] = False
+        if self.tank[i] <= 0 and self.mode[i] == Mode.ACTIVE:
+            self.mode[i] = Mode.RETURNING
+
+    def range_px(self) -> np.ndarray:
+        """(N,) px each agent can still fly away from home and back (battery / drain, minus the
+        current way home)."""
+        return np.maximum(self.battery / DRAIN_PER_PX - np.hypot(*(self.home - self.pos).T), 0.0)

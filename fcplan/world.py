@@ -1,0 +1,326 @@
+"""The world: fire, team, sensing, pruning and facility damage, advanced one fixed tick at a time.
+
+:class:`World` is usable on its own, without any scheduler: ``reset(scenario, seed)`` then
+``step(commands)`` as often as you like. Each tick runs, in this order (the reference MARL order):
+
+1. apply the commands (:class:`fcplan.team.Command` per agent id);
+2. agents move, dock, recharge, and apply the battery and 3-second rules;
+3. the fire propagates (regions activate after their delay);
+4. every perception/hybrid agent senses: each burning cell inside its field of view is sensed
+   independently with the agent's altitude confidence; a sensed cell stays sensed;
+5. every armed action/hybrid agent dumps if a dump can do something: each *sensed* burning cell in
+   its field of view is pruned with its prune confidence (the manual's rule that action needs
+   perception first). With ``scenario.action_gate == "reference"`` the 2020 code's looser gate is
+   used instead: every burning cell in view may be pruned, provided one of them was sensed or
+   nothing is sensed anywhere;
+6. facility counts and the trace row are updated.
+
+Randomness comes from four independent streams spawned from the seed (fire, sensing, pruning, and
+one for whoever controls the team, :attr:`World.controller_rng`), so the fire's evolution depends
+only on the seed and on where cells were pruned.
+
+Examples
+--------
+>>> from fcplan import World, load_scenario
+>>> from fcplan.team import Command
+>>> world = World().reset(load_scenario("practice"), seed=0)
+>>> info = world.step({"P1": Command(route=((350.0, 350.0),), altitude=60.0)})
+>>> while not world.done:
+...     info = world.step()
+>>> world.tick == world.scenario.n_ticks
+True
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from fcplan.fire import BURNING, Fire
+from fcplan.team import Command, Team
+from fcplan.trace import AgentTrace, Trace
+
+__all__ = ["World", "StepInfo"]
+
+_EMPTY = np.zeros(0, dtype=np.int64)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class StepInfo:
+    """What happened during one tick (flat cell indices are ``x * W + y``)."""
+
+    tick: int
+    time_s: float
+    ignited: np.ndarray  # (k,) int64 cells that started burning
+    sensed: np.ndarray  # (k,) int64 cells sensed this tick (unique)
+    newly_sensed: np.ndarray  # (k,) int64 cells sensed for the first time
+    pruned: np.ndarray  # (k,) int64 cells put out this tick
+    fov: np.ndarray  # (N, 4) float64 [x0, x1, y0, y1] of every agent after moving
+    dumped: tuple[int, ...]  # rows of agents that dumped
+    arrived: tuple[int, ...]  # rows of agents that reached a route goal
+
+
+def _rect_slices(rect: np.ndarray, w: int) -> tuple[int, int, int, int] | None:
+    """Integer cell range covered by an inclusive rectangle, clipped to the map, or None."""
+    x0 = max(math.ceil(rect[0]), 0)
+    x1 = min(math.floor(rect[1]), w - 1)
+    y0 = max(math.ceil(rect[2]), 0)
+    y1 = min(math.floor(rect[3]), w - 1)
+    if x1 < x0 or y1 < y0:
+        return None
+    return x0, x1 + 1, y0, y1 + 1
+
+
+class World:
+    """Fire, team and scoring state of one episode.
+
+    Parameters
+    ----------
+    scenario : fcplan.scenario.Scenario, optional
+        If given, the world is reset at once with ``seed``.
+    seed : int, numpy.random.SeedSequence or numpy.random.Generator, optional
+
+    Attributes
+    ----------
+    scenario : Scenario
+    fire : fcplan.fire.Fire
+    team : fcplan.team.Team
+    sensed : ndarray, (W, W) bool
+        Cells sensed at least once.
+    facility_burning, facility_pruned : ndarray, (F,) int64
+        Per scored facility (houses, hospitals, power stations, depot last): burning cells inside
+        its footprint, and cumulative pruned cells inside it.
+    """
+
+    def __init__(self, scenario=None, seed=None) -> None:
+        self.scenario = None
+        if scenario is not None:
+            self.reset(scenario, seed)
+
+    # ------------------------------------------------------------------ setup
+    def reset(self, scenario=None, seed=None) -> World:
+        """Start a new episode (same scenario if none is given); return ``self``."""
+        if scenario is None:
+            scenario = self.scenario
+            if scenario is None:
+                raise ValueError("World.reset needs a scenario the first time")
+        self.scenario = scenario
+        self.seed = seed
+        streams = _spawn(seed, 4)
+        rng_fire, self.rng_sense, self.rng_prune, self.controller_rng = streams
+        w = scenario.world_size
+        self.world_size = w
+        self.fire = Fire(scenario.regions, w, scenario.ticks_per_second, rng_fire)
+        self.team = Team(scenario)
+        self.sensed = np.zeros((w, w), dtype=bool)
+        self._sensed_flat = self.sensed.reshape(-1)
+        self._state_flat = self.fire.state.reshape(-1)
+        facilities = scenario.scored_facilities
+        self.facility_labels = np.full((w, w), -1, dtype=np.int16)
+        for f, fac in enumerate(facilities):
+            x0, x1, y0, y1 = fac.footprint  # open bounds: x0 < x < x1
+            xs, xe = max(math.floor(x0) + 1, 0), min(math.ceil(x1) - 1, w - 1)
+            ys, ye = max(math.floor(y0) + 1, 0), min(math.ceil(y1) - 1, w - 1)
+            if xe >= xs and ye >= ys:
+                self.facility_labels[xs : xe + 1, ys : ye + 1] = f
+        self._labels_flat = self.facility_labels.reshape(-1)
+        self.n_facilities = len(facilities)
+        self.facility_penalties = np.array([f.penalty for f in facilities], dtype=np.float64)
+        self.facility_burning = np.zeros(self.n_facilities, dtype=np.int64)
+        self.facility_pruned = np.zeros(self.n_facilities, dtype=np.int64)
+        self.n_sensed_active = 0
+        self.n_sensed_ever = 0
+        self.tick = 0
+        self._alloc_trace(scenario.n_ticks)
+        return self
+
+    def _alloc_trace(self, rows: int) -> None:
+        n, f = self.team.n, self.n_facilities
+        rows = max(rows, 1)
+        self._rows = {
+            "active": np.zeros(rows, np.int64),
+            "pruned": np.zeros(rows, np.int64),
+            "sensed_active": np.zeros(rows, np.int64),
+            "sensed_ever": np.zeros(rows, np.int64),
+            "facility_burning": np.zeros((rows, f), np.int64),
+            "facility_pruned": np.zeros((rows, f), np.int64),
+            "xyz": np.zeros((rows, n, 3), np.float64),
+            "battery": np.zeros((rows, n), np.float64),
+            "tank": np.zeros((rows, n), np.int16),
+            "mode": np.zeros((rows, n), np.int8),
+            "dumps": np.zeros((rows, n), np.int16),
+        }
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def time_s(self) -> float:
+        """Simulated seconds elapsed."""
+        return self.tick / self.scenario.ticks_per_second
+
+    @property
+    def done(self) -> bool:
+        """True once the scenario's duration has been simulated."""
+        return self.tick >= self.scenario.n_ticks
+
+    def trace(self) -> Trace:
+        """The per-tick record so far (copies), ready for :func:`fcplan.metrics.compute_metrics`."""
+        t = self.tick
+        r = {k: v[:t].copy() for k, v in self._rows.items()}
+        sc = self.scenario
+        agents = AgentTrace(
+            ids=self.team.ids,
+            xyz=r["xyz"],
+            battery=r["battery"],
+            tank=r["tank"],
+            mode=r["mode"],
+            dumps=r["dumps"],
+        )
+        return Trace(
+            ticks_per_second=sc.ticks_per_second,
+            active=r["active"],
+            pruned=r["pruned"],
+            sensed_active=r["sensed_active"],
+            sensed_ever=r["sensed_ever"],
+            facility_burning=r["facility_burning"],
+            facility_pruned=r["facility_pruned"],
+            facility_kinds=tuple(f.kind for f in sc.scored_facilities),
+            facility_penalties=self.facility_penalties.copy(),
+            region_delays_s=np.array([r_.delay_s for r_ in sc.regions], np.float64),
+            fire_mode=sc.fire_mode,
+            propagation_weight=sc.scoring.propagation_weight,
+            temporal_exponent=sc.scoring.temporal_exponent,
+            agents=agents,
+        )
+
+    # ------------------------------------------------------------------ dynamics
+    def step(self, commands: Mapping[str | int, Command] | None = None) -> StepInfo:
+        """Advance one tick with optional per-agent commands; return what happened."""
+        if self.scenario is None:
+            raise ValueError("World.step before World.reset")
+        team, fire = self.team, self.fire
+        team.apply(commands)
+        arrived = team.move()
+        self.tick += 1
+        ignited = fire.step()
+        if ignited.size:
+            self._count_facilities(ignited, +1)
+        fov = team.fov_rects()
+        sensed, newly = self._sense(fov)
+        pruned, dumped = self._prune(fov)
+        self._record()
+        return StepInfo(
+            tick=self.tick,
+            time_s=self.time_s,
+            ignited=ignited,
+            sensed=sensed,
+            newly_sensed=newly,
+            pruned=pruned,
+            fov=fov,
+            dumped=tuple(dumped),
+            arrived=tuple(int(i) for i in arrived),
+        )
+
+    def _count_facilities(self, flat: np.ndarray, sign: int) -> np.ndarray:
+        lab = self._labels_flat[flat]
+        lab = lab[lab >= 0]
+        if lab.size == 0:
+            return lab
+        counts = np.bincount(lab, minlength=self.n_facilities)
+        self.facility_burning += sign * counts
+        return counts
+
+    def _sense(self, fov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        team, w = self.team, self.world_size
+        conf = team.sensing_confidence()
+        state = self.fire.state
+        parts = []
+        for i in np.flatnonzero(team.can_sense):
+            sl = _rect_slices(fov[i], w)
+            if sl is None:
+                continue
+            x0, x1, y0, y1 = sl
+            bx, by = np.nonzero(state[x0:x1, y0:y1] == BURNING)
+            if bx.size == 0:
+                continue
+            keep = self.rng_sense.random(bx.size) < conf[i]
+            if keep.any():
+                parts.append((bx[keep] + x0) * w + (by[keep] + y0))
+        if not parts:
+            return _EMPTY, _EMPTY
+        sensed = parts[0] if len(parts) == 1 else np.unique(np.concatenate(parts))
+        newly = sensed[~self._sensed_flat[sensed]]
+        if newly.size:
+            self._sensed_flat[newly] = True
+            self.n_sensed_active += int(newly.size)
+            self.n_sensed_ever += int(newly.size)
+        return sensed, newly
+
+    def _prune(self, fov: np.ndarray) -> tuple[np.ndarray, list[int]]:
+        team, w = self.team, self.world_size
+        armed = np.flatnonzero(team.armed & team.can_act & (team.tank > 0))
+        if armed.size == 0:
+            return _EMPTY, []
+        reference_gate = self.scenario.action_gate == "reference"
+        state, sensed = self.fire.state, self.sensed
+        parts, dumped = [], []
+        for i in armed:
+            sl = _rect_slices(fov[i], w)
+            if sl is None:
+                continue
+            x0, x1, y0, y1 = sl
+            burning = state[x0:x1, y0:y1] == BURNING
+            seen = burning & sensed[x0:x1, y0:y1]
+            if reference_gate:
+                if not (seen.any() or self.n_sensed_active == 0) or not burning.any():
+                    continue
+                cand = burning
+            else:
+                if not seen.any():
+                    continue
+                cand = seen
+            bx, by = np.nonzero(cand)
+            keep = self.rng_prune.random(bx.size) < team.prune_confidence[i]
+            flat = (bx[keep] + x0) * w + (by[keep] + y0)
+            hit = self.fire.prune(flat)
+            if hit.size:
+                counts = self._count_facilities(hit, -1)
+                if counts.size:
+                    self.facility_pruned += counts
+                self.n_sensed_active -= int(self._sensed_flat[hit].sum())
+                parts.append(hit)
+            team.record_dump(int(i))
+            dumped.append(int(i))
+        if not parts:
+            return _EMPTY, dumped
+        return (parts[0] if len(parts) == 1 else np.concatenate(parts)), dumped
+
+    def _record(self) -> None:
+        k = self.tick - 1
+        rows = self._rows
+        if k >= len(rows["active"]):
+            for name, arr in rows.items():
+                rows[name] = np.concatenate([arr, np.zeros_like(arr)])
+        team = self.team
+        rows["active"][k] = self.fire.n_burning
+        rows["pruned"][k] = self.fire.n_pruned
+        rows["sensed_active"][k] = self.n_sensed_active
+        rows["sensed_ever"][k] = self.n_sensed_ever
+        rows["facility_burning"][k] = self.facility_burning
+        rows["facility_pruned"][k] = self.facility_pruned
+        rows["xyz"][k, :, :2] = team.pos
+        rows["xyz"][k, :, 2] = team.z
+        rows["battery"][k] = team.battery
+        rows["tank"][k] = team.tank
+        rows["mode"][k] = team.mode
+        rows["dumps"][k] = team.dumps
+
+
+def _spawn(seed, n: int) -> list[np.random.Generator]:
+    """``n`` independent generators from an int, SeedSequence, Generator or None."""
+    if isinstance(seed, np.random.Generator):
+        return list(seed.spawn(n))
+    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    return [np.random.default_rng(s) for s in ss.spawn(n)]

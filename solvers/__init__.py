@@ -1,0 +1,10 @@
+"""Built-in schedulers for fcplan.
+
+Each scheduler uses only fcplan's public API and is registered by name in the
+``fcplan.schedulers`` entry-point group (see ``pyproject.toml``):
+
+* ``greedy`` (:class:`solvers.greedy.GreedyScheduler`): value-per-travel-time assignment of
+  action agents to fresh fires, with perception agents watching the fires being fought and
+  exploring stale areas;
+* ``idle`` and ``random`` (:mod:`solvers.baselines`): lower baselines.
+"""

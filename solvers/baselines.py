@@ -1,0 +1,68 @@
+"""Lower baselines: ``idle`` does nothing, ``random`` sends each agent to a random task.
+
+Examples
+--------
+>>> from fcplan import run_episode
+>>> run_episode("practice", "idle", seed=0).metrics["manual"].overall_firefighting
+0.0
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fcplan.plan import Plan
+from fcplan.scheduling import SolveStats
+from fcplan.taskgraph import TaskGraph
+from fcplan.team import Mode
+from solvers._feasible import round_trip_ok, start_budget, start_positions
+
+__all__ = ["IdleScheduler", "RandomScheduler"]
+
+
+class IdleScheduler:
+    """Never moves anyone: the score of doing nothing."""
+
+    name = "idle"
+
+    def plan(self, graph: TaskGraph, *, time_limit=None, rng=None) -> Plan:
+        """Return the empty plan."""
+        return Plan(stats=SolveStats(status="heuristic", objective=0.0))
+
+
+class RandomScheduler:
+    """Each agent that is not on its way home gets one random task its role and battery allow,
+    and perception agents a random altitude.
+
+    Parameters
+    ----------
+    keep_probability : float
+        Chance that an agent with a route keeps it at a replan (so agents finish some trips).
+    """
+
+    name = "random"
+
+    def __init__(self, keep_probability: float = 0.5) -> None:
+        self.keep_probability = float(keep_probability)
+
+    def plan(self, graph: TaskGraph, *, time_limit=None, rng: np.random.Generator) -> Plan:
+        """Draw a random feasible route of one task per free agent."""
+        start = start_positions(graph)
+        budget = start_budget(graph)
+        d_first = np.hypot(*(start[:, None, :] - graph.task_pos[None, :, :]).transpose(2, 0, 1))
+        feasible = graph.can_do & round_trip_ok(graph)
+        feasible &= d_first + graph.task_home_distance <= budget[:, None]
+        routes, alts = {}, {}
+        for i, agent in enumerate(graph.agent_ids):
+            if graph.agent_mode[i] == Mode.HOMING:
+                continue
+            if graph.agent_mode[i] == Mode.ACTIVE and rng.random() < self.keep_probability:
+                continue
+            options = np.flatnonzero(feasible[i])
+            if options.size == 0:
+                continue
+            routes[agent] = (graph.task_ids[int(rng.choice(options))],)
+            if graph.agent_can_sense[i]:
+                lo, hi = graph.agent_alt_range[i]
+                alts[agent] = float(rng.uniform(lo, hi))
+        return Plan(routes=routes, altitudes=alts, stats=SolveStats(status="heuristic"))

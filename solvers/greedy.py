@@ -1,0 +1,225 @@
+"""Greedy scheduler: value per travel time, with perception agents supporting the fire fight.
+
+Each replan, in this order:
+
+1. **Action agents** (and hybrids) with water are assigned fire tasks one pick at a time: among
+   all (agent, task) pairs the pick with the highest ``value * freshness / (1 + eta)`` wins, where
+   ``value`` is the task's known cells weighted by the penalties of the facilities it threatens,
+   ``freshness`` decays once the fire has not been sensed for ``fresh_s`` seconds, and ``eta`` is
+   the agent's arrival time (seconds) after the tasks already on its route. A fire task gets one
+   agent; a route holds at most ``route_length`` tasks and no more than the agent's tank; every
+   pick keeps the route plus the way home within the agent's battery.
+2. **Perception agents** watch: each fire that an action agent is heading to first gets the
+   nearest free perception agent hovering over it at ``watch_altitude`` (low, for a high sensing
+   confidence), so the cells the fire adds before the dump are sensed and can be pruned. At most
+   ``max_watch_fraction`` of the perception agents watch; the rest search.
+3. **Searching** perception agents take the stalest search blocks by
+   ``value / (1 + eta)``, one block at a time, discounting blocks near ones already taken so the
+   agents spread out; they fly at ``search_altitude`` (a wide view).
+
+Agents on a forced return (battery or tank) are planned from their depot slot with a full
+battery: they resume the new route after recharging.
+
+Examples
+--------
+>>> from fcplan import run_episode
+>>> m = run_episode(3, "greedy", seed=0).metrics["manual"]
+>>> m.overall_firefighting > 0
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fcplan.plan import Plan
+from fcplan.scheduling import SolveStats
+from fcplan.taskgraph import TaskGraph
+from fcplan.team import Mode
+from solvers._feasible import round_trip_ok, start_budget, start_positions
+
+__all__ = ["GreedyScheduler"]
+
+
+class GreedyScheduler:
+    """Sequential best-ratio assignment (see the module docstring).
+
+    Parameters
+    ----------
+    route_length : int
+        Most fire tasks per action agent per replan.
+    search_route_length : int
+        Search blocks per searching perception agent.
+    fresh_s : float
+        A fire sensed within this many seconds counts as fresh.
+    watch_altitude : float
+        Altitude (m) of perception agents watching a fire (clipped to their bounds).
+    search_altitude : float
+        Altitude (m) of searching perception agents (clipped to their bounds).
+    max_watch_fraction : float
+        Largest share of perception agents that watch rather than search (at least one watches
+        when there is a fire being fought).
+    spread_px : float
+        Search blocks within this distance of a block already taken are discounted.
+    """
+
+    name = "greedy"
+
+    def __init__(
+        self,
+        route_length: int = 3,
+        search_route_length: int = 2,
+        fresh_s: float = 5.0,
+        watch_altitude: float = 35.0,
+        search_altitude: float = 70.0,
+        max_watch_fraction: float = 0.5,
+        spread_px: float = 250.0,
+    ) -> None:
+        self.route_length = int(route_length)
+        self.search_route_length = int(search_route_length)
+        self.fresh_s = float(fresh_s)
+        self.watch_altitude = float(watch_altitude)
+        self.search_altitude = float(search_altitude)
+        self.max_watch_fraction = float(max_watch_fraction)
+        self.spread_px = float(spread_px)
+
+    # ------------------------------------------------------------------ main
+    def plan(self, graph: TaskGraph, *, time_limit=None, rng=None) -> Plan:
+        """Build the greedy plan for ``graph``."""
+        routes: dict[str, tuple[str, ...]] = {}
+        alts: dict[str, float] = {}
+        start = start_positions(graph)
+        budget = start_budget(graph)
+        free = graph.agent_mode != Mode.HOMING
+        fires = graph.fire_tasks
+        objective = 0.0
+
+        # 1. action agents -> fires
+        actors = np.flatnonzero(free & graph.agent_can_act & (graph.agent_tank > 0)
+                                & ~graph.agent_can_sense)
+        hybrids = np.flatnonzero(free & graph.agent_can_act & graph.agent_can_sense
+                                 & (graph.agent_tank > 0))
+        actors = np.r_[actors, hybrids].astype(np.int64)
+        first_fire: dict[int, int] = {}
+        if actors.size and fires.size:
+            fresh = np.where(
+                graph.task_staleness[fires] <= self.fresh_s,
+                1.0,
+                np.exp(-(graph.task_staleness[fires] - self.fresh_s) / max(self.fresh_s, 1e-9)),
+            )
+            value = graph.task_value[fires] * fresh
+            picks, gained = self._assign(graph, actors, fires, value, start, budget,
+                                         limit=np.minimum(graph.agent_tank[actors], self.route_length))
+            objective += gained
+            for row, tasks in picks.items():
+                if tasks:
+                    routes[graph.agent_ids[row]] = tuple(graph.task_ids[k] for k in tasks)
+                    first_fire[row] = tasks[0]
+
+        # 2. perception agents watch the fires being fought
+        sensors = np.flatnonzero(free & graph.agent_can_sense & ~graph.agent_can_act)
+        busy: set[int] = set()
+        if sensors.size and first_fire:
+            n_watch = max(1, int(self.max_watch_fraction * sensors.size)) if sensors.size > 1 else 1
+            watched_clusters: set[int] = set()
+            targets = sorted(first_fire.values(), key=lambda k: -graph.task_value[k])
+            for k in targets:
+                if len(busy) >= n_watch:
+                    break
+                cl = int(graph.task_cluster[k])
+                if cl in watched_clusters:
+                    continue
+                cand = [i for i in sensors if i not in busy]
+                d = np.hypot(*(start[cand] - graph.task_pos[k]).T)
+                ok = d + graph.task_home_distance[cand, k] <= budget[cand]
+                if not ok.any():
+                    continue
+                i = int(np.asarray(cand)[ok][np.argmin(d[ok])])
+                busy.add(i)
+                watched_clusters.add(cl)
+                routes[graph.agent_ids[i]] = (graph.task_ids[k],)
+                alts[graph.agent_ids[i]] = self._clip_alt(graph, i, self.watch_altitude)
+
+        # 3. the others search
+        searchers = np.array([i for i in np.r_[sensors, hybrids] if i not in busy
+                              and graph.agent_ids[i] not in routes], dtype=np.int64)
+        blocks = graph.search_tasks
+        if searchers.size and blocks.size:
+            picks, gained = self._assign(
+                graph, searchers, blocks, graph.task_value[blocks].astype(np.float64), start,
+                budget, limit=np.full(searchers.size, self.search_route_length), spread=True,
+            )
+            objective += gained
+            for row, tasks in picks.items():
+                if tasks:
+                    routes[graph.agent_ids[row]] = tuple(graph.task_ids[k] for k in tasks)
+                    alts[graph.agent_ids[row]] = self._clip_alt(graph, row, self.search_altitude)
+        return Plan(
+            routes=routes,
+            altitudes=alts,
+            stats=SolveStats(
+                status="heuristic",
+                objective=float(objective),
+                size={"agents": graph.n_agents, "tasks": graph.n_tasks, "fires": int(fires.size)},
+            ),
+        )
+
+    # ------------------------------------------------------------------ helpers
+    @staticmethod
+    def _clip_alt(graph: TaskGraph, i: int, z: float) -> float:
+        lo, hi = graph.agent_alt_range[i]
+        return float(min(max(z, lo), hi))
+
+    def _assign(
+        self,
+        graph: TaskGraph,
+        agents: np.ndarray,
+        tasks: np.ndarray,
+        value: np.ndarray,
+        start: np.ndarray,
+        budget: np.ndarray,
+        *,
+        limit: np.ndarray,
+        spread: bool = False,
+    ) -> tuple[dict[int, list[int]], float]:
+        """Repeatedly give the best (agent, task) pick; return routes (task rows) per agent row."""
+        value = value.copy()
+        speed = graph.agent_speed[agents]
+        pos = start[agents].copy()
+        used = np.zeros(agents.size)  # px already planned
+        elapsed = np.zeros(agents.size)  # s already planned
+        home = graph.task_home_distance[np.ix_(agents, tasks)]  # (a, k)
+        ok_trip = round_trip_ok(graph)[np.ix_(agents, tasks)]
+        left = budget[agents]
+        count = np.zeros(agents.size, dtype=np.int64)
+        taken = np.zeros(tasks.size, dtype=bool)
+        routes: dict[int, list[int]] = {int(a): [] for a in agents}
+        tpos = graph.task_pos[tasks]
+        gained = 0.0
+        for _ in range(int(limit.sum())):
+            d = np.hypot(*(pos[:, None, :] - tpos[None, :, :]).transpose(2, 0, 1))  # (a, k)
+            eta = elapsed[:, None] + d / speed[:, None]
+            score = value[None, :] / (1.0 + eta)
+            feasible = (
+                ok_trip
+                & ~taken[None, :]
+                & (count < limit)[:, None]
+                & (used[:, None] + d + home <= left[:, None])
+                & (value[None, :] > 0)
+            )
+            score = np.where(feasible, score, -np.inf)
+            flat = int(np.argmax(score))
+            a, k = divmod(flat, tasks.size)
+            if not np.isfinite(score[a, k]):
+                break
+            routes[int(agents[a])].append(int(tasks[k]))
+            gained += float(value[k])
+            taken[k] = True
+            count[a] += 1
+            used[a] += d[a, k]
+            elapsed[a] = eta[a, k]
+            pos[a] = tpos[k]
+            if spread:
+                near = np.hypot(*(tpos - tpos[k]).T) < self.spread_px
+                value[near] *= 0.3
+        return routes, gained

@@ -1,0 +1,158 @@
+"""Tests for fcplan.fire: FARSITE statistics, delays, pruning, map edges, determinism."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fcplan.fire import BURNING, INTENSITY_COEFF, PRUNED, Fire, FireRegionParams, spread_rate_ratio
+
+
+def region(**kw) -> FireRegionParams:
+    base = dict(center=(600, 600), fronts=10, delay_s=0, fuel=10, wind_speed=5, wind_dir_deg=45)
+    base.update(kw)
+    return FireRegionParams(**base)
+
+
+def first_step(fire: Fire) -> tuple[np.ndarray, np.ndarray]:
+    x0, y0 = fire.x.copy(), fire.y.copy()
+    fire.step()
+    return fire.x - x0, fire.y - y0
+
+
+def test_spread_ratio_matches_reference_table():
+    """C/R is 0 at U=0, 0.428 at 2, 0.460 at 3, 0.487 at 5 and 0.499 at 10 (spec 1.4)."""
+    got = spread_rate_ratio(np.array([0.0, 2.0, 3.0, 5.0, 10.0]))
+    np.testing.assert_allclose(got, [0.0, 0.428, 0.460, 0.487, 0.499], atol=2e-3)
+
+
+def test_mean_first_step_is_about_quarter_fuel_at_wind_5():
+    """The mean front step on the first tick is about 0.24 x fuel px at wind speed 5."""
+    for fuel in (3.0, 10.0):
+        fire = Fire([region(fronts=40_000, fuel=fuel)], 1200, 10, np.random.default_rng(1))
+        dx, dy = first_step(fire)
+        mean = np.hypot(dx, dy).mean()
+        assert 0.22 * fuel < mean < 0.26 * fuel, mean
+
+
+def test_step_rescales_with_tick_rate():
+    """At 20 ticks/s a front moves half as far per tick as at 10 ticks/s."""
+    a = Fire([region(fronts=40_000)], 1200, 10, np.random.default_rng(2))
+    b = Fire([region(fronts=40_000)], 1200, 20, np.random.default_rng(2))
+    sa = np.hypot(*first_step(a)).mean()
+    sb = np.hypot(*first_step(b)).mean()
+    assert abs(sb / sa - 0.5) < 0.02
+
+
+def test_drift_follows_wind_azimuth():
+    """Fronts drift along the wind azimuth (90 deg = +x) by about e^-2 of the step length."""
+    fire = Fire([region(fronts=60_000, wind_dir_deg=90)], 1200, 10, np.random.default_rng(3))
+    dx, dy = first_step(fire)
+    step = np.hypot(dx, dy).mean()
+    assert 0.08 * step < dx.mean() < 0.2 * step
+    assert abs(dy.mean()) < 0.03 * step
+    fire = Fire([region(fronts=60_000, wind_dir_deg=0)], 1200, 10, np.random.default_rng(3))
+    dx, dy = first_step(fire)
+    assert dy.mean() > 0.08 * step and abs(dx.mean()) < 0.03 * step
+
+
+def test_delay_is_respected_and_ignition_cells_burn_on_activation():
+    """A region with a 3 s delay burns nothing before tick 30 and its ignition cells at tick 30."""
+    fire = Fire([region(delay_s=3.0)], 1200, 10, np.random.default_rng(4))
+    ignition = set((fire.x.astype(int) * 1200 + fire.y.astype(int)).tolist())
+    x_before = fire.x.copy()
+    for _ in range(29):
+        assert fire.step().size == 0
+    assert fire.n_burning == 0
+    np.testing.assert_array_equal(fire.x, x_before)
+    new = fire.step()
+    assert ignition <= set(new.tolist())
+    assert fire.n_burning == int((fire.state == BURNING).sum())
+
+
+def test_ignition_box_is_centre_plus_minus_half_width():
+    """Initial fronts are integer pixels in [c - 50, c + 49] on each axis."""
+    fire = Fire([region(fronts=5000, center=(350, 450))], 1200, 10, np.random.default_rng(5))
+    assert np.all(fire.x == np.round(fire.x))
+    assert fire.x.min() >= 300 and fire.x.max() <= 399
+    assert fire.y.min() >= 400 and fire.y.max() <= 499
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), every=st.integers(1, 5), share=st.integers(1, 3))
+def test_pruned_cells_never_burn_again_and_fronts_freeze(seed, every, share):
+    """Pruned cells never re-ignite and frozen fronts never move, whatever gets pruned when."""
+    fire = Fire([region(fronts=12, fuel=15)], 1200, 10, np.random.default_rng(seed))
+    ever_pruned = np.zeros_like(fire.state, dtype=bool)
+    for t in range(120):
+        frozen = fire.frozen.copy()
+        xy = np.stack([fire.x, fire.y])[:, frozen].copy()
+        fire.step()
+        np.testing.assert_array_equal(np.stack([fire.x, fire.y])[:, frozen], xy)
+        assert not np.any((fire.state == BURNING) & ever_pruned)
+        if t % every == 0:
+            burning = np.flatnonzero(fire.state.reshape(-1) == BURNING)
+            fire.prune(burning[::share])
+            ever_pruned |= fire.state == PRUNED
+    assert fire.n_burning == int((fire.state == BURNING).sum())
+    assert fire.n_pruned == int((fire.state == PRUNED).sum())
+    assert fire.n_burning + fire.n_pruned == fire.n_ignited
+
+
+def test_frozen_front_keeps_its_position():
+    """Once its cell is pruned a front stays exactly where it is for the rest of the episode."""
+    fire = Fire([region(fronts=5)], 1200, 10, np.random.default_rng(6))
+    for _ in range(5):
+        fire.step()
+    fire.prune(fire.cell[:2])
+    assert fire.frozen[:2].all()
+    xy = np.stack([fire.x[:2], fire.y[:2]]).copy()
+    for _ in range(50):
+        fire.step()
+    np.testing.assert_array_equal(np.stack([fire.x[:2], fire.y[:2]]), xy)
+
+
+def test_fronts_leaving_the_map_die_without_a_phantom_cell():
+    """Fronts that leave the map die; no phantom burning cell appears at (0, 0)."""
+    fire = Fire(
+        [region(center=(50, 1150), fronts=200, fuel=20, wind_dir_deg=135)],
+        1200,
+        10,
+        np.random.default_rng(7),
+    )
+    for _ in range(400):
+        fire.step()
+    assert (~fire.alive).any()
+    assert fire.state[0, 0] != BURNING or 0 in (fire.cell[fire.alive])
+    dead_cells = fire.cell[~fire.alive]
+    assert np.all((fire.x[~fire.alive] < 0) | (fire.x[~fire.alive] >= 1200)
+                  | (fire.y[~fire.alive] < 0) | (fire.y[~fire.alive] >= 1200))
+    assert dead_cells.size > 0
+
+
+def test_same_seed_same_fire_and_random_stream_independent_of_pruning():
+    """Same seed gives the same fire; pruning elsewhere does not change other fronts' draws."""
+    a = Fire([region(), region(center=(200, 900))], 1200, 10, np.random.default_rng(8))
+    b = Fire([region(), region(center=(200, 900))], 1200, 10, np.random.default_rng(8))
+    for _ in range(100):
+        a.step()
+        b.step()
+    np.testing.assert_array_equal(a.state, b.state)
+    # prune region 0's cells in b only: region 1's fronts must move identically
+    b.prune(np.flatnonzero(b.state.reshape(-1) == BURNING))
+    for _ in range(100):
+        a.step()
+        b.step()
+    r1 = a.region == 1
+    unfrozen = ~b.frozen & r1
+    np.testing.assert_array_equal(a.x[unfrozen], b.x[unfrozen])
+
+
+def test_one_visit_gives_reference_peak_intensity():
+    """A single front visit radiates about 22.5 kW/m at its own cell (spec 1.5)."""
+    fire = Fire([region(fronts=1)], 1200, 10, np.random.default_rng(9))
+    fire.visits[600, 600] = 1
+    peak = fire.intensity()[600, 600]
+    assert 19.0 < peak < 25.0
+    assert abs(INTENSITY_COEFF - 12.776) < 1e-3
