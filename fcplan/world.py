@@ -117,7 +117,6 @@ class World:
         self.team = Team(scenario)
         self.sensed = np.zeros((w, w), dtype=bool)
         self._sensed_flat = self.sensed.reshape(-1)
-        self._state_flat = self.fire.state.reshape(-1)
         facilities = scenario.scored_facilities
         self.facility_labels = np.full((w, w), -1, dtype=np.int16)
         for f, fac in enumerate(facilities):
@@ -194,6 +193,23 @@ class World:
             temporal_exponent=sc.scoring.temporal_exponent,
             agents=agents,
         )
+
+    def ignite(self, xy) -> np.ndarray:
+        """Set cells burning by hand (spot fires, tests); return the flat indices that ignited.
+
+        Parameters
+        ----------
+        xy : array_like, (k, 2)
+            Integer cell coordinates inside the map. Pruned or burning cells are left alone.
+        """
+        xy = np.asarray(xy, dtype=np.int64).reshape(-1, 2)
+        w = self.world_size
+        if xy.size and (xy.min() < 0 or xy.max() >= w):
+            raise ValueError(f"cells must lie in 0..{w - 1}")
+        new = self.fire._ignite(xy[:, 0] * w + xy[:, 1])
+        if new.size:
+            self._count_facilities(new, +1)
+        return new
 
     # ------------------------------------------------------------------ dynamics
     def step(self, commands: Mapping[str | int, Command] | None = None) -> StepInfo:

@@ -138,14 +138,18 @@ def parse_cell(cell: str, world_size: int | None = None, *, field: str = "cell")
         raise ScenarioError(field, "must be a cell name like 'D-05'", got=cell)
     m = _CELL_RE.match(cell)
     if not m or int(m.group(2)) < 1:
-        raise ScenarioError(field, "must be a cell name like 'D-05' (column letters, row >= 1)", got=cell)
+        raise ScenarioError(
+            field, "must be a cell name like 'D-05' (column letters, row >= 1)", got=cell
+        )
     column, row = _column_index(m.group(1)), int(m.group(2))
     if world_size is not None:
         n = world_size // CELL_PX
         if column >= n or row > n:
             last = format_cell(n - 1, n)
             raise ScenarioError(
-                field, f"must be a cell of the {n}x{n} grid of a {world_size} px map (A-01..{last})", got=cell
+                field,
+                f"must be a cell of the {n}x{n} grid of a {world_size} px map (A-01..{last})",
+                got=cell,
             )
     return column, row
 

@@ -170,13 +170,17 @@ _KINDS = {
 
 
 # -------------------------------------------------------------------------------------- reading
+def _is_pair(v: Any) -> bool:
+    return isinstance(v, list) and len(v) == 2 and all(map(is_number, v))
+
+
 def _convert(value: Any, kind: str, field: str) -> Any:
     """Check the TOML type of ``value`` and convert it (numbers to float, pairs to tuples)."""
     ok = {
         "str": lambda v: isinstance(v, str),
         "int": is_integer,
         "number": is_number,
-        "pair": lambda v: isinstance(v, list) and len(v) == 2 and all(map(is_number, v)),
+        "pair": _is_pair,
         "strings": lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v),
     }[kind](value)
     if not ok:
@@ -200,7 +204,9 @@ class _Table:
         self.data, self.path = value, path
         for key in value:
             if key not in allowed:
-                raise ScenarioError(self.field(key), f"unknown key; allowed keys: {', '.join(allowed)}")
+                raise ScenarioError(
+                    self.field(key), f"unknown key; allowed keys: {', '.join(allowed)}"
+                )
 
     def field(self, key: str) -> str:
         return f"{self.path}.{key}" if self.path else key
@@ -221,21 +227,27 @@ class _Table:
     def tables(self, key: str, allowed: tuple[str, ...]) -> list[_Table]:
         value = self.data.get(key, [])
         if not isinstance(value, list):
-            raise ScenarioError(self.field(key), f"must be an array of tables [[{self.field(key)}]]", got=value)
+            raise ScenarioError(
+                self.field(key), f"must be an array of tables [[{self.field(key)}]]", got=value
+            )
         return [_Table(v, f"{self.field(key)}[{i}]", allowed) for i, v in enumerate(value)]
 
-    def per_agent(self, key: str, kind: str, count: int, default: Any, *, shared: bool = True) -> list[Any]:
+    def per_agent(
+        self, key: str, kind: str, count: int, default: Any, *, shared: bool = True
+    ) -> list[Any]:
         """A value given once for the whole role (if ``shared``), or a list with one per agent."""
         field = self.field(key)
         if key not in self.data:
             return [default] * count
         value = self.data[key]
-        if shared:
-            if kind == "pair" and isinstance(value, list) and len(value) == 2 and all(map(is_number, value)):
-                return [_convert(value, kind, field)] * count
-            if kind != "pair" and not isinstance(value, list):
-                return [_convert(value, kind, field)] * count
-        one = f"{_KINDS[kind]}, or a list with one per agent" if shared else f"a list with one {_KINDS[kind]} per agent"
+        is_one = _is_pair(value) if kind == "pair" else not isinstance(value, list)
+        if shared and is_one:
+            return [_convert(value, kind, field)] * count
+        one = (
+            f"{_KINDS[kind]}, or a list with one per agent"
+            if shared
+            else f"a list with one {_KINDS[kind]} per agent"
+        )
         if not isinstance(value, list):
             raise ScenarioError(field, f"must be {one}", got=value)
         if len(value) != count:
@@ -253,7 +265,9 @@ def _place(t: _Table, kind: str, world: int) -> tuple[tuple[float, float], str |
         return cell_center(cell, kind, world), cell
     if t.has("center"):
         return t.get("center", "pair"), None
-    raise ScenarioError(t.field("cell"), "is required: a grid cell like 'D-05' (or center = [x, y])")
+    raise ScenarioError(
+        t.field("cell"), "is required: a grid cell like 'D-05' (or center = [x, y])"
+    )
 
 
 def scenario_from_dict(doc: Mapping[str, Any], source: str | None = None) -> Scenario:
@@ -280,7 +294,9 @@ def scenario_from_dict(doc: Mapping[str, Any], source: str | None = None) -> Sce
     >>> s.regions[0].center, s.regions[0].fronts, s.agent_ids
     ((450.0, 150.0), 10, ('P1', 'A1'))
     """
-    label = source or (doc.get("name") if isinstance(doc, Mapping) and isinstance(doc.get("name"), str) else None)
+    label = source or (
+        doc.get("name") if isinstance(doc, Mapping) and isinstance(doc.get("name"), str) else None
+    )
     try:
         return _build(dict(doc) if isinstance(doc, Mapping) else doc, source)
     except ScenarioError as err:
@@ -314,12 +330,14 @@ def _build(doc: Any, source: str | None) -> Scenario:
     penalties_t = scoring_t.table("penalties", _PENALTY_KEYS)
     penalties = {k: penalties_t.get(k, "number", v) for k, v in DEFAULT_PENALTIES.items()}
 
-    depot_t = _Table(top.data.get("depot"), "depot", _DEPOT_KEYS) if top.has("depot") else None
-    if depot_t is None:
+    if not top.has("depot"):
         raise ScenarioError("depot", "is required (a table with cell or center, and orientation)")
+    depot_t = top.table("depot", _DEPOT_KEYS)
     orientation = depot_t.get("orientation", "str", "vertical")
     if orientation not in ("vertical", "horizontal"):
-        raise ScenarioError("depot.orientation", "must be one of 'vertical', 'horizontal'", got=orientation)
+        raise ScenarioError(
+            "depot.orientation", "must be one of 'vertical', 'horizontal'", got=orientation
+        )
     center, cell = _place(depot_t, f"depot_{orientation}", world)
     depot = Depot(center, orientation, penalties["depot"], cell)
 
@@ -328,11 +346,15 @@ def _build(doc: Any, source: str | None) -> Scenario:
         kind = t.get("kind", "str")
         if kind not in FACILITY_KINDS:
             raise ScenarioError(
-                t.field("kind"), "must be one of 'house', 'hospital', 'power_station' (the depot goes in [depot])", got=kind
+                t.field("kind"),
+                "must be one of 'house', 'hospital', 'power_station' (the depot goes in [depot])",
+                got=kind,
             )
         center, cell = _place(t, kind, world)
         size = t.get("size", "pair", FACILITY_SIZES[kind])
-        facilities.append(Facility(kind, center, size, t.get("penalty", "number", penalties[kind]), cell))
+        facilities.append(
+            Facility(kind, center, size, t.get("penalty", "number", penalties[kind]), cell)
+        )
 
     lakes = [Lake(*_place(t, "lake", world)) for t in top.tables("lakes", _LAKE_KEYS)]
 
@@ -371,9 +393,18 @@ def _team(top: _Table, depot: Depot) -> tuple[AgentSpec, ...]:
     agents: list[AgentSpec] = []
     for role, count, t in columns:
         fixed = (ACTION_ALTITUDE, ACTION_ALTITUDE)
-        altitude = t.per_agent("altitude", "pair", count, TEAM_DEFAULTS["altitude"]) if role.can_sense else [fixed] * count
-        default_z = [ACTION_ALTITUDE if role is Role.ACTION else min(max(20.0, lo), hi) for lo, hi in altitude]
-        start_z = t.per_agent("start_altitude", "number", count, None) if role.can_sense else default_z
+        altitude = (
+            t.per_agent("altitude", "pair", count, TEAM_DEFAULTS["altitude"])
+            if role.can_sense
+            else [fixed] * count
+        )
+        default_z = [
+            ACTION_ALTITUDE if role is Role.ACTION else min(max(20.0, lo), hi)
+            for lo, hi in altitude
+        ]
+        start_z = (
+            t.per_agent("start_altitude", "number", count, None) if role.can_sense else default_z
+        )
         first = len(agents)
         starts = t.per_agent("start", "pair", count, None, shared=False)
         starts = [slots[first + k] if p is None else p for k, p in enumerate(starts)]
@@ -381,16 +412,25 @@ def _team(top: _Table, depot: Depot) -> tuple[AgentSpec, ...]:
         speed = t.per_agent("speed", "number", count, TEAM_DEFAULTS["speed"])
         if role.can_act:
             tank = t.per_agent("tank", "int", count, TEAM_DEFAULTS["tank"])
-            prune = t.per_agent("prune_confidence", "number", count, TEAM_DEFAULTS["prune_confidence"][role])
+            prune = t.per_agent(
+                "prune_confidence", "number", count, TEAM_DEFAULTS["prune_confidence"][role]
+            )
         else:
             tank, prune = [0] * count, [0.0] * count
         for k in range(count):
             z = default_z[k] if start_z[k] is None else start_z[k]
             agents.append(
                 AgentSpec(
-                    f"{role.letter}{k + 1}", role, starts[k], altitude[k], z,
-                    battery[k], speed[k], tank[k], prune[k],
-                )  # fmt: skip
+                    id=f"{role.letter}{k + 1}",
+                    role=role,
+                    start=starts[k],
+                    altitude=altitude[k],
+                    start_altitude=z,
+                    battery=battery[k],
+                    speed=speed[k],
+                    tank=tank[k],
+                    prune_confidence=prune[k],
+                )
             )
     return tuple(agents)
 
@@ -485,7 +525,9 @@ def scenario_to_dict(s: Scenario) -> dict[str, Any]:
         if any(a.start != slots[n] for n, a in members):
             entry["start"] = [list(a.start) for a in agents]
         default_z = [min(max(20.0, a.altitude[0]), a.altitude[1]) for a in agents]
-        if role.can_sense and any(a.start_altitude != z for a, z in zip(agents, default_z, strict=True)):
+        if role.can_sense and any(
+            a.start_altitude != z for a, z in zip(agents, default_z, strict=True)
+        ):
             entry["start_altitude"] = _one_or_list([a.start_altitude for a in agents])
         team[role.key] = entry
     doc["team"] = team
@@ -593,7 +635,9 @@ def _shipped() -> dict[str, Path]:
     numbered = sorted((int(stem), p) for stem, p in files.items() if stem.isdigit())
     out = {"practice": files["practice"]} if "practice" in files else {}
     out.update((str(n), p) for n, p in numbered)
-    out.update((stem, files[stem]) for stem in sorted(files) if not stem.isdigit() and stem != "practice")
+    out.update(
+        (stem, files[stem]) for stem in sorted(files) if not stem.isdigit() and stem != "practice"
+    )
     return out
 
 

@@ -76,7 +76,10 @@ DEFAULT_PENALTIES: dict[str, float] = {
 }
 """Penalty coefficient per burning cell inside each kind of footprint."""
 
-DEPOT_SIZES: dict[str, tuple[float, float]] = {"vertical": (160.0, 400.0), "horizontal": (400.0, 160.0)}
+DEPOT_SIZES: dict[str, tuple[float, float]] = {
+    "vertical": (160.0, 400.0),
+    "horizontal": (400.0, 160.0),
+}
 """Depot footprint (width, height) in px per orientation."""
 
 DEPOT_SLOTS: dict[str, tuple[tuple[float, float], ...]] = {
@@ -420,9 +423,9 @@ class AgentSpec:
     prune_confidence: float
 
     def __post_init__(self) -> None:
-        if isinstance(self.role, Integral) and not isinstance(self.role, (bool, Role)):
-            if 0 <= int(self.role) <= 2:
-                _set(self, "role", Role(int(self.role)))
+        role = self.role
+        if isinstance(role, Integral) and not isinstance(role, (bool, Role)) and 0 <= role <= 2:
+            _set(self, "role", Role(int(role)))
         _set(self, "start", _as_pair(self.start))
         _set(self, "altitude", _as_pair(self.altitude))
         _set(self, "tank", _as_int(self.tank))
@@ -575,8 +578,8 @@ class Scenario:
         Examples
         --------
         >>> from fcplan.scenario import load_scenario
-        >>> load_scenario(1).replace(world_size=1000).world_size
-        1000
+        >>> load_scenario(1).replace(duration_s=60).n_ticks
+        600
         """
         return dataclasses.replace(self, **changes)
 
