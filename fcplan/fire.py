@@ -67,6 +67,8 @@ WIND_DIR_SD_RAD = 2.0
 REFERENCE_TPS = 10
 #: Cell states in :attr:`Fire.state`.
 UNBURNT, BURNING, PRUNED = 0, 1, 2
+#: Side (px) of the blocks in :attr:`Fire.block_burning`.
+BLOCK = 16
 
 
 @dataclass(frozen=True, slots=True)
@@ -176,6 +178,12 @@ class Fire:
             np.clip(self.x, 0, w - 1).astype(np.int64) * w + np.clip(self.y, 0, w - 1).astype(np.int64),
             0,
         )
+        #: (B, B) int32 burning cells per ``BLOCK`` x ``BLOCK`` block: lets callers skip empty
+        #: areas without scanning cells.
+        nblk = -(-w // BLOCK)
+        self.block_burning = np.zeros((nblk, nblk), dtype=np.int32)
+        self._block_flat = self.block_burning.reshape(-1)
+        self._nblk = nblk
         #: (n,) bool: the front stands in a pruned cell and never moves again.
         self.frozen = np.zeros(n, dtype=bool)
         self.n_burning = 0
@@ -219,6 +227,16 @@ class Fire:
         field = fftconvolve(self.visits.astype(np.float64), kernel, mode="same")
         return 1000.0 * INTENSITY_COEFF * field
 
+    def _block_of(self, flat: np.ndarray) -> np.ndarray:
+        w = self.world_size
+        return (flat // w // BLOCK) * self._nblk + (flat % w) // BLOCK
+
+    def any_burning_in(self, x0: int, x1: int, y0: int, y1: int) -> bool:
+        """True if a cell in ``[x0, x1) x [y0, y1)`` may burn (exact for block-aligned ranges;
+        otherwise a cheap necessary condition)."""
+        b = self.block_burning[x0 // BLOCK : (x1 - 1) // BLOCK + 1, y0 // BLOCK : (y1 - 1) // BLOCK + 1]
+        return bool(b.any())
+
     # ------------------------------------------------------------------ dynamics
     def _ignite(self, flat: np.ndarray) -> np.ndarray:
         """Set unburnt cells burning; return the newly burning ones (unique)."""
@@ -226,6 +244,7 @@ class Fire:
         if fresh.size > 1:
             fresh = np.unique(fresh)
         self._state_flat[fresh] = BURNING
+        np.add.at(self._block_flat, self._block_of(fresh), _ONE32)
         self.n_burning += int(fresh.size)
         self.n_ignited += int(fresh.size)
         return fresh
@@ -283,6 +302,7 @@ class Fire:
         if hit.size == 0:
             return hit
         self._state_flat[hit] = PRUNED
+        np.subtract.at(self._block_flat, self._block_of(hit), _ONE32)
         self.n_burning -= int(hit.size)
         self.n_pruned += int(hit.size)
         self.frozen |= self.alive & (self._state_flat[self.cell] == PRUNED)
@@ -291,3 +311,4 @@ class Fire:
 
 _EMPTY = np.zeros(0, dtype=np.int64)
 _ONE = np.uint32(1)
+_ONE32 = np.int32(1)

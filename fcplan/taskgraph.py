@@ -40,9 +40,9 @@ Examples
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import IntEnum
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -133,7 +133,6 @@ class TaskGraph:
     threat_time_s: np.ndarray  # (K, F) float64 estimated time for fire k to reach f (inf: none)
     tile_px: tuple[float, float]
     known_cells: int = 0
-    _extra: dict = field(default_factory=dict, repr=False)
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -394,7 +393,7 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     fire_ids = tuple(
         f"fire:{int(x)}:{int(y)}" for x, y in zip(fire_pos[:, 0], fire_pos[:, 1], strict=True)
     )
-    search_ids = tuple(f"search:{grid_block_name(int(a), int(b))}" for a, b in zip(bx, by, strict=True))
+    search_ids = _search_ids(nb)
     # keep ids unique when two tiles round to the same point
     if len(set(fire_ids)) != len(fire_ids):
         fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))
@@ -441,6 +440,12 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         tile_px=(tw, th),
         known_cells=int(counts.sum()),
     )
+
+
+@lru_cache(maxsize=16)
+def _search_ids(nb: int) -> tuple[str, ...]:
+    """Ids of the ``nb x nb`` search blocks in task order (x-major)."""
+    return tuple(f"search:{grid_block_name(a, b)}" for a in range(nb) for b in range(nb))
 
 
 def _clusters(tx: np.ndarray, ty: np.ndarray, nx_: int, ny_: int) -> np.ndarray:

@@ -21,7 +21,8 @@ Rules (ARCHITECTURE.md "Agents", FIRECOMMANDER.md section 4, rescaled to ``ticks
   soon as a dump can do something (see :mod:`fcplan.world`): one tank unit per dump, so tank ``T``
   gives ``T`` dumps (the 2020 code gave ``T + 1``). An empty tank sends the agent home.
 * **Depot.** At home the agent recharges and refills at once; after a forced return it resumes
-  its route, after a commanded return (or the 3-second rule) it stays idle.
+  its route (or flies back to the last goal it was holding), after a commanded return (or the
+  3-second rule) it stays idle.
 * **3-second rule.** An action agent hovering at its last goal for 3 s goes home and idles.
 
 Examples
@@ -121,6 +122,10 @@ def sensing_confidence(z: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndar
     return np.clip(c, 0.4, 1.0)
 
 
+_IDLE, _ACTIVE, _RETURNING, _HOMING = (int(m) for m in Mode)
+_ROLE_ACTION = 1
+
+
 class Team:
     """State of every agent, as arrays.
 
@@ -170,6 +175,8 @@ class Team:
         self.battery_capacity = np.array([a.battery for a in agents], dtype=np.float64)
         self.tank_capacity = np.array([a.tank for a in agents], dtype=np.int64)
         self.prune_confidence = np.array([a.prune_confidence for a in agents], dtype=np.float64)
+        span = self.alt_hi - self.alt_lo
+        self._inv_span = np.where(span > 0, 1.0 / np.where(span > 0, span, 1.0), 0.0)
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -219,8 +226,8 @@ class Team:
 
     def sensing_confidence(self) -> np.ndarray:
         """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""
-        c = sensing_confidence(self.z, self.alt_lo, self.alt_hi)
-        return np.where(self.can_sense, c, 0.0)
+        c = 1.0 - 0.6 * (self.z - self.alt_lo) * self._inv_span
+        return np.minimum(np.maximum(c, 0.4), 1.0) * self.can_sense
 
     def return_cost(self) -> np.ndarray:
         """(N,) battery needed to fly straight home from where each agent is."""
@@ -269,8 +276,8 @@ class Team:
     def move(self) -> np.ndarray:
         """Move every agent one tick; return the rows that arrived at a route goal this tick."""
         mode = self.mode
-        active = mode == Mode.ACTIVE
-        going_home = (mode == Mode.RETURNING) | (mode == Mode.HOMING)
+        active = mode == _ACTIVE
+        going_home = (mode == _RETURNING) | (mode == _HOMING)
         target = np.where(going_home[:, None], self.home, self.goal)
         flying = going_home | (active & self.has_goal)
         d = target - self.pos
@@ -286,14 +293,17 @@ class Team:
         self.hover_s = np.where(hovering, self.hover_s + self.dt_s, 0.0)
         # altitude
         climb = CLIMB_PER_TICK * self.tick_scale
-        dz = np.clip(self.z_target - self.z, -climb, climb)
-        self.z = self.z + np.where(self.can_sense, dz, 0.0)
+        dz = np.minimum(np.maximum(self.z_target - self.z, -climb), climb)
+        self.z += dz * self.can_sense
 
-        arrived_goal = np.flatnonzero(arrive & active)
-        for i in np.flatnonzero(arrive & going_home):
-            self._dock(int(i))
-        for i in arrived_goal:
-            self._next_goal(int(i))
+        if arrive.any():
+            for i in np.flatnonzero(arrive & going_home):
+                self._dock(int(i))
+            arrived_goal = np.flatnonzero(arrive & active)
+            for i in arrived_goal:
+                self._next_goal(int(i))
+        else:
+            arrived_goal = _NO_ROWS
         self._rules()
         return arrived_goal
 
@@ -317,8 +327,11 @@ class Team:
         self.tank[i] = self.tank_capacity[i]
         self.sorties[i] += 1
         route = self.routes[i]
-        k = self.goal_index[i]
-        if self.mode[i] == Mode.RETURNING and k < len(route):
+        # after a forced return the agent resumes: the goal it was heading to, or its last goal
+        # (a post it was holding) if it had finished the route
+        k = min(int(self.goal_index[i]), len(route) - 1)
+        if self.mode[i] == _RETURNING and k >= 0:
+            self.goal_index[i] = k
             self.mode[i] = Mode.ACTIVE
             self.has_goal[i] = True
             self.goal[i] = route[k]
@@ -332,7 +345,7 @@ class Team:
 
     def _rules(self) -> None:
         """Battery reserve, and the 3-second rule for action agents."""
-        active = self.mode == Mode.ACTIVE
+        active = self.mode == _ACTIVE
         if not active.any():
             return
         # Reserve: after one more step (which can also lengthen the way home by one step) the
@@ -343,16 +356,15 @@ class Team:
             + 2.0 * DRAIN_PER_HOVER_TICK * self.tick_scale
         )
         low = active & (self.battery <= reserve)
-        self.mode[low] = Mode.RETURNING
-        from fcplan.scenario import Role
-
+        if low.any():
+            self.mode[low] = _RETURNING
         idle_action = (
-            (self.mode == Mode.ACTIVE)
-            & (self.role == int(Role.ACTION))
+            (self.mode == _ACTIVE)
+            & (self.role == _ROLE_ACTION)
             & (self.hover_s >= ACTION_IDLE_LIMIT_S - 1e-9)
         )
         if idle_action.any():
-            self.mode[idle_action] = Mode.HOMING
+            self.mode[idle_action] = _HOMING
             self.has_goal[idle_action] = False
 
     def record_dump(self, i: int) -> None:
@@ -367,3 +379,6 @@ class Team:
         """(N,) px each agent can still fly away from home and back (battery / drain, minus the
         current way home)."""
         return np.maximum(self.battery / DRAIN_PER_PX - np.hypot(*(self.home - self.pos).T), 0.0)
+
+
+_NO_ROWS = np.zeros(0, dtype=np.int64)

@@ -251,13 +251,16 @@ class World:
     def _sense(self, fov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         team, w = self.team, self.world_size
         conf = team.sensing_confidence()
-        state = self.fire.state
+        fire = self.fire
+        state = fire.state
         parts = []
         for i in np.flatnonzero(team.can_sense):
             sl = _rect_slices(fov[i], w)
             if sl is None:
                 continue
             x0, x1, y0, y1 = sl
+            if not fire.any_burning_in(x0, x1, y0, y1):
+                continue
             bx, by = np.nonzero(state[x0:x1, y0:y1] == BURNING)
             if bx.size == 0:
                 continue
@@ -287,6 +290,8 @@ class World:
             if sl is None:
                 continue
             x0, x1, y0, y1 = sl
+            if not self.fire.any_burning_in(x0, x1, y0, y1):
+                continue
             burning = state[x0:x1, y0:y1] == BURNING
             seen = burning & sensed[x0:x1, y0:y1]
             if reference_gate:

@@ -260,7 +260,7 @@ def _place(t: _Table, kind: str, world: int) -> tuple[tuple[float, float], str |
     if t.has("cell") and t.has("center"):
         raise ScenarioError(t.path, "give either cell or center, not both")
     if t.has("cell"):
-        column, row = parse_cell(t.get("cell", "str"), world, field=t.field("cell"))
+        column, row = parse_cell(t.data["cell"], world, field=t.field("cell"))
         cell = format_cell(column, row)
         return cell_center(cell, kind, world), cell
     if t.has("center"):
@@ -606,7 +606,7 @@ def dump_scenario(scenario: Scenario, path: str | os.PathLike[str] | None = None
     >>> "[[fire.regions]]" in text and 'cell = "D-04"' in text
     True
     """
-    lines = [f"# Scenario {scenario.name}, written by fcplan.scenario.dump_scenario."]
+    lines = ["# Written by fcplan.scenario.dump_scenario."]
     _emit(lines, "", scenario_to_dict(scenario))
     text = "\n".join(lines) + "\n"
     if path is not None:

@@ -331,7 +331,7 @@ class Depot:
         evenly spaced lattice inside the footprint: the footprint is cut into ``cols x rows``
         equal boxes (``cols`` across its short side, the fewest boxes that hold them, about square)
         and agent 10, 11, ... takes the centre of box 0, 1, ... row by row along the long side,
-        rounded to whole px. Lattice points may coincide with GUI slots; agents are points, so
+        rounded to whole px (halves up). Lattice points may coincide with GUI slots; agents are points, so
         sharing a start is harmless.
         """
         (cx, cy) = self.center
@@ -349,7 +349,7 @@ class Depot:
                 a = (i + 0.5) * short / across
                 b = (j + 0.5) * long_ / along
                 dx, dy = (a, b) if w <= h else (b, a)
-                out.append((float(round(x0 + dx)), float(round(y0 + dy))))
+                out.append((float(math.floor(x0 + dx + 0.5)), float(math.floor(y0 + dy + 0.5))))
         return tuple(out)
 
 
