@@ -86,19 +86,20 @@ def _build_parser() -> argparse.ArgumentParser:
 def _cmd_scenarios() -> int:
     from fcplan.scenario import list_scenarios, load_scenario
 
-    print(f"{'name':<22} {'difficulty':<10} {'team':<9} fire regions (fronts, delay)")
+    rows = []
     for name in list_scenarios():
         s = load_scenario(name)
-        team = "/".join(
-            f"{n}{r[0].upper()}" for r, n in s.team_counts.items() if n
-        )
+        team = "/".join(f"{n}{r[0].upper()}" for r, n in s.team_counts.items() if n)
         regions = ", ".join(
             f"{r.cell or tuple(int(c) for c in r.center)}({r.fronts}f"
             + (f", +{r.delay_s:g}s)" if r.delay_s else ")")
             for r in s.regions
         )
-        label = name if s.number is None else s.name
-        print(f"{label:<22} {s.difficulty:<10} {team:<9} {regions}")
+        rows.append((name if s.number is None else s.name, s.difficulty, team, regions))
+    widths = [max(len(r[k]) for r in rows + [("name", "difficulty", "team", "")]) for k in range(3)]
+    header = ("name", "difficulty", "team", "fire regions (fronts, delay)")
+    for row in [header, *rows]:
+        print("  ".join(c.ljust(w) for c, w in zip(row[:3], widths, strict=True)) + "  " + row[3])
     return 0
 
 
@@ -189,6 +190,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("fcplan: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. `fcplan scenarios | head`
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

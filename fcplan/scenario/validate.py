@@ -163,12 +163,12 @@ def agent_field(agents: list[AgentSpec], role: Role, k: int, name: str) -> str:
     """TOML path of agent field ``name`` for the ``k``-th (0-based) agent of ``role``.
 
     ``team.<role>.<name>`` when every agent of that role has the same value (a scalar in TOML),
-    else ``team.<role>.<name>[k]``.
+    else ``team.<role>.<name>[k]``. Start positions are always per agent.
     """
     same_role = [a for a in agents if a.role is role]
     values = {repr(getattr(a, name)) for a in same_role}
     base = f"team.{role.key}.{name}"
-    return base if len(values) == 1 else f"{base}[{k}]"
+    return base if len(values) == 1 and name != "start" else f"{base}[{k}]"
 
 
 # ------------------------------------------------------------------------------------------ errors
