@@ -39,8 +39,12 @@ def median_us(fn, n: int) -> float:
 
 
 def fire_for(scenario, seed: int = 0) -> Fire:
-    return Fire(scenario.regions, scenario.world_size, scenario.ticks_per_second,
-                np.random.default_rng(seed))
+    return Fire(
+        scenario.regions,
+        scenario.world_size,
+        scenario.ticks_per_second,
+        np.random.default_rng(seed),
+    )
 
 
 def bench_scenarios(names, ticks: int, repeats: int) -> None:
@@ -53,17 +57,21 @@ def bench_scenarios(names, ticks: int, repeats: int) -> None:
         print(f"{sc.name:<10} {fire.n_fronts:>6} {us:>9.1f} {fire.n_burning:>21}")
     print()
     print("## Whole episode with greedy (world + belief + task graph + replans + metrics)")
-    print(f"{'scenario':<10} {'episode s':>9} {'us/tick':>9} {'replans':>8} {'solve p50 ms':>13}"
-          f" {'final (manual)':>15}")
+    print(
+        f"{'scenario':<10} {'episode s':>9} {'us/tick':>9} {'replans':>8} {'solve p50 ms':>13}"
+        f" {'final (manual)':>15}"
+    )
     for name in names:
         walls = []
         for _ in range(repeats):
             res = fcplan.run_episode(name, "greedy", seed=0)
             walls.append(res.wall_time_s)
         wall = statistics.median(walls)
-        print(f"{res.scenario:<10} {wall:>9.3f} {wall / res.ticks * 1e6:>9.1f} "
-              f"{len(res.solves):>8} {np.median(res.solve_times_s) * 1e3:>13.2f} "
-              f"{res.metrics['manual'].final_score:>15.1f}")
+        print(
+            f"{res.scenario:<10} {wall:>9.3f} {wall / res.ticks * 1e6:>9.1f} "
+            f"{len(res.solves):>8} {np.median(res.solve_times_s) * 1e3:>13.2f} "
+            f"{res.metrics['manual'].final_score:>15.1f}"
+        )
     print()
 
 
@@ -105,9 +113,17 @@ def scaling(ticks: int) -> None:
             k = max(1, min(25, n // 10))  # regions
             rng = np.random.default_rng(1)
             centres = rng.uniform(100, w - 100, size=(k, 2))
-            regions = [FireRegionParams(center=(float(cx), float(cy)), fronts=n // k, delay_s=0,
-                                        fuel=10, wind_speed=5, wind_dir_deg=45)
-                       for cx, cy in centres]
+            regions = [
+                FireRegionParams(
+                    center=(float(cx), float(cy)),
+                    fronts=n // k,
+                    delay_s=0,
+                    fuel=10,
+                    wind_speed=5,
+                    wind_dir_deg=45,
+                )
+                for cx, cy in centres
+            ]
             fire = Fire(regions, w, 10, np.random.default_rng(0))
             for _ in range(50):
                 fire.step()
@@ -126,8 +142,10 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args()
     ticks = 300 if args.quick else 1800
-    print(f"fcplan {fcplan.__version__}, numpy {np.__version__}, Python "
-          f"{platform.python_version()}, {platform.machine()}\n")
+    print(
+        f"fcplan {fcplan.__version__}, numpy {np.__version__}, Python "
+        f"{platform.python_version()}, {platform.machine()}\n"
+    )
     bench_scenarios(["practice", "1", "12", "24"], ticks, 1 if args.quick else 3)
     scaling(100 if args.quick else 300)
 

@@ -75,10 +75,18 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("scenario", help="practice, 1..24, or a TOML file")
     r.add_argument("--scheduler", "-s", default="greedy", help="registered scheduler name")
     r.add_argument("--seed", type=_seed, default=0, help="random seed (integer >= 0)")
-    r.add_argument("--replan-period", type=_positive_float, default=1.0,
-                   help="simulated seconds between replans (default 1.0)")
-    r.add_argument("--time-limit", type=_positive_float, default=None,
-                   help="seconds per scheduler call (default: the scheduler's own)")
+    r.add_argument(
+        "--replan-period",
+        type=_positive_float,
+        default=1.0,
+        help="simulated seconds between replans (default 1.0)",
+    )
+    r.add_argument(
+        "--time-limit",
+        type=_positive_float,
+        default=None,
+        help="seconds per scheduler call (default: the scheduler's own)",
+    )
     r.add_argument("--json", action="store_true", help="print the results as JSON")
     return p
 

@@ -175,7 +175,8 @@ class Fire:
         #: (n,) int64 flat index of each front's current cell (valid while alive).
         self.cell = np.where(
             self.alive,
-            np.clip(self.x, 0, w - 1).astype(np.int64) * w + np.clip(self.y, 0, w - 1).astype(np.int64),
+            np.clip(self.x, 0, w - 1).astype(np.int64) * w
+            + np.clip(self.y, 0, w - 1).astype(np.int64),
             0,
         )
         #: (B, B) int32 burning cells per ``BLOCK`` x ``BLOCK`` block: lets callers skip empty
@@ -234,7 +235,9 @@ class Fire:
     def any_burning_in(self, x0: int, x1: int, y0: int, y1: int) -> bool:
         """True if a cell in ``[x0, x1) x [y0, y1)`` may burn (exact for block-aligned ranges;
         otherwise a cheap necessary condition)."""
-        b = self.block_burning[x0 // BLOCK : (x1 - 1) // BLOCK + 1, y0 // BLOCK : (y1 - 1) // BLOCK + 1]
+        b = self.block_burning[
+            x0 // BLOCK : (x1 - 1) // BLOCK + 1, y0 // BLOCK : (y1 - 1) // BLOCK + 1
+        ]
         return bool(b.any())
 
     # ------------------------------------------------------------------ dynamics

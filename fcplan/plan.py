@@ -75,7 +75,9 @@ def validate_plan(plan: Plan, graph: TaskGraph) -> None:
     aidx, tidx = graph.agent_index, graph.task_index
     for agent in list(plan.routes) + list(plan.altitudes) + list(plan.patrol) + list(plan.home):
         if agent not in aidx:
-            raise PlanError(f"plan names unknown agent {agent!r}; agents are {', '.join(graph.agent_ids)}")
+            raise PlanError(
+                f"plan names unknown agent {agent!r}; agents are {', '.join(graph.agent_ids)}"
+            )
     both = set(plan.home) & {a for a, r in plan.routes.items() if r}
     if both:
         raise PlanError(f"agents {sorted(both)} are both routed and sent home")
@@ -131,6 +133,11 @@ def plan_commands(plan: Plan, graph: TaskGraph) -> dict[str, Command]:
         route = plan.routes.get(agent)
         pts = None
         if route is not None:
-            pts = tuple((float(graph.task_pos[tidx[t], 0]), float(graph.task_pos[tidx[t], 1])) for t in route)
-        out[agent] = Command(route=pts, patrol=agent in plan.patrol, altitude=plan.altitudes.get(agent))
+            pts = tuple(
+                (float(graph.task_pos[tidx[t], 0]), float(graph.task_pos[tidx[t], 1]))
+                for t in route
+            )
+        out[agent] = Command(
+            route=pts, patrol=agent in plan.patrol, altitude=plan.altitudes.get(agent)
+        )
     return out

@@ -260,9 +260,7 @@ class TaskGraph:
             if b >= 0:
                 g.add_edge(t, self.task_ids[b], kind="requires")
             for f in np.flatnonzero(np.isfinite(self.threat_time_s[k])):
-                g.add_edge(
-                    t, fac_ids[f], kind="threatens", time_s=float(self.threat_time_s[k, f])
-                )
+                g.add_edge(t, fac_ids[f], kind="threatens", time_s=float(self.threat_time_s[k, f]))
         times = self.agent_task_time
         can = self.can_do
         for i, a in enumerate(self.agent_ids):
@@ -278,10 +276,14 @@ def _pairwise(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _rect_distance(points: np.ndarray, rects: np.ndarray) -> np.ndarray:
     """(P, F) distance from points to axis-aligned rectangles (0 inside)."""
-    dx = np.maximum(np.maximum(rects[None, :, 0] - points[:, None, 0], 0.0),
-                    points[:, None, 0] - rects[None, :, 1])
-    dy = np.maximum(np.maximum(rects[None, :, 2] - points[:, None, 1], 0.0),
-                    points[:, None, 1] - rects[None, :, 3])
+    dx = np.maximum(
+        np.maximum(rects[None, :, 0] - points[:, None, 0], 0.0),
+        points[:, None, 0] - rects[None, :, 1],
+    )
+    dy = np.maximum(
+        np.maximum(rects[None, :, 2] - points[:, None, 1], 0.0),
+        points[:, None, 1] - rects[None, :, 3],
+    )
     return np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
 
 
@@ -376,7 +378,10 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     # search value: age (capped) times (1 + nearby known fire)
     near_fire = np.zeros(nb * nb)
     if n_fire:
-        fb = (np.minimum(fire_pos[:, 0] // blk, nb - 1) * nb + np.minimum(fire_pos[:, 1] // blk, nb - 1)).astype(np.int64)
+        fb = (
+            np.minimum(fire_pos[:, 0] // blk, nb - 1) * nb
+            + np.minimum(fire_pos[:, 1] // blk, nb - 1)
+        ).astype(np.int64)
         near = np.bincount(fb, weights=counts, minlength=nb * nb).reshape(nb, nb)
         # spread to the 8 neighbours: fire grows across block borders
         padded = np.pad(near, 1)
@@ -388,7 +393,9 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         fire_block = n_fire + fb
     else:
         fire_block = np.zeros(0, dtype=np.int64)
-    search_value = np.minimum(search_age, p.search_value_cap_s) * (1.0 + np.minimum(near_fire, 50) / 10.0)
+    search_value = np.minimum(search_age, p.search_value_cap_s) * (
+        1.0 + np.minimum(near_fire, 50) / 10.0
+    )
 
     fire_ids = tuple(
         f"fire:{int(x)}:{int(y)}" for x, y in zip(fire_pos[:, 0], fire_pos[:, 1], strict=True)

@@ -95,10 +95,12 @@ class GreedyScheduler:
         objective = 0.0
 
         # 1. action agents -> fires
-        actors = np.flatnonzero(free & graph.agent_can_act & (graph.agent_tank > 0)
-                                & ~graph.agent_can_sense)
-        hybrids = np.flatnonzero(free & graph.agent_can_act & graph.agent_can_sense
-                                 & (graph.agent_tank > 0))
+        actors = np.flatnonzero(
+            free & graph.agent_can_act & (graph.agent_tank > 0) & ~graph.agent_can_sense
+        )
+        hybrids = np.flatnonzero(
+            free & graph.agent_can_act & graph.agent_can_sense & (graph.agent_tank > 0)
+        )
         actors = np.r_[actors, hybrids].astype(np.int64)
         first_fire: dict[int, int] = {}
         if actors.size and fires.size:
@@ -108,8 +110,15 @@ class GreedyScheduler:
                 np.exp(-(graph.task_staleness[fires] - self.fresh_s) / max(self.fresh_s, 1e-9)),
             )
             value = graph.task_value[fires] * fresh
-            picks, gained = self._assign(graph, actors, fires, value, start, budget,
-                                         limit=np.minimum(graph.agent_tank[actors], self.route_length))
+            picks, gained = self._assign(
+                graph,
+                actors,
+                fires,
+                value,
+                start,
+                budget,
+                limit=np.minimum(graph.agent_tank[actors], self.route_length),
+            )
             objective += gained
             for row, tasks in picks.items():
                 if tasks:
@@ -141,13 +150,25 @@ class GreedyScheduler:
                 alts[graph.agent_ids[i]] = self._clip_alt(graph, i, self.watch_altitude)
 
         # 3. the others search
-        searchers = np.array([i for i in np.r_[sensors, hybrids] if i not in busy
-                              and graph.agent_ids[i] not in routes], dtype=np.int64)
+        searchers = np.array(
+            [
+                i
+                for i in np.r_[sensors, hybrids]
+                if i not in busy and graph.agent_ids[i] not in routes
+            ],
+            dtype=np.int64,
+        )
         blocks = graph.search_tasks
         if searchers.size and blocks.size:
             picks, gained = self._assign(
-                graph, searchers, blocks, graph.task_value[blocks].astype(np.float64), start,
-                budget, limit=np.full(searchers.size, self.search_route_length), spread=True,
+                graph,
+                searchers,
+                blocks,
+                graph.task_value[blocks].astype(np.float64),
+                start,
+                budget,
+                limit=np.full(searchers.size, self.search_route_length),
+                spread=True,
             )
             objective += gained
             for row, tasks in picks.items():

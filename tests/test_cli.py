@@ -13,9 +13,20 @@ def test_run_prints_both_metric_definitions(capsys):
     """`fcplan run practice` prints every manual metric, both definitions, ticks and wall time."""
     assert main(["run", "practice", "--scheduler", "greedy", "--seed", "0"]) == 0
     out = capsys.readouterr().out
-    for text in ("total negative reward", "negative reward ratio", "overall firefighting",
-                 "perception", "action", "facility protection", "final score", "grade",
-                 "manual", "reference2020", "1800 ticks", "wall time"):
+    for text in (
+        "total negative reward",
+        "negative reward ratio",
+        "overall firefighting",
+        "perception",
+        "action",
+        "facility protection",
+        "final score",
+        "grade",
+        "manual",
+        "reference2020",
+        "1800 ticks",
+        "wall time",
+    ):
         assert text in out, text
 
 
@@ -71,10 +82,14 @@ def test_bad_input_gives_one_line_and_exit_2(tmp_path, capsys):
 
 def test_console_entry_point_runs_as_module():
     """`python -m fcplan run` works and errors exit 2 without a traceback."""
-    ok = subprocess.run([sys.executable, "-m", "fcplan", "run", "3", "-s", "idle", "--json"],
-                        capture_output=True, text=True)
+    ok = subprocess.run(
+        [sys.executable, "-m", "fcplan", "run", "3", "-s", "idle", "--json"],
+        capture_output=True,
+        text=True,
+    )
     assert ok.returncode == 0 and json.loads(ok.stdout)["scenario"] == "#3"
-    bad = subprocess.run([sys.executable, "-m", "fcplan", "run", "nope"],
-                         capture_output=True, text=True)
+    bad = subprocess.run(
+        [sys.executable, "-m", "fcplan", "run", "nope"], capture_output=True, text=True
+    )
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
     assert len(bad.stderr.strip().splitlines()) == 1

@@ -25,7 +25,8 @@ def test_metrics_are_recomputable_from_the_trace_alone():
     res = run_episode(3, "greedy", seed=1)
     again = compute_all(res.trace)
     assert {k: m.as_dict() for k, m in again.items()} == {
-        k: m.as_dict() for k, m in res.metrics.items()}
+        k: m.as_dict() for k, m in res.metrics.items()
+    }
 
 
 def test_periodic_replans_follow_the_period():
@@ -68,4 +69,6 @@ def test_idle_team_scores_nothing_and_greedy_prunes():
 def test_summary_has_headline_numbers():
     """EpisodeResult.summary flattens both metric definitions and the solve statistics."""
     s = run_episode("practice", "greedy", seed=0).summary()
-    assert {"manual.final_score", "reference2020.final_score", "solve_p95_ms", "fallbacks"} <= set(s)
+    assert {"manual.final_score", "reference2020.final_score", "solve_p95_ms", "fallbacks"} <= set(
+        s
+    )

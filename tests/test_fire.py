@@ -126,8 +126,12 @@ def test_fronts_leaving_the_map_die_without_a_phantom_cell():
     assert (~fire.alive).any()
     assert fire.state[0, 0] != BURNING or 0 in (fire.cell[fire.alive])
     dead_cells = fire.cell[~fire.alive]
-    assert np.all((fire.x[~fire.alive] < 0) | (fire.x[~fire.alive] >= 1200)
-                  | (fire.y[~fire.alive] < 0) | (fire.y[~fire.alive] >= 1200))
+    assert np.all(
+        (fire.x[~fire.alive] < 0)
+        | (fire.x[~fire.alive] >= 1200)
+        | (fire.y[~fire.alive] < 0)
+        | (fire.y[~fire.alive] >= 1200)
+    )
     assert dead_cells.size > 0
 
 

@@ -159,8 +159,12 @@ def test_unknown_agent_in_command_is_a_plan_error():
 
 points = st.tuples(st.floats(0, 1199), st.floats(0, 1199))
 commands = st.one_of(
-    st.builds(Command, route=st.lists(points, max_size=4).map(tuple), patrol=st.booleans(),
-              altitude=st.one_of(st.none(), st.floats(0, 150))),
+    st.builds(
+        Command,
+        route=st.lists(points, max_size=4).map(tuple),
+        patrol=st.booleans(),
+        altitude=st.one_of(st.none(), st.floats(0, 150)),
+    ),
     st.just(Command(home=True)),
     st.none(),
 )
@@ -175,8 +179,16 @@ commands = st.one_of(
 def test_battery_and_tank_never_negative_and_agents_recover(script, battery, tank):
     """Under any command sequence battery and tank stay in [0, capacity], agents forced home
     dock and get full battery and tank, and no agent is lost."""
-    team = Team(scenario_with(1, **{"team.perception.battery": battery,
-                                    "team.action.battery": battery, "team.action.tank": tank}))
+    team = Team(
+        scenario_with(
+            1,
+            **{
+                "team.perception.battery": battery,
+                "team.action.battery": battery,
+                "team.action.tank": tank,
+            },
+        )
+    )
     for agent, cmd, dump in script:
         if cmd is not None:
             team.apply({agent: cmd})

@@ -53,7 +53,8 @@ def test_sensing_rate_matches_altitude_confidence(z):
     hx = z
     hy = 0.57735 * z
     in_view = (np.abs(block(580, 580, 40, 22)[:, 0] - 600) <= hx) & (
-        np.abs(block(580, 580, 40, 22)[:, 1] - 591) <= hy)
+        np.abs(block(580, 580, 40, 22)[:, 1] - 591) <= hy
+    )
     expected = 1 - 0.6 * (z - 10) / 90
     got = info.sensed.size / in_view.sum()
     assert got == pytest.approx(expected, abs=0.08)
@@ -128,9 +129,16 @@ def test_facility_counts_follow_ignition_and_pruning():
 
 
 @settings(max_examples=15, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), moves=st.lists(
-    st.tuples(st.sampled_from(["P1", "P2", "A1", "A2"]),
-              st.tuples(st.floats(150, 600), st.floats(150, 600))), max_size=8))
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    moves=st.lists(
+        st.tuples(
+            st.sampled_from(["P1", "P2", "A1", "A2"]),
+            st.tuples(st.floats(150, 600), st.floats(150, 600)),
+        ),
+        max_size=8,
+    ),
+)
 def test_counts_are_conserved(seed, moves):
     """Every tick: active + pruned = ever ignited, sensed_active <= active, sensed_ever <=
     active + pruned, facility counts match the grid, and pruned cells never burn again."""
@@ -169,8 +177,13 @@ def test_same_seed_gives_byte_identical_traces_across_processes():
     another seed differs."""
     code = "from tests.test_world import _trace_digest; print(_trace_digest(7))"
     out = [
-        subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                       cwd=str(__import__("pathlib").Path(__file__).parents[1])).stdout.strip()
+        subprocess.run(
+            [sys.executable, "-c", code],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=str(__import__("pathlib").Path(__file__).parents[1]),
+        ).stdout.strip()
         for _ in range(2)
     ]
     assert out[0] == out[1] == _trace_digest(7)

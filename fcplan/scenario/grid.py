@@ -6,8 +6,8 @@ numbered from 1 along y (y grows downward), written with at least two digits (``
 ``100``...). A cell is named ``"<letters>-<row>"``, e.g. ``"D-05"`` spans x in [300, 400) and
 y in [400, 500).
 
-In the FireCommander GUI an object is placed by typing the **top-left** cell of the block of cells it
-reserves; its pixel centre is the centre of that block:
+In the FireCommander GUI an object is placed by typing the **top-left** cell of the block of cells
+it reserves; its pixel centre is the centre of that block:
 
 =================  ============  ===============================
 object (kind)      block (c x r)  centre from top-left cell (c, r)

@@ -51,8 +51,15 @@ def test_cell_center_defaults_to_a_fire_region_and_returns_floats():
 def test_column_letters_continue_past_z():
     """Columns are A..Z, then AA, AB, ... (bijective base 26)."""
     assert [column_letters(i) for i in (0, 25, 26, 27, 51, 52, 701, 702)] == [
-        "A", "Z", "AA", "AB", "AZ", "BA", "ZZ", "AAA",
-    ]  # fmt: skip
+        "A",
+        "Z",
+        "AA",
+        "AB",
+        "AZ",
+        "BA",
+        "ZZ",
+        "AAA",
+    ]
 
 
 def test_rows_have_at_least_two_digits():

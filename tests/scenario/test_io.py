@@ -86,13 +86,25 @@ def test_base_design_loads_with_defaults(tmp_path):
     assert s.ticks_per_second == 10 and s.action_gate == "sensed" and s.comm_range is None
     r = s.regions[0]
     assert (r.center, r.cell, r.fronts, r.delay_s, r.fuel, r.wind_speed, r.wind_dir_deg) == (
-        (450, 150), "E-02", 4, 0, 8, 5, 90,
-    )  # fmt: skip
+        (450, 150),
+        "E-02",
+        4,
+        0,
+        8,
+        5,
+        90,
+    )
     assert r.half_width == 50
     assert s.depot.center == (100, 200) and s.depot.penalty == 5
     assert s.facilities[0].center == (600, 500) and s.facilities[0].penalty == 1
     p1, a1, a2 = s.agents
-    assert (p1.altitude, p1.start_altitude, p1.battery, p1.speed, p1.tank) == ((10, 100), 20, 500, 20, 0)
+    assert (p1.altitude, p1.start_altitude, p1.battery, p1.speed, p1.tank) == (
+        (10, 100),
+        20,
+        500,
+        20,
+        0,
+    )
     assert (a1.altitude, a1.start_altitude, a1.tank, a1.prune_confidence) == ((30, 30), 30, 10, 0.9)
     assert [a.start for a in s.agents] == [(60, 20), (60, 80), (60, 140)]
     assert s.source == str(tmp_path / "design.toml")
@@ -101,7 +113,7 @@ def test_base_design_loads_with_defaults(tmp_path):
 def test_fire_table_values_are_defaults_for_every_region(tmp_path):
     """Region parameters in [fire] apply to every region that does not give its own."""
     text = edit('mode = "specific"', 'mode = "specific"\nfuel = 3\ndelay_s = 20')
-    text += '\n[[fire.regions]]\ncenter = [725, 675]\nfronts = 2\nwind_dir_deg = 0\n'
+    text += "\n[[fire.regions]]\ncenter = [725, 675]\nfronts = 2\nwind_dir_deg = 0\n"
     s = load_scenario(write(tmp_path, text))
     assert [r.fuel for r in s.regions] == [8, 3]
     assert [r.delay_s for r in s.regions] == [20, 20]
@@ -117,8 +129,13 @@ def test_hybrid_and_heterogeneous_team(tmp_path):
     s = load_scenario(write(tmp_path, text))
     h1, h2 = s.agents[3:]
     assert (h1.id, h1.role, h1.altitude, h1.battery, h1.speed, h1.tank) == (
-        "H1", Role.HYBRID, (10, 60), 300, 15, 3,
-    )  # fmt: skip
+        "H1",
+        Role.HYBRID,
+        (10, 60),
+        300,
+        15,
+        3,
+    )
     assert (h2.altitude, h2.start_altitude, h2.battery, h2.tank) == ((25, 100), 25, 700, 4)
     assert h1.prune_confidence == h2.prune_confidence == 0.8
     assert h2.start == s.depot.slots(5)[4]
@@ -177,14 +194,31 @@ def test_malformed_toml_gives_line_and_column(tmp_path):
 @pytest.mark.parametrize(
     ("old", "new", "field", "allowed"),
     [
-        ("fronts = 4", "frontz = 4", "fire.regions[0].frontz", "allowed keys: cell, center, fronts"),
+        (
+            "fronts = 4",
+            "frontz = 4",
+            "fire.regions[0].frontz",
+            "allowed keys: cell, center, fronts",
+        ),
         ('name = "small"', 'name = "small"\nseed = 1', "seed", "allowed keys: name, number"),
-        ('orientation = "vertical"', 'orientation = "vertical"\nangle = 0', "depot.angle",
-         "allowed keys: cell, center, orientation"),  # fmt: skip
-        ("[team.action]", "[team.action]\naltitude = [10, 100]", "team.action.altitude",
-         "allowed keys: count, battery, speed, tank, prune_confidence, start"),  # fmt: skip
-        ("[team.action]", "[team.drones]\ncount = 1\n[team.action]", "team.drones",
-         "allowed keys: perception, action, hybrid"),  # fmt: skip
+        (
+            'orientation = "vertical"',
+            'orientation = "vertical"\nangle = 0',
+            "depot.angle",
+            "allowed keys: cell, center, orientation",
+        ),
+        (
+            "[team.action]",
+            "[team.action]\naltitude = [10, 100]",
+            "team.action.altitude",
+            "allowed keys: count, battery, speed, tank, prune_confidence, start",
+        ),
+        (
+            "[team.action]",
+            "[team.drones]\ncount = 1\n[team.action]",
+            "team.drones",
+            "allowed keys: perception, action, hybrid",
+        ),
     ],
 )
 def test_unknown_keys_are_errors(tmp_path, old, new, field, allowed):
@@ -202,14 +236,30 @@ def test_unknown_keys_are_errors(tmp_path, old, new, field, allowed):
         ("world_size = 800", "world_size = 800.5", "world_size", "must be an integer"),
         ('cell = "E-02"', "cell = 5", "fire.regions[0].cell", "must be a cell name like 'D-05'"),
         ('cell = "E-02"', "center = [450]", "fire.regions[0].center", "must be a pair of numbers"),
-        ("[team.action]\ncount = 2", "[team.action]\ncount = 2\nbattery = [500]",
-         "team.action.battery", "one per agent (2 agents)"),  # fmt: skip
-        ("[team.action]\ncount = 2", "[team.action]\ncount = 3\nstart = [60, 80]",
-         "team.action.start", "must be a list with one a pair of numbers [x, y] per agent"),  # fmt: skip
-        ("[team.action]\ncount = 2", "[team.action]\ncount = 2\nstart = [60, 80]",
-         "team.action.start[0]", "must be a pair of numbers [x, y] (got 60)"),  # fmt: skip
-        ("[team.action]\ncount = 2", "[team.action]\ncount = 2\ntank = [1, false]",
-         "team.action.tank[1]", "must be an integer (got False)"),  # fmt: skip
+        (
+            "[team.action]\ncount = 2",
+            "[team.action]\ncount = 2\nbattery = [500]",
+            "team.action.battery",
+            "one per agent (2 agents)",
+        ),
+        (
+            "[team.action]\ncount = 2",
+            "[team.action]\ncount = 3\nstart = [60, 80]",
+            "team.action.start",
+            "must be a list with one a pair of numbers [x, y] per agent",
+        ),
+        (
+            "[team.action]\ncount = 2",
+            "[team.action]\ncount = 2\nstart = [60, 80]",
+            "team.action.start[0]",
+            "must be a pair of numbers [x, y] (got 60)",
+        ),
+        (
+            "[team.action]\ncount = 2",
+            "[team.action]\ncount = 2\ntank = [1, false]",
+            "team.action.tank[1]",
+            "must be an integer (got False)",
+        ),
         ('name = "small"', "name = 3", "name", "must be a string (got 3)"),
         ('name = "small"', 'name = "small"\nnotes = "x"', "notes", "must be a list of strings"),
     ],
@@ -223,19 +273,35 @@ def test_wrong_types_are_errors(tmp_path, old, new, field, problem):
 @pytest.mark.parametrize(
     ("old", "new", "field", "problem"),
     [
-        ('cell = "E-02"', 'cell = "E-02"\ncenter = [450, 150]', "fire.regions[0]",
-         "give either cell or center, not both"),  # fmt: skip
+        (
+            'cell = "E-02"',
+            'cell = "E-02"\ncenter = [450, 150]',
+            "fire.regions[0]",
+            "give either cell or center, not both",
+        ),
         ('cell = "E-02"\n', "", "fire.regions[0].cell", "is required"),
         ('cell = "E-02"', 'cell = "I-02"', "fire.regions[0].cell", "8x8 grid of a 800 px map"),
         ('name = "small"\n', "", "name", "is required (a string)"),
-        ("[team.perception]\ncount = 1", "[team.perception]\nbattery = 3", "team.perception.count",
-         "is required"),  # fmt: skip
-        ("[team.perception]\ncount = 1", "[team.perception]\ncount = -1", "team.perception.count",
-         "must be an integer >= 0"),  # fmt: skip
-        ('orientation = "vertical"', 'orientation = "diagonal"', "depot.orientation",
-         "must be one of 'vertical', 'horizontal'"),  # fmt: skip
+        (
+            "[team.perception]\ncount = 1",
+            "[team.perception]\nbattery = 3",
+            "team.perception.count",
+            "is required",
+        ),
+        (
+            "[team.perception]\ncount = 1",
+            "[team.perception]\ncount = -1",
+            "team.perception.count",
+            "must be an integer >= 0",
+        ),
+        (
+            'orientation = "vertical"',
+            'orientation = "diagonal"',
+            "depot.orientation",
+            "must be one of 'vertical', 'horizontal'",
+        ),
         ('kind = "house"', 'kind = "depot"', "facilities[0].kind", "the depot goes in [depot]"),
-        ("[fire]", "[fire]\naction_gate = \"never\"", "fire.action_gate", "'sensed', 'reference'"),
+        ("[fire]", '[fire]\naction_gate = "never"', "fire.action_gate", "'sensed', 'reference'"),
     ],
 )
 def test_structural_errors_name_the_field(tmp_path, old, new, field, problem):
@@ -253,7 +319,9 @@ def test_missing_depot_is_an_error(tmp_path):
 def test_from_dict_errors_use_the_name_without_a_file():
     """from_dict without a source attributes errors to the scenario name."""
     doc = tomllib.loads(edit("fronts = 4", "fronts = 0"))
-    with pytest.raises(ScenarioError, match=r"^small: fire.regions\[0\].fronts: must be an integer >= 1"):
+    with pytest.raises(
+        ScenarioError, match=r"^small: fire.regions\[0\].fronts: must be an integer >= 1"
+    ):
         load_scenario(1).from_dict(doc)
 
 
@@ -274,7 +342,9 @@ def test_round_trip_keeps_non_default_details(tmp_path):
     agents[0] = dataclasses.replace(agents[0], start=(333.5, 870), start_altitude=55)
     agents[3] = dataclasses.replace(agents[3], battery=250.25)
     facilities = list(base.facilities)
-    facilities[1] = dataclasses.replace(facilities[1], penalty=4, size=(100, 100), center=(510, 405), cell=None)
+    facilities[1] = dataclasses.replace(
+        facilities[1], penalty=4, size=(100, 100), center=(510, 405), cell=None
+    )
     facilities[4] = dataclasses.replace(facilities[4], penalty=0)
     s = base.replace(
         regions=(

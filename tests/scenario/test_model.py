@@ -36,7 +36,10 @@ def make_scenario(**changes) -> Scenario:
         fire_mode="specific",
         regions=[FireRegion((450, 150), 5, 0, 10, 5, 45, cell="E-02")],
         depot=Depot((100, 200), "vertical", cell="A-01"),
-        facilities=[Facility.standard("house", (600, 600)), Facility.standard("hospital", (400, 600))],
+        facilities=[
+            Facility.standard("house", (600, 600)),
+            Facility.standard("hospital", (400, 600)),
+        ],
         lakes=[Lake((650, 300))],
         agents=[
             AgentSpec("P1", Role.PERCEPTION, (60, 20), (10, 100), 20, 500, 20, 0, 0.0),
@@ -86,8 +89,12 @@ def test_depot_sizes_and_facility_view():
     assert v.footprint == (20, 180, 400, 800)
     fac = h.as_facility()
     assert (fac.kind, fac.center, fac.size, fac.penalty, fac.cell) == (
-        "depot", (500, 900), (400, 160), 5, "D-09",
-    )  # fmt: skip
+        "depot",
+        (500, 900),
+        (400, 160),
+        5,
+        "D-09",
+    )
 
 
 @pytest.mark.parametrize("orientation", ["vertical", "horizontal"])
@@ -158,7 +165,9 @@ def test_agent_index_is_its_position_within_the_role():
 
 def test_direct_construction_is_validated():
     """Scenario(...) in Python raises ScenarioError for invalid values, naming the field."""
-    with pytest.raises(ScenarioError, match=r"^tiny: fire.regions\[0\].fronts: must be an integer >= 1"):
+    with pytest.raises(
+        ScenarioError, match=r"^tiny: fire.regions\[0\].fronts: must be an integer >= 1"
+    ):
         make_scenario(regions=[FireRegion((450, 150), 0, 0, 10, 5, 45)])
     with pytest.raises(ScenarioError, match=r"team.action.tank: must be an integer >= 1"):
         make_scenario(
@@ -190,7 +199,9 @@ def test_equality_ignores_the_source_file():
 
 def test_summary_is_one_line():
     """summary() names the scenario, difficulty, team and regions on one line."""
-    assert load_scenario(12).summary() == "#12  moderate  team 3P/2A  regions D-08(3f) K-11(10f, +60s)"
+    assert (
+        load_scenario(12).summary() == "#12  moderate  team 3P/2A  regions D-08(3f) K-11(10f, +60s)"
+    )
     tiny = make_scenario(regions=[FireRegion((455, 150), 5, 30, 10, 5, 45)])
     assert tiny.summary() == "tiny  custom  team 1P/1A  regions (455,150)(5f, +30s)  800px 60s"
 
