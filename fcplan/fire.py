@@ -84,6 +84,11 @@ class FireRegionParams:
     half_width: float = 50.0
 
 
+def _lb(u):
+    """FARSITE length-to-breadth ratio LB(U) (reference exponents 0.2566 and 0.1548)."""
+    return 0.936 * np.exp(0.2566 * u) + 0.461 * np.exp(-0.1548 * u) - 0.397
+
+
 def spread_rate_ratio(wind_speed: np.ndarray | float) -> np.ndarray:
     """FARSITE ``C / R`` as a function of wind speed ``U`` (0 at U = 0, about 0.487 at U = 5).
 
@@ -92,8 +97,7 @@ def spread_rate_ratio(wind_speed: np.ndarray | float) -> np.ndarray:
     >>> round(float(spread_rate_ratio(5.0)), 3)
     0.487
     """
-    u = np.asarray(wind_speed, dtype=np.float64)
-    lb = 0.936 * np.exp(0.2566 * u) + 0.461 * np.exp(-0.1548 * u) - 0.397
+    lb = _lb(np.asarray(wind_speed, dtype=np.float64))
     s = np.sqrt(np.abs(lb * lb - 1.0))
     with np.errstate(divide="ignore", invalid="ignore"):
         inv_hb = np.where(lb - s != 0.0, (lb - s) / (lb + s), 1.0)
@@ -187,6 +191,7 @@ class Fire:
         self._nblk = nblk
         #: (n,) bool: the front stands in a pruned cell and never moves again.
         self.frozen = np.zeros(n, dtype=bool)
+        self._moving: np.ndarray | None = None  # cached rows of moving fronts
         self.n_burning = 0
         self.n_pruned = 0
         self.n_ignited = 0
@@ -265,24 +270,29 @@ class Fire:
             waking = (~self.region_active) & (self.delay_ticks <= self.tick)
             if waking.any():
                 self.region_active |= waking
+                self._moving = None
                 new = self._ignite(self.cell[self.alive & waking[self.region]])
         z = self.rng.standard_normal((2, self.n_fronts))
-        idx = np.flatnonzero(self.alive & self.region_active[self.region] & ~self.frozen)
+        if self._moving is None:
+            self._refresh_moving()
+        idx = self._moving
         if idx.size == 0:
             return new
         np.add.at(self._visits_flat, self.cell[idx], _ONE)
         xm, ym = self.x[idx], self.y[idx]
-        u = self._wind[idx] + WIND_SPEED_SD * z[0, idx]
-        theta = self._theta[idx] + WIND_DIR_SD_RAD * z[1, idx]
+        zz = z[:, idx]
+        u = self._m_wind + WIND_SPEED_SD * zz[0]
+        theta = self._m_theta + WIND_DIR_SD_RAD * zz[1]
         fuel = self.terrain[np.rint(xm).astype(np.int64), np.rint(ym).astype(np.int64)]
-        c = np.maximum(self._fuel[idx] * fuel, 1e-15) * spread_rate_ratio(u) * self.dt
+        c = fuel * self._m_fuel_dt * np.interp(u, _U_GRID, _RATIO_TABLE)
         xm += c * np.sin(theta)
         ym += c * np.cos(theta)
         self.x[idx] = xm
         self.y[idx] = ym
-        inside = (xm >= 0.0) & (xm < w) & (ym >= 0.0) & (ym < w)
+        inside = (np.minimum(xm, ym) >= 0.0) & (np.maximum(xm, ym) < w)
         if not inside.all():
             self.alive[idx[~inside]] = False
+            self._moving = None
             idx, xm, ym = idx[inside], xm[inside], ym[inside]
         flat = xm.astype(np.int64) * w + ym.astype(np.int64)
         self.cell[idx] = flat
@@ -290,8 +300,17 @@ class Fire:
         into_pruned = self._state_flat[flat] == PRUNED
         if into_pruned.any():
             self.frozen[idx[into_pruned]] = True
+            self._moving = None
         fresh = self._ignite(flat)
         return fresh if new.size == 0 else np.concatenate([new, fresh])
+
+    def _refresh_moving(self) -> None:
+        """Cache the fronts that move (alive, region active, not frozen) and their parameters."""
+        idx = np.flatnonzero(self.alive & self.region_active[self.region] & ~self.frozen)
+        self._moving = idx
+        self._m_wind = self._wind[idx]
+        self._m_theta = self._theta[idx]
+        self._m_fuel_dt = self._fuel[idx] * self.dt
 
     def prune(self, flat: np.ndarray) -> np.ndarray:
         """Put out burning cells; return the flat indices actually pruned (they were burning).
@@ -309,9 +328,30 @@ class Fire:
         self.n_burning -= int(hit.size)
         self.n_pruned += int(hit.size)
         self.frozen |= self.alive & (self._state_flat[self.cell] == PRUNED)
+        self._moving = None
         return hit
 
 
 _EMPTY = np.zeros(0, dtype=np.int64)
+
+
+def _ratio_grid() -> np.ndarray:
+    """Wind speeds at which C/R is tabulated: uniform, plus log-spaced points around the kinks
+    where LB(U) = 1 (there sqrt|LB^2 - 1| has an infinite slope)."""
+    from scipy.optimize import brentq
+
+    base = np.linspace(-40.0, 60.0, 20001)
+    gb = _lb(base) ** 2 - 1.0
+    pieces = [base]
+    for k in np.flatnonzero(np.sign(gb[:-1]) != np.sign(gb[1:])):
+        root = brentq(lambda u: _lb(u) ** 2 - 1.0, base[k], base[k + 1], xtol=1e-14)
+        off = np.logspace(-12, 0, 1500)
+        pieces += [root - off, root + off, np.array([root])]
+    return np.unique(np.concatenate(pieces))
+
+
+# C/R tabulated once; linear interpolation stays within 1e-4 of the exact value everywhere.
+_U_GRID = _ratio_grid()
+_RATIO_TABLE = spread_rate_ratio(_U_GRID)
 _ONE = np.uint32(1)
 _ONE32 = np.int32(1)

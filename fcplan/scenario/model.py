@@ -8,8 +8,9 @@ scoring weights. It knows nothing about what happens during a game.
 
 Units are those of the FireCommander GUI: 1 px = 1 map unit (1 m), x to the right, y downward,
 times in simulated seconds. Agent ``speed`` is px per tick at 10 ticks per simulated second (the
-manual's "velocity = step size" per frame) and ``battery`` is in the manual's capacity units (0.1 per
-px flown, 0.05 per hovering tick); the simulator rescales both when ``ticks_per_second`` is not 10.
+manual's "velocity = step size" per frame) and ``battery`` is in the manual's capacity units (0.1
+per px flown, 0.05 per hovering tick); the simulator rescales both when ``ticks_per_second`` is not
+10.
 
 Every dataclass here is frozen. Constructing a :class:`Scenario` validates it (see
 :mod:`fcplan.scenario.validate`): an invalid scenario cannot exist. The parts (regions, facilities,
@@ -327,12 +328,17 @@ class Depot:
     def slots(self, n: int) -> tuple[tuple[float, float], ...]:
         """Start positions of ``n`` agents (perception first, then action, then hybrid).
 
-        The first nine are the GUI's slots (``DEPOT_SLOTS``). Agents beyond the ninth sit on an
-        evenly spaced lattice inside the footprint: the footprint is cut into ``cols x rows``
-        equal boxes (``cols`` across its short side, the fewest boxes that hold them, about square)
-        and agent 10, 11, ... takes the centre of box 0, 1, ... row by row along the long side,
-        rounded to whole px (halves up). Lattice points may coincide with GUI slots; agents are points, so
-        sharing a start is harmless.
+        The first nine are the GUI's slots (``DEPOT_SLOTS``). The ``m`` agents beyond the ninth sit
+        on an evenly spaced lattice inside the footprint: it is cut into ``a`` columns across its
+        short side and ``b`` rows along its long side, ``a = max(1, round(sqrt(m * short / long)))``
+        and ``b = ceil(m / a)``, so that the boxes are about square; extra agent ``k`` (0-based)
+        takes the centre of box ``(k % a, k // a)``, rounded to whole px (halves up). Lattice
+        points may coincide with GUI slots: agents are points, so sharing a start is harmless.
+
+        Examples
+        --------
+        >>> Depot((100, 600), "vertical").slots(12)[9:]
+        ((100.0, 467.0), (100.0, 600.0), (100.0, 733.0))
         """
         (cx, cy) = self.center
         rel = DEPOT_SLOTS.get(self.orientation, DEPOT_SLOTS["vertical"])

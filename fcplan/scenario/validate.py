@@ -305,8 +305,8 @@ def _check_sites(s: Scenario) -> None:
             _require(
                 not _overlap(f.footprint, box),
                 _where(p, f),
-                f"footprint {_fmt_box(f.footprint)} overlaps {other} ({other_path}: {_fmt_box(box)}); "
-                "facility and depot footprints may not overlap",
+                f"footprint {_fmt_box(f.footprint)} overlaps {other} "
+                f"({other_path}: {_fmt_box(box)}); facility and depot footprints may not overlap",
                 _fmt_point(f.center),
             )
         placed.append((f"{f.kind} {_fmt_point(f.center)}", p, f.footprint))
@@ -318,7 +318,8 @@ def _check_sites(s: Scenario) -> None:
                 not (x0 < x < x1 and y0 < y < y1),
                 _where(f"fire.regions[{i}]", r),
                 f"region centre lies inside the footprint of {other} ({other_path}: "
-                f"{_fmt_box((x0, x1, y0, y1))}); fires may not start inside a facility or the depot",
+                f"{_fmt_box((x0, x1, y0, y1))}); "
+                "fires may not start inside a facility or the depot",
                 _fmt_point(r.center),
             )
 

@@ -17,6 +17,15 @@ from fcplan.scenario import (
     load_scenario,
 )
 
+REGION = """\
+[[fire.regions]]
+cell = "E-02"
+fronts = 4
+fuel = 8
+wind_speed = 5
+wind_dir_deg = 90
+"""
+
 BASE = """\
 name = "small"
 world_size = 800
@@ -123,7 +132,8 @@ def load_text(tmp_path: Path, text: str):
         (
             "[team.action]\ncount = 2",
             "[team.action]\ncount = 2\nprune_confidence = 1.5",
-            "team.action.prune_confidence: must be a probability in (0, 1] (the manual's 10..100 %) (got 1.5)",
+            "team.action.prune_confidence: must be a probability in (0, 1] "
+            "(the manual's 10..100 %) (got 1.5)",
         ),
         (
             "[team.action]\ncount = 2",
@@ -166,7 +176,7 @@ def load_text(tmp_path: Path, text: str):
             "team.perception.start[0]: must lie inside the map [0, 800] x [0, 800]",
         ),
         (
-            '[[fire.regions]]\ncell = "E-02"\nfronts = 4\nfuel = 8\nwind_speed = 5\nwind_dir_deg = 90\n',
+            REGION,
             "",
             "fire.regions: must list at least one fire region",
         ),
@@ -185,8 +195,8 @@ def test_overlapping_facilities_are_an_error(tmp_path):
         in msg
     )
     assert (
-        "(facilities[0]: x in (540, 660), y in (425, 575)); facility and depot footprints may not overlap"
-        in msg
+        "(facilities[0]: x in (540, 660), y in (425, 575)); "
+        "facility and depot footprints may not overlap" in msg
     )
 
 
@@ -269,7 +279,8 @@ def test_uniform_mode_requires_identical_region_parameters(tmp_path):
     """In uniform mode every region shares fronts, delay, fuel and wind."""
     two = (
         BASE
-        + '\n[[fire.regions]]\ncell = "B-06"\nfronts = 4\nfuel = 9\nwind_speed = 5\nwind_dir_deg = 90\n'
+        + '\n[[fire.regions]]\ncell = "B-06"\nfronts = 4\nfuel = 9\n'
+        + "wind_speed = 5\nwind_dir_deg = 90\n"
     )
     msg = load_error(tmp_path, two.replace('mode = "specific"', 'mode = "uniform"'))
     assert "fire.regions[1].fuel: must equal fire.regions[0].fuel (8) in uniform fire mode" in msg
@@ -496,7 +507,8 @@ def team_change(role: Role, **changes):
         ),
         (
             team_change(Role.ACTION, start=(500, 500)),
-            "team.action.start[0]: (500, 500) (manual: agents start in their depot slot (480, 860))",
+            "team.action.start[0]: (500, 500) "
+            "(manual: agents start in their depot slot (480, 860))",
         ),
         (
             team_change(Role.HYBRID, start_altitude=50),
@@ -529,12 +541,14 @@ def test_placement_limits_are_reported():
     )
     inland = s.replace(depot=Depot((500, 800), "horizontal"))
     assert (
-        "depot: horizontal depot at D-08 (manual: top-left cell in row 1 or 9, on the top or bottom edge)"
+        "depot: horizontal depot at D-08 "
+        "(manual: top-left cell in row 1 or 9, on the top or bottom edge)"
         in inland.manual_limit_violations()
     )
     vertical = load_scenario(1).replace(depot=Depot((300, 600), "vertical"))
     assert (
-        "depot: vertical depot at C-05 (manual: top-left cell in column A or K, on the left or right edge)"
+        "depot: vertical depot at C-05 "
+        "(manual: top-left cell in column A or K, on the left or right edge)"
         in vertical.manual_limit_violations()
     )
     right_edge = load_scenario(1).replace(depot=Depot((1100, 1000), "vertical"))
@@ -546,8 +560,8 @@ def test_lake_block_past_the_map_edge_is_reported():
     s = within_manual()
     edge = s.replace(lakes=(dataclasses.replace(s.lakes[0], center=(950, 200), cell="I-01"),))
     assert (
-        "lakes[0]: its 3x4 block at I-01 extends past the 10x10 grid (manual: objects fit inside the map)"
-        in (edge.manual_limit_violations())
+        "lakes[0]: its 3x4 block at I-01 extends past the 10x10 grid "
+        "(manual: objects fit inside the map)" in (edge.manual_limit_violations())
     )
 
 
