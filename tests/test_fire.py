@@ -160,3 +160,24 @@ def test_one_visit_gives_reference_peak_intensity():
     peak = fire.intensity()[600, 600]
     assert 19.0 < peak < 25.0
     assert abs(INTENSITY_COEFF - 12.776) < 1e-3
+
+
+def test_tabulated_spread_ratio_matches_formula():
+    """The per-tick lookup table of C/R agrees with the FARSITE formula to 1e-4 for all winds."""
+    from fcplan.fire import _RATIO_TABLE, _U_GRID
+
+    u = np.linspace(-40, 60, 400_001)
+    np.testing.assert_allclose(np.interp(u, _U_GRID, _RATIO_TABLE), spread_rate_ratio(u), atol=1e-4)
+
+
+def test_block_counts_track_burning_cells():
+    """The coarse burning-cell counts used to skip empty views equal the grid's cells per block."""
+    from fcplan.fire import BLOCK
+
+    fire = Fire([region(fronts=30, fuel=15)], 1200, 10, np.random.default_rng(11))
+    for t in range(200):
+        fire.step()
+        if t % 20 == 0:
+            fire.prune(np.flatnonzero(fire.state.reshape(-1) == BURNING)[::3])
+    b = (fire.state == BURNING).reshape(1200 // BLOCK, BLOCK, 1200 // BLOCK, BLOCK).sum(axis=(1, 3))
+    np.testing.assert_array_equal(fire.block_burning, b)
