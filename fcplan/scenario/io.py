@@ -329,6 +329,9 @@ def _build(doc: Any, source: str | None) -> Scenario:
     )
     penalties_t = scoring_t.table("penalties", _PENALTY_KEYS)
     penalties = {k: penalties_t.get(k, "number", v) for k, v in DEFAULT_PENALTIES.items()}
+    for kind, value in penalties.items():
+        if not (math.isfinite(value) and value >= 0):
+            raise ScenarioError(penalties_t.field(kind), "must be a number >= 0", got=value)
 
     if not top.has("depot"):
         raise ScenarioError("depot", "is required (a table with cell or center, and orientation)")

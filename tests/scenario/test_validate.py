@@ -180,6 +180,11 @@ def load_text(tmp_path: Path, text: str):
             "",
             "fire.regions: must list at least one fire region",
         ),
+        (
+            'orientation = "vertical"',
+            'orientation = "vertical"\n[scoring.penalties]\nhospital = -2',
+            "scoring.penalties.hospital: must be a number >= 0 (got -2.0)",
+        ),
     ],
 )
 def test_out_of_range_values_are_one_line_errors(tmp_path, old, new, expected):
