@@ -1,0 +1,240 @@
+"""Tests for fcplan.scheduling: the registry, the Scheduler protocol and solve's fallbacks."""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+import pytest
+
+import fcplan
+from fcplan import scheduling
+from fcplan.belief import Belief
+from fcplan.errors import FcplanError, UnknownNameError
+from fcplan.plan import Plan, validate_plan
+from fcplan.scheduling import (
+    STATUSES,
+    Scheduler,
+    SolveStats,
+    available_schedulers,
+    make_scheduler,
+    register_scheduler,
+    solve,
+)
+from fcplan.taskgraph import TaskGraph, build_task_graph
+
+BUILTINS = ("greedy", "idle", "random")
+
+
+@lru_cache(maxsize=1)
+def graph() -> TaskGraph:
+    sc = fcplan.load_scenario(1)
+    world = fcplan.World().reset(sc, seed=0)
+    return build_task_graph(sc, world.team, Belief(sc))
+
+
+def rng() -> np.random.Generator:
+    return np.random.default_rng(0)
+
+
+class Raising:
+    """A scheduler whose every call fails."""
+
+    name = "raising"
+
+    def plan(self, graph, *, time_limit=None, rng=None):
+        raise RuntimeError("solver exploded")
+
+
+class NotAPlan:
+    """A scheduler returning a dict instead of a Plan."""
+
+    name = "not-a-plan"
+
+    def plan(self, graph, *, time_limit=None, rng=None):
+        return {"P1": ("search:A-01",)}
+
+
+class Invalid:
+    """A scheduler sending an action agent to a search block."""
+
+    name = "invalid"
+
+    def plan(self, graph, *, time_limit=None, rng=None):
+        return Plan(routes={"A1": ("search:D-05",)})
+
+
+class Reporting:
+    """A valid scheduler reporting its own (wrong) wall time."""
+
+    name = "reporting"
+
+    def __init__(self, objective: float = 7.0) -> None:
+        self.objective = objective
+
+    def plan(self, graph, *, time_limit=None, rng=None):
+        return Plan(
+            routes={"P1": ("search:B-05",)},
+            stats=SolveStats(status="optimal", objective=self.objective, wall_time_s=-1.0),
+        )
+
+
+# ---------------------------------------------------------------------- registry
+@pytest.mark.parametrize("name", BUILTINS)
+def test_make_scheduler_finds_builtins(name):
+    """make_scheduler returns the built-in greedy/idle/random scheduler with that name."""
+    s = make_scheduler(name)
+    assert s.name == name
+    assert name in available_schedulers()
+    assert fcplan.make_scheduler is make_scheduler
+
+
+@pytest.mark.parametrize("name", BUILTINS)
+def test_builtins_satisfy_the_runtime_checkable_protocol(name):
+    """Every built-in scheduler is an instance of the runtime-checkable Scheduler protocol."""
+    assert isinstance(make_scheduler(name), Scheduler)
+
+
+def test_protocol_rejects_objects_without_plan():
+    """Objects lacking ``plan`` (or ``name``) are not Schedulers."""
+
+    class NoPlan:
+        name = "x"
+
+    class NoName:
+        def plan(self, graph, *, time_limit, rng):
+            return Plan()
+
+    assert not isinstance(NoPlan(), Scheduler)
+    assert not isinstance(NoName(), Scheduler)
+    assert isinstance(Raising(), Scheduler)
+
+
+def test_unknown_name_lists_known_schedulers():
+    """An unknown scheduler name raises UnknownNameError (a KeyError and FcplanError) whose
+    one-line message names it and lists the known schedulers."""
+    with pytest.raises(UnknownNameError) as exc:
+        make_scheduler("no-such-solver")
+    msg = str(exc.value)
+    assert "no-such-solver" in msg
+    for name in BUILTINS:
+        assert name in msg
+    assert "\n" not in msg
+    assert isinstance(exc.value, KeyError) and isinstance(exc.value, FcplanError)
+
+
+def test_bad_settings_raise_fcplan_error():
+    """Settings the factory does not accept raise FcplanError naming the scheduler."""
+    with pytest.raises(FcplanError, match="greedy"):
+        make_scheduler("greedy", no_such_option=3)
+
+
+def test_settings_reach_the_factory():
+    """Keyword settings are passed to the scheduler's factory."""
+    s = make_scheduler("random", keep_probability=0.25)
+    assert s.keep_probability == 0.25
+
+
+def test_register_scheduler_for_a_user_class(monkeypatch):
+    """register_scheduler makes a user class available by name (with settings), listed by
+    available_schedulers and usable by solve and run_episode."""
+    monkeypatch.setattr(scheduling, "_RUNTIME", dict(scheduling._RUNTIME))
+    register_scheduler("test-user-scheduler", Reporting)
+    assert "test-user-scheduler" in available_schedulers()
+    s = make_scheduler("test-user-scheduler", objective=3.0)
+    assert isinstance(s, Reporting) and s.objective == 3.0
+    plan = solve(s, graph(), time_limit=None, rng=rng())
+    assert plan.stats.status == "optimal" and plan.stats.objective == 3.0
+    sc = fcplan.load_scenario(1).replace(duration_s=2)
+    result = fcplan.run_episode(sc, "test-user-scheduler", seed=0)
+    assert result.scheduler == "reporting"
+    assert result.fallbacks == 0
+
+
+# ---------------------------------------------------------------------- solve
+@pytest.mark.parametrize(
+    ("scheduler", "fragment"),
+    [
+        (Raising(), "solver exploded"),
+        (NotAPlan(), "dict"),
+        (Invalid(), "A1"),
+    ],
+    ids=["raises", "not-a-plan", "invalid-plan"],
+)
+def test_solve_falls_back_to_greedy(scheduler, fragment):
+    """When a scheduler raises, returns a non-Plan or returns an invalid plan, solve returns
+    greedy's (valid) plan with status 'fallback' and a message saying why."""
+    g = graph()
+    plan = solve(scheduler, g, time_limit=1.0, rng=rng())
+    assert isinstance(plan, Plan)
+    validate_plan(plan, g)
+    assert plan.stats.status == "fallback"
+    assert fragment in plan.stats.message
+    greedy = make_scheduler("greedy").plan(g, time_limit=None, rng=rng())
+    assert dict(plan.routes) == dict(greedy.routes)
+    assert dict(plan.altitudes) == dict(greedy.altitudes)
+    assert plan.stats.wall_time_s >= 0.0
+
+
+@pytest.mark.parametrize("name", BUILTINS)
+def test_solve_records_wall_time(name):
+    """solve attaches SolveStats whose wall time is measured by solve itself (finite, >= 0)
+    and whose status is one of STATUSES."""
+    plan = solve(make_scheduler(name), graph(), time_limit=None, rng=rng())
+    st = plan.stats
+    assert isinstance(st, SolveStats)
+    assert math.isfinite(st.wall_time_s) and st.wall_time_s >= 0.0
+    assert st.status in STATUSES and st.status != "fallback"
+
+
+def test_solve_overrides_reported_wall_time_and_keeps_the_rest():
+    """A scheduler's own stats are kept (status, objective) but the wall time is solve's."""
+    plan = solve(Reporting(), graph(), time_limit=None, rng=rng())
+    assert plan.stats.status == "optimal"
+    assert plan.stats.objective == 7.0
+    assert plan.stats.wall_time_s >= 0.0
+    assert plan.routes == {"P1": ("search:B-05",)}
+
+
+def test_solve_gives_default_stats_to_plans_without_them():
+    """A valid plan with no stats gets default SolveStats ('heuristic')."""
+
+    class Bare:
+        name = "bare"
+
+        def plan(self, graph, *, time_limit=None, rng=None):
+            return Plan(routes={"P2": ("search:A-04",)})
+
+    plan = solve(Bare(), graph(), time_limit=None, rng=rng())
+    assert plan.stats.status == "heuristic"
+    assert plan.routes == {"P2": ("search:A-04",)}
+
+
+def test_solve_passes_time_limit_and_rng():
+    """solve hands the scheduler the graph, the time limit and the generator it was given."""
+    seen = {}
+
+    class Spy:
+        name = "spy"
+
+        def plan(self, graph, *, time_limit=None, rng=None):
+            seen.update(graph=graph, time_limit=time_limit, rng=rng)
+            return Plan()
+
+    g, r = graph(), rng()
+    solve(Spy(), g, time_limit=2.5, rng=r)
+    assert seen == {"graph": g, "time_limit": 2.5, "rng": r}
+
+
+def test_episode_survives_an_always_failing_scheduler():
+    """An episode whose scheduler raises at every replan runs to the end; every replan is a
+    counted fallback and greedy's plans still fight the fire."""
+    sc = fcplan.load_scenario(1).replace(duration_s=20)
+    result = fcplan.run_episode(sc, Raising(), seed=0)
+    assert result.ticks == sc.n_ticks
+    assert len(result.solves) >= 20
+    assert result.fallbacks == len(result.solves)
+    assert all(s.status == "fallback" and "RuntimeError" in s.message for s in result.solves)
+    assert result.summary()["fallbacks"] == result.fallbacks
+    assert result.trace.sensed_ever[-1] > 0
