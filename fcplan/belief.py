@@ -101,16 +101,24 @@ class Belief:
     def coverage_age_s(self, block_px: int) -> np.ndarray:
         """(B, B) mean seconds since the coarse cells of each ``block_px`` block were covered.
 
-        Never-covered cells count as covered at tick 0 minus one minute, so unexplored areas are
+        ``B = ceil(W / block_px)``; a coarse cell belongs to the block holding its centre, and a
+        block smaller than a coarse cell takes the age of the coarse cell under its centre.
+        Never-covered cells count as covered one minute before the start, so unexplored areas are
         the stalest.
         """
         c = self.coverage_px
-        per = max(block_px // c, 1)
         nc = self.coverage.shape[0]
-        nb = -(-nc // per)
+        nb = -(-self.world_size // int(block_px))
         ticks = np.where(self.coverage >= 0, self.coverage, -60 * self.ticks_per_second)
         age = (self.tick - ticks).astype(np.float64) / self.ticks_per_second
-        pad = nb * per - nc
-        if pad:
-            age = np.pad(age, ((0, pad), (0, pad)), mode="edge")
-        return age.reshape(nb, per, nb, per).mean(axis=(1, 3))
+        bi = np.minimum(((np.arange(nc) + 0.5) * c // block_px).astype(np.int64), nb - 1)
+        key = (bi[:, None] * nb + bi[None, :]).ravel()
+        sums = np.bincount(key, weights=age.ravel(), minlength=nb * nb)
+        counts = np.bincount(key, minlength=nb * nb)
+        out = sums / np.maximum(counts, 1)
+        empty = np.flatnonzero(counts == 0)
+        if empty.size:
+            centre = (np.arange(nb) + 0.5) * block_px
+            ci = np.minimum((centre // c).astype(np.int64), nc - 1)
+            out[empty] = age[ci[empty // nb], ci[empty % nb]]
+        return out.reshape(nb, nb)

@@ -84,8 +84,6 @@ def validate_plan(plan: Plan, graph: TaskGraph) -> None:
     for agent, z in plan.altitudes.items():
         i = aidx[agent]
         lo, hi = graph.agent_alt_range[i]
-        if not graph.agent_can_sense[i]:
-            continue
         if not (np.isfinite(z) and lo - 1e-9 <= z <= hi + 1e-9):
             raise PlanError(f"agent {agent}: altitude {z!r} is outside its range {lo:g}..{hi:g} m")
     for agent, route in plan.routes.items():

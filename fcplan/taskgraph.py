@@ -400,7 +400,7 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     fire_ids = tuple(
         f"fire:{int(x)}:{int(y)}" for x, y in zip(fire_pos[:, 0], fire_pos[:, 1], strict=True)
     )
-    search_ids = _search_ids(nb)
+    search_ids = _search_ids(nb, blk)
     # keep ids unique when two tiles round to the same point
     if len(set(fire_ids)) != len(fire_ids):
         fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))
@@ -450,9 +450,12 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
 
 
 @lru_cache(maxsize=16)
-def _search_ids(nb: int) -> tuple[str, ...]:
-    """Ids of the ``nb x nb`` search blocks in task order (x-major)."""
-    return tuple(f"search:{grid_block_name(a, b)}" for a in range(nb) for b in range(nb))
+def _search_ids(nb: int, blk: int) -> tuple[str, ...]:
+    """Ids of the ``nb x nb`` search blocks in task order (x-major): the chess name of the grid
+    cell for 100-px blocks (``search:D-05``), else the block's indices (``search:3:4``)."""
+    if blk == 100:
+        return tuple(f"search:{grid_block_name(a, b)}" for a in range(nb) for b in range(nb))
+    return tuple(f"search:{a}:{b}" for a in range(nb) for b in range(nb))
 
 
 def _clusters(tx: np.ndarray, ty: np.ndarray, nx_: int, ny_: int) -> np.ndarray:

@@ -45,7 +45,9 @@ def fire_graph() -> TaskGraph:
     xs, ys = np.meshgrid(np.arange(470, 531, 2), np.arange(480, 521, 2), indexing="ij")
     cells = np.stack([xs.ravel(), ys.ravel()], axis=1)
     g = graph_for(
-        sc, ticks=40, commands={"P1": Command(route=((500.0, 500.0),), altitude=100.0)},
+        sc,
+        ticks=40,
+        commands={"P1": Command(route=((500.0, 500.0),), altitude=100.0)},
         ignite=cells,
     )
     assert g.fire_tasks.size > 0
@@ -115,9 +117,7 @@ def test_routed_and_sent_home_is_rejected():
     """An agent both given a (non-empty) route and sent home raises PlanError naming it; an
     empty route with home is fine."""
     g = start_graph()
-    raises_naming(
-        Plan(routes={"P1": ("search:B-05",)}, home=frozenset({"P1", "A1"})), g, "P1"
-    )
+    raises_naming(Plan(routes={"P1": ("search:B-05",)}, home=frozenset({"P1", "A1"})), g, "P1")
     validate_plan(Plan(routes={"P1": ()}, home=frozenset({"P1"})), g)
 
 
@@ -167,8 +167,11 @@ def test_valid_plans_are_accepted():
     validate_plan(Plan(), g)
     validate_plan(
         Plan(
-            routes={"P1": (fires[0], "search:F-05"), "P2": ("search:C-03", "search:C-04"),
-                    "A1": tuple(fires[:2])},
+            routes={
+                "P1": (fires[0], "search:F-05"),
+                "P2": ("search:C-03", "search:C-04"),
+                "A1": tuple(fires[:2]),
+            },
             altitudes={"P1": 35.0, "P2": 90.0, "A2": 30.0},
             patrol=frozenset({"P2"}),
             home=frozenset({"A2"}),

@@ -90,9 +90,7 @@ def fire_tile_of_cells(graph: TaskGraph, xy: np.ndarray) -> np.ndarray:
         (int(graph.task_pos[k, 0] // tw), int(graph.task_pos[k, 1] // th)): int(k) for k in fires
     }
     assert len(tiles) == fires.size, "two fire tasks share a tile"
-    return np.array(
-        [tiles.get((int(x // tw), int(y // th)), -1) for x, y in xy], dtype=np.int64
-    )
+    return np.array([tiles.get((int(x // tw), int(y // th)), -1) for x, y in xy], dtype=np.int64)
 
 
 # strategies: a few clumps of cells inside one 200 x 115 px view centred on a random point
@@ -225,6 +223,27 @@ def test_search_tasks_cover_the_map_in_chess_named_blocks(name):
     np.testing.assert_allclose(g.task_pos[k], [350.0, 450.0])
 
 
+@pytest.mark.parametrize(
+    "block",
+    [100, 200, 120, 150, 50, 10],
+)
+def test_search_blocks_for_other_block_sizes(block):
+    """With TaskGraphParams(search_block_px=b), the map is covered by ceil(W / b)^2 search
+    tasks at the block centres, each with a finite staleness."""
+    sc = load_scenario(1)
+    world = World().reset(sc, seed=0)
+    belief = Belief(sc)
+    for _ in range(5):
+        belief.update(world.step())
+    g = build_task_graph(sc, world.team, belief, TaskGraphParams(search_block_px=block))
+    nb = -(-sc.world_size // block)
+    s = g.search_tasks
+    assert s.size == nb * nb
+    assert np.all(np.isfinite(g.task_staleness[s])) and np.all(g.task_staleness[s] >= 0)
+    blocks = {(int(x // block), int(y // block)) for x, y in g.task_pos[s]}
+    assert blocks == {(bx, by) for bx in range(nb) for by in range(nb)}
+
+
 def test_grid_block_name_examples():
     """grid_block_name uses letters for columns (A.., Z, AA..) and 2-digit 1-based rows."""
     assert grid_block_name(3, 4) == "D-05"
@@ -273,7 +292,9 @@ def test_threatens_edges_for_fire_next_to_a_house():
     assert g.fire_tasks.size > 0
     for k in g.fire_tasks:
         t = g.task_ids[k]
-        edges = {v: d["time_s"] for _, v, d in G.out_edges(t, data=True) if d["kind"] == "threatens"}
+        edges = {
+            v: d["time_s"] for _, v, d in G.out_edges(t, data=True) if d["kind"] == "threatens"
+        }
         assert house in edges
         expected = set()
         dist = {}
@@ -283,7 +304,7 @@ def test_threatens_edges_for_fire_next_to_a_house():
             if d < radius:
                 expected.add(fid)
         assert set(edges) == expected
-        for fid, t_s in edges.items():
+        for t_s in edges.values():
             assert math.isfinite(t_s) and t_s >= 0.0
         ordered = sorted(edges, key=dist.get)
         times = [edges[f] for f in ordered]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
-from functools import lru_cache
+from functools import cache, lru_cache
 
 import numpy as np
 import pytest
@@ -22,7 +22,7 @@ SCENARIOS = ["practice", *range(1, 25), "open_world_example"]
 TICKS = (0, 100, 300, 600)
 
 
-@lru_cache(maxsize=None)
+@cache
 def episode_graphs(name) -> tuple[TaskGraph, ...]:
     """Task graphs at :data:`TICKS` of a greedy episode (replanning every simulated second)."""
     sc = load_scenario(name)
@@ -68,10 +68,6 @@ def check_greedy_plan(g: TaskGraph, plan: Plan) -> None:
         if any(k == TaskKind.SEARCH for k in kinds):
             assert g.agent_can_sense[i], f"{a} cannot sense but got a search task"
         n_fire = sum(k == TaskKind.FIRE for k in kinds)
-        if g.agent_can_act[i] and n_fire and not (g.agent_can_sense[i] and len(route) == 1
-                                                  and a in plan.altitudes
-                                                  and False):
-            pass
         if g.agent_can_act[i]:
             assert n_fire <= g.agent_tank[i], f"{a}: {n_fire} fires for tank {g.agent_tank[i]}"
             for t, k in zip(route, kinds, strict=True):
@@ -138,7 +134,9 @@ def test_route_never_exceeds_the_tank(tank):
     plan = greedy_plan(g, route_length=10)
     check_greedy_plan(g, plan)
     n = [len(plan.routes.get(a, ())) for i, a in enumerate(g.agent_ids) if g.agent_can_act[i]]
-    assert max(n) == min(tank, g.fire_tasks.size)
+    assert max(n) <= tank
+    # every fire is within reach, so the tanks are used up before the fires run out
+    assert sum(n) == min(g.fire_tasks.size, tank * len(n))
 
 
 def test_route_respects_a_low_battery():
@@ -186,7 +184,8 @@ def test_known_fire_gets_an_action_agent():
         assert plan.routes.get(a), f"{a} is idle although fire is known"
         assert set(plan.routes[a]) <= fire_ids
     watchers = [
-        a for i, a in enumerate(g.agent_ids)
+        a
+        for i, a in enumerate(g.agent_ids)
         if g.agent_can_sense[i] and set(plan.routes.get(a, ())) & fire_ids
     ]
     assert watchers
@@ -206,7 +205,9 @@ def test_single_known_fire_is_taken_by_an_action_agent():
         task_staleness=g.task_staleness[keep],
         task_threat=g.task_threat[keep],
         task_cluster=g.task_cluster[keep],
-        task_block=np.where(g.task_block[keep] >= 0, g.task_block[keep] - (g.fire_tasks.size - 1), -1),
+        task_block=np.where(
+            g.task_block[keep] >= 0, g.task_block[keep] - (g.fire_tasks.size - 1), -1
+        ),
         threat_time_s=g.threat_time_s[:1],
     )
     plan = greedy_plan(g1)
