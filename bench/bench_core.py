@@ -5,7 +5,7 @@ Prints median microseconds per tick:
 * fire alone on the shipped scenarios (practice, #1, #12, #24), 1,800 ticks each;
 * the whole episode (world + belief + task graph + greedy replans + metrics) on the same
   scenarios, with the episode wall time;
-* fire scaling with 10, 100, 1,000 and 10,000 fronts on 1,200 px and 5,000 px maps, against a
+* fire scaling with 10, 30, 100, 1,000 and 10,000 fronts on 1,200 px and 5,000 px maps, against a
   baseline measured in the same run: the same FARSITE rules written as a plain Python loop over
   fronts (the way the 2020 reference structures its loop, without its history-intensity cost).
 
@@ -109,7 +109,7 @@ def scaling(ticks: int) -> None:
     print("## Fire scaling (median us per tick; ticks 50..50+N, fuel 10, wind 5)")
     print(f"{'map px':>7} {'fronts':>7} {'fcplan us':>10} {'python-loop us':>15} {'speed-up':>9}")
     for w in (1200, 5000):
-        for n in (10, 100, 1000, 10_000):
+        for n in (10, 30, 100, 1000, 10_000):
             k = max(1, min(25, n // 10))  # regions
             rng = np.random.default_rng(1)
             centres = rng.uniform(100, w - 100, size=(k, 2))
