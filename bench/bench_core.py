@@ -26,7 +26,8 @@ import time
 import numpy as np
 
 import fcplan
-from fcplan.fire import Fire, FireRegionParams, spread_rate_ratio
+from fcplan.fire import Fire, spread_rate_ratio
+from fcplan.scenario import FireRegion
 
 
 def median_us(fn, n: int) -> float:
@@ -114,7 +115,7 @@ def scaling(ticks: int) -> None:
             rng = np.random.default_rng(1)
             centres = rng.uniform(100, w - 100, size=(k, 2))
             regions = [
-                FireRegionParams(
+                FireRegion(
                     center=(float(cx), float(cy)),
                     fronts=n // k,
                     delay_s=0,

@@ -32,9 +32,10 @@ Cells are indexed ``[x, y]``; a flat cell index is ``x * W + y``.
 Examples
 --------
 >>> import numpy as np
->>> from fcplan.fire import Fire, FireRegionParams
->>> region = FireRegionParams(center=(350, 350), fronts=10, delay_s=0, fuel=10, wind_speed=5,
-...                           wind_dir_deg=45)
+>>> from fcplan.fire import Fire
+>>> from fcplan.scenario import FireRegion
+>>> region = FireRegion(center=(350, 350), fronts=10, delay_s=0, fuel=10, wind_speed=5,
+...                     wind_dir_deg=45)
 >>> fire = Fire([region], world_size=1200, ticks_per_second=10, rng=np.random.default_rng(0))
 >>> for _ in range(50):
 ...     _ = fire.step()
@@ -46,13 +47,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = [
     "Fire",
-    "FireRegionParams",
     "spread_rate_ratio",
     "INTENSITY_COEFF",
     "UNBURNT",
@@ -69,19 +68,6 @@ REFERENCE_TPS = 10
 UNBURNT, BURNING, PRUNED = 0, 1, 2
 #: Side (px) of the blocks in :attr:`Fire.block_burning`.
 BLOCK = 16
-
-
-@dataclass(frozen=True, slots=True)
-class FireRegionParams:
-    """The fire parameters of one region (duck-type compatible with ``fcplan.scenario.FireRegion``)."""
-
-    center: tuple[float, float]
-    fronts: int
-    delay_s: float
-    fuel: float
-    wind_speed: float
-    wind_dir_deg: float
-    half_width: float = 50.0
 
 
 def _lb(u):
@@ -109,9 +95,9 @@ class Fire:
 
     Parameters
     ----------
-    regions : sequence of region parameters
-        Objects with ``center``, ``fronts``, ``delay_s``, ``fuel``, ``wind_speed``,
-        ``wind_dir_deg`` and ``half_width`` (e.g. :class:`fcplan.scenario.FireRegion`).
+    regions : sequence of fcplan.scenario.FireRegion
+        Any objects with ``center``, ``fronts``, ``delay_s``, ``fuel``, ``wind_speed``,
+        ``wind_dir_deg`` and ``half_width``.
     world_size : int
         Map side ``W`` in px (cells).
     ticks_per_second : int

@@ -6,13 +6,14 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fcplan.fire import BURNING, INTENSITY_COEFF, PRUNED, Fire, FireRegionParams, spread_rate_ratio
+from fcplan.fire import BURNING, INTENSITY_COEFF, PRUNED, Fire, spread_rate_ratio
+from fcplan.scenario import FireRegion
 
 
-def region(**kw) -> FireRegionParams:
+def region(**kw) -> FireRegion:
     base = dict(center=(600, 600), fronts=10, delay_s=0, fuel=10, wind_speed=5, wind_dir_deg=45)
     base.update(kw)
-    return FireRegionParams(**base)
+    return FireRegion(**base)
 
 
 def first_step(fire: Fire) -> tuple[np.ndarray, np.ndarray]:

@@ -5,43 +5,26 @@ from __future__ import annotations
 
 import os
 from concurrent.futures import ProcessPoolExecutor
-from functools import cache
 
 import numpy as np
 import pytest
 
 import fcplan
-from fcplan import World, load_scenario
-from fcplan.belief import Belief
 from fcplan.plan import Plan, plan_commands, validate_plan
 from fcplan.scheduling import available_schedulers, make_scheduler, solve
-from fcplan.taskgraph import TaskGraph, TaskKind, build_task_graph
+from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
 from solvers.baselines import IdleScheduler, RandomScheduler
+from tests.solvers.graphs import SCENARIOS
+from tests.solvers.graphs import episode_graphs as _episode_graphs
 
-SCENARIOS = ["practice", *range(1, 25), "open_world_example"]
 TICKS = (0, 150, 450)
 BUILTINS = ("greedy", "idle", "random")
 
 
-@cache
 def episode_graphs(name) -> tuple[TaskGraph, ...]:
-    """Task graphs at :data:`TICKS` of a greedy episode (replanning every simulated second)."""
-    sc = load_scenario(name)
-    world = World().reset(sc, seed=0)
-    belief = Belief(sc)
-    greedy = make_scheduler("greedy")
-    rng = world.controller_rng
-    out = []
-    while world.tick <= max(TICKS):
-        commands = None
-        if world.tick % sc.ticks_per_second == 0:
-            g = build_task_graph(sc, world.team, belief)
-            if world.tick in TICKS:
-                out.append(g)
-            commands = plan_commands(solve(greedy, g, time_limit=None, rng=rng), g)
-        belief.update(world.step(commands))
-    return tuple(out)
+    """Task graphs at :data:`TICKS` of a greedy episode."""
+    return _episode_graphs(name, TICKS)
 
 
 def same_plan(a: Plan, b: Plan) -> bool:

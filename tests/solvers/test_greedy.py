@@ -3,44 +3,28 @@
 from __future__ import annotations
 
 import dataclasses
-from functools import cache, lru_cache
+from functools import lru_cache
 
 import numpy as np
 import pytest
 
 from fcplan import World, load_scenario
 from fcplan.belief import Belief
-from fcplan.plan import Plan, plan_commands, validate_plan
-from fcplan.scheduling import make_scheduler, solve
+from fcplan.plan import Plan, validate_plan
 from fcplan.taskgraph import TaskGraph, TaskKind, build_task_graph
 from fcplan.team import Command, Mode
 from solvers.greedy import GreedyScheduler
+from tests.solvers.graphs import SCENARIOS
+from tests.solvers.graphs import episode_graphs as _episode_graphs
 
 #: every shipped scenario, plus the open-world example (hybrids, 1000 px map)
-SCENARIOS = ["practice", *range(1, 25), "open_world_example"]
 #: replan ticks at which graphs are taken from a greedy episode
 TICKS = (0, 100, 300, 600)
 
 
-@cache
 def episode_graphs(name) -> tuple[TaskGraph, ...]:
-    """Task graphs at :data:`TICKS` of a greedy episode (replanning every simulated second)."""
-    sc = load_scenario(name)
-    world = World().reset(sc, seed=0)
-    belief = Belief(sc)
-    greedy = make_scheduler("greedy")
-    rng = world.controller_rng
-    out = []
-    period = sc.ticks_per_second
-    while world.tick <= max(TICKS):
-        commands = None
-        if world.tick % period == 0:
-            g = build_task_graph(sc, world.team, belief)
-            if world.tick in TICKS:
-                out.append(g)
-            commands = plan_commands(solve(greedy, g, time_limit=None, rng=rng), g)
-        belief.update(world.step(commands))
-    return tuple(out)
+    """Task graphs at :data:`TICKS` of a greedy episode."""
+    return _episode_graphs(name, TICKS)
 
 
 def greedy_plan(g: TaskGraph, **settings) -> Plan:
