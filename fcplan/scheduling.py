@@ -79,6 +79,10 @@ class SolveStats:
         Model size (e.g. variables, constraints, agents, tasks).
     message : str
         Why a fallback happened, or solver remarks.
+    time_limit_s : float or None
+        The limit the call was given.
+    overrun_s : float
+        Wall time beyond the limit (0 when within it), measured by :func:`solve`.
     """
 
     status: str = "heuristic"
@@ -88,6 +92,8 @@ class SolveStats:
     wall_time_s: float = 0.0
     size: dict = field(default_factory=dict)
     message: str = ""
+    time_limit_s: float | None = None
+    overrun_s: float = 0.0
 
     def as_dict(self) -> dict[str, Any]:
         """Plain dict (for tables and JSON)."""
@@ -190,5 +196,7 @@ def solve(
         stats = SolveStats(status="fallback", message=message)
     else:
         stats = plan.stats if isinstance(plan.stats, SolveStats) else SolveStats()
-    stats = replace(stats, wall_time_s=time.perf_counter() - t0)
+    wall = time.perf_counter() - t0
+    overrun = max(wall - time_limit, 0.0) if time_limit is not None else 0.0
+    stats = replace(stats, wall_time_s=wall, time_limit_s=time_limit, overrun_s=overrun)
     return plan.with_stats(stats)
