@@ -203,44 +203,68 @@ class GreedyScheduler:
         limit: np.ndarray,
         spread: bool = False,
     ) -> tuple[dict[int, list[int]], float]:
-        """Repeatedly give the best (agent, task) pick; return routes (task rows) per agent row."""
-        value = value.copy()
+        """Repeatedly give the best (agent, task) pick; return routes (task rows) per agent row.
+
+        The (agent, task) score matrix is built once; after each pick only the picking agent's
+        row (its position, time and budget changed), the taken task's column and the rows whose
+        best choice was affected are updated, so a replan costs O(A K + picks (K + A)).
+        """
+        n_a, n_k = agents.size, tasks.size
+        routes: dict[int, list[int]] = {int(a): [] for a in agents}
+        if n_a == 0 or n_k == 0:
+            return routes, 0.0
+        value = value.astype(np.float64)
         speed = graph.agent_speed[agents]
         pos = start[agents].copy()
-        used = np.zeros(agents.size)  # px already planned
-        elapsed = np.zeros(agents.size)  # s already planned
+        used = np.zeros(n_a)  # px already planned
+        elapsed = np.zeros(n_a)  # s already planned
         home = graph.task_home_distance[np.ix_(agents, tasks)]  # (a, k)
-        ok_trip = round_trip_ok(graph)[np.ix_(agents, tasks)]
+        ok = round_trip_ok(graph)[np.ix_(agents, tasks)] & (value > 0)[None, :]
         left = budget[agents]
-        count = np.zeros(agents.size, dtype=np.int64)
-        taken = np.zeros(tasks.size, dtype=bool)
-        routes: dict[int, list[int]] = {int(a): [] for a in agents}
+        count = np.zeros(n_a, dtype=np.int64)
+        taken = np.zeros(n_k, dtype=bool)
         tpos = graph.task_pos[tasks]
+
+        def rows(r: np.ndarray | slice) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            diff = pos[r][:, None, :] - tpos[None, :, :]
+            d = np.sqrt(np.einsum("akc,akc->ak", diff, diff))
+            eta = elapsed[r][:, None] + d / speed[r][:, None]
+            feasible = ok[r] & (used[r][:, None] + d + home[r] <= left[r][:, None])
+            return np.where(feasible, value[None, :] / (1.0 + eta), -np.inf), d, eta
+
+        score, dist, eta = rows(slice(None))
+        score[count >= limit] = -np.inf
+        best = np.argmax(score, axis=1)
+        best_s = score[np.arange(n_a), best]
         gained = 0.0
-        for _ in range(int(limit.sum())):
-            d = np.hypot(*(pos[:, None, :] - tpos[None, :, :]).transpose(2, 0, 1))  # (a, k)
-            eta = elapsed[:, None] + d / speed[:, None]
-            score = value[None, :] / (1.0 + eta)
-            feasible = (
-                ok_trip
-                & ~taken[None, :]
-                & (count < limit)[:, None]
-                & (used[:, None] + d + home <= left[:, None])
-                & (value[None, :] > 0)
-            )
-            score = np.where(feasible, score, -np.inf)
-            flat = int(np.argmax(score))
-            a, k = divmod(flat, tasks.size)
-            if not np.isfinite(score[a, k]):
+        while True:
+            a = int(np.argmax(best_s))
+            k = int(best[a])
+            if not np.isfinite(best_s[a]):
                 break
             routes[int(agents[a])].append(int(tasks[k]))
             gained += float(value[k])
-            taken[k] = True
             count[a] += 1
-            used[a] += d[a, k]
+            used[a] += dist[a, k]
             elapsed[a] = eta[a, k]
             pos[a] = tpos[k]
+            taken[k] = True
+            score[:, k] = -np.inf  # one agent per task
+            touched = best == k
             if spread:
                 near = np.hypot(*(tpos - tpos[k]).T) < self.spread_px
+                near[k] = False
                 value[near] *= 0.3
+                score[:, near] *= 0.3  # scores are proportional to value (finite ones are > 0)
+                touched |= near[best]
+            if count[a] < limit[a]:
+                row, d_a, eta_a = rows(np.array([a]))
+                row[0, taken] = -np.inf
+                score[a], dist[a], eta[a] = row[0], d_a[0], eta_a[0]
+            else:
+                score[a] = -np.inf
+            touched[a] = True
+            idx = np.flatnonzero(touched)
+            best[idx] = np.argmax(score[idx], axis=1)
+            best_s[idx] = score[idx, best[idx]]
         return routes, gained
