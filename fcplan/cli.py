@@ -5,6 +5,8 @@ Commands::
     fcplan scenarios                         list the shipped scenarios
     fcplan scenario validate FILE [FILE...]  check scenario files; list manual limits exceeded
     fcplan run SCENARIO [--scheduler NAME] [--seed N] [--replan-period S] [--time-limit S] [--json]
+    fcplan compare --schedulers A,B [--scenarios 1-24] [--seeds 0-4] [--jobs N] [--time-limit S]
+                   [--replan-period S] [--json PATH] [--csv PATH] [--by-difficulty] [--quiet]
 
 Bad input (an unknown scenario or scheduler, a malformed file, an out-of-range argument) prints one
 line naming the problem and exits with status 2; ``--debug`` shows the traceback instead.
@@ -59,6 +61,41 @@ def _seed(text: str) -> int:
     return v
 
 
+def _positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}")
+    return v
+
+
+def _scenario_list(text: str) -> list:
+    from fcplan.experiments.compare import RangeError, parse_range
+
+    try:
+        return parse_range(text)
+    except RangeError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _seed_list(text: str) -> list:
+    from fcplan.experiments.compare import RangeError, parse_range
+
+    try:
+        return parse_range(text, names=False)
+    except RangeError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _name_list(text: str) -> list[str]:
+    names = [t.strip() for t in text.split(",")]
+    if not text.strip() or any(not t for t in names):
+        raise argparse.ArgumentTypeError(f"expected comma-separated names, got {text!r}")
+    return list(dict.fromkeys(names))
+
+
 def _build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="fcplan", description="FireCommander multi-robot task assignment testbed")
     p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
@@ -88,6 +125,45 @@ def _build_parser() -> argparse.ArgumentParser:
         help="seconds per scheduler call (default: the scheduler's own)",
     )
     r.add_argument("--json", action="store_true", help="print the results as JSON")
+
+    c = sub.add_parser(
+        "compare",
+        help="run schedulers over scenarios x seeds in parallel and print a comparison table",
+    )
+    c.add_argument(
+        "--schedulers",
+        type=_name_list,
+        required=True,
+        help="comma-separated registered scheduler names, e.g. greedy,idle",
+    )
+    c.add_argument(
+        "--scenarios",
+        type=_scenario_list,
+        default="1-24",
+        help="scenarios as numbers, ranges and names, e.g. 1-24 or practice,1,3,5-7 (default 1-24)",
+    )
+    c.add_argument(
+        "--seeds", type=_seed_list, default="0-4", help="seeds, e.g. 0-4 or 0,7 (default 0-4)"
+    )
+    c.add_argument(
+        "--jobs", "-j", type=_positive_int, default=None, help="worker processes (default: CPUs)"
+    )
+    c.add_argument(
+        "--time-limit",
+        type=_positive_float,
+        default=None,
+        help="seconds per scheduler call (default: each scheduler's own)",
+    )
+    c.add_argument(
+        "--replan-period",
+        type=_positive_float,
+        default=1.0,
+        help="simulated seconds between replans (default 1.0)",
+    )
+    c.add_argument("--json", metavar="PATH", help="also write the table and every episode as JSON")
+    c.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
+    c.add_argument("--by-difficulty", action="store_true", help="also print a table per difficulty")
+    c.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
     return p
 
 
@@ -171,6 +247,52 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_output(path: str | None, option: str) -> None:
+    """Fail before a long run, not after it, when an output file cannot be written."""
+    if path is None:
+        return
+    from pathlib import Path
+
+    p = Path(path)
+    if p.is_dir():
+        raise _ArgumentError(f"{option} {path}: is a directory")
+    if not p.parent.is_dir():
+        raise _ArgumentError(f"{option} {path}: no such directory {str(p.parent)!r}")
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from fcplan.experiments.compare import ProgressPrinter, compare
+
+    _check_output(args.json, "--json")
+    _check_output(args.csv, "--csv")
+    result = compare(
+        args.scenarios,
+        args.schedulers,
+        args.seeds,
+        jobs=args.jobs,
+        time_limit=args.time_limit,
+        replan_period=args.replan_period,
+        progress=None if args.quiet else ProgressPrinter(sys.stderr),
+    )
+    print(result.format())
+    if args.by_difficulty:
+        print()
+        print(result.format(by_difficulty=True))
+    for path, write in ((args.json, result.to_json), (args.csv, result.to_csv)):
+        if path is not None:
+            try:
+                write(path)
+            except OSError as exc:
+                raise _ArgumentError(f"cannot write {path}: {exc.strerror or exc}") from None
+    for e in result.errors:
+        print(
+            f"fcplan: warning: episode {e['scenario']} {e['scheduler']} seed {e['seed']} "
+            f"failed: {e['error']}",
+            file=sys.stderr,
+        )
+    return 0
+
+
 def _pct(a, q) -> float:
     import numpy as np
 
@@ -189,6 +311,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _cmd_validate(args.files)
         if args.command == "run":
             return _cmd_run(args)
+        if args.command == "compare":
+            return _cmd_compare(args)
         raise _ArgumentError(f"unknown command {args.command!r}")  # pragma: no cover
     except FcplanError as exc:
         if debug:

@@ -93,3 +93,48 @@ def test_console_entry_point_runs_as_module():
     )
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
     assert len(bad.stderr.strip().splitlines()) == 1
+
+
+def _short_scenario(tmp_path, n=3, seconds=20):
+    from fcplan.scenario import dump_scenario, load_scenario
+
+    path = tmp_path / f"short{n}.toml"
+    dump_scenario(load_scenario(n).replace(duration_s=seconds), path)
+    return str(path)
+
+
+def test_compare_prints_table_and_writes_files(tmp_path, capsys):
+    """`fcplan compare` prints progress on stderr and the table on stdout, writes --json and
+    --csv, and exits 0."""
+    out_json, out_csv = tmp_path / "c.json", tmp_path / "c.csv"
+    argv = ["compare", "--scenarios", _short_scenario(tmp_path), "--schedulers", "greedy,idle"]
+    argv += ["--seeds", "0-1", "--jobs", "1", "--json", str(out_json), "--csv", str(out_csv)]
+    assert main([*argv, "--by-difficulty"]) == 0
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    assert lines[0].startswith("4 episodes: 1 scenario(s) x 2 scheduler(s) x 2 seed(s)")
+    assert lines[1].split()[:3] == ["scheduler", "n", "err"]
+    assert lines[2].split()[:3] == ["greedy", "2", "0"] and lines[3].startswith("idle")
+    assert "difficulty" in captured.out
+    assert "compare: 4/4 episodes (100%)" in captured.err and "ETA" in captured.err
+    doc = json.loads(out_json.read_text())
+    assert [r["scheduler"] for r in doc["table"]] == ["greedy", "idle"]
+    assert len(doc["episodes"]) == 4
+    assert out_csv.read_text().splitlines()[0].startswith("scheduler,episodes,errors,")
+
+
+def test_compare_bad_input_gives_one_line_and_exit_2(tmp_path, capsys):
+    """Bad ranges, unknown names, bad numbers and unwritable outputs print one line, exit 2."""
+    _one_line_error(
+        ["compare", "--scenarios", "99", "--schedulers", "greedy"], capsys, "99", "practice"
+    )
+    _one_line_error(["compare", "--schedulers", "nope"], capsys, "nope", "greedy")
+    _one_line_error(["compare", "--schedulers", "greedy", "--seeds", "a-b"], capsys, "seeds", "a-b")
+    _one_line_error(["compare", "--schedulers", "greedy", "--scenarios", "5-3"], capsys, "5-3")
+    _one_line_error(["compare", "--schedulers", "greedy", "--jobs", "0"], capsys, "jobs")
+    _one_line_error(
+        ["compare", "--schedulers", "greedy", "--time-limit", "x"], capsys, "time-limit"
+    )
+    _one_line_error(["compare", "--scenarios", "3"], capsys, "--schedulers")
+    missing = str(tmp_path / "no" / "c.json")
+    _one_line_error(["compare", "--schedulers", "greedy", "--json", missing], capsys, "--json")
