@@ -351,3 +351,24 @@ def test_episode_completes_and_prunes_fire(name):
 
 def load_ticks(name) -> int:
     return fcplan.load_scenario(name).n_ticks
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1))
+def test_plan_objective_scores_other_schedulers_below_the_optimum(seed):
+    """plan_objective gives the MILP's own optimal plan its objective, and no feasible plan of
+    another scheduler scores above the MILP optimum."""
+    from fcplan.scheduling import make_scheduler
+    from solvers.milp_model import plan_objective
+
+    g = synthetic_task_graph(3, 8, np.random.default_rng(seed))
+    best = make_scheduler("milp", fire_candidates=g.n_tasks, search_candidates=g.n_tasks).plan(
+        g, time_limit=10.0, rng=None
+    )
+    obj, ok = plan_objective(g, best)
+    assert ok and obj == pytest.approx(best.stats.objective, rel=1e-5, abs=1e-6)
+    for name in ("greedy", "random", "cbba"):
+        other = make_scheduler(name).plan(g, time_limit=None, rng=np.random.default_rng(seed))
+        o, feasible = plan_objective(g, other)
+        if feasible:
+            assert o <= obj + 1e-6 * max(1.0, abs(obj))
