@@ -84,13 +84,20 @@ class EpisodeResult:
                 if k != "definition":
                     out[f"{name}.{k}"] = v
         st = self.solve_times_s
+        statuses = [s.status for s in self.solves]
+        rounds = [s.size["rounds"] for s in self.solves if "rounds" in s.size]
+        messages = [s.size["messages"] for s in self.solves if "messages" in s.size]
         out.update(
             ticks=self.ticks,
             wall_time_s=self.wall_time_s,
             replans=len(self.solves),
             fallbacks=self.fallbacks,
+            optimal_replans=statuses.count("optimal"),
+            time_limit_replans=statuses.count("time_limit"),
             solve_p50_ms=float(np.median(st) * 1e3) if st.size else 0.0,
             solve_p95_ms=float(np.percentile(st, 95) * 1e3) if st.size else 0.0,
+            rounds_per_replan=float(np.mean(rounds)) if rounds else float("nan"),
+            messages_per_replan=float(np.mean(messages)) if messages else float("nan"),
         )
         return out
 

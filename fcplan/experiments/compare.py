@@ -441,6 +441,10 @@ def compare(
 # results
 
 
+def _share(x: float) -> str:
+    return "-" if x != x else f"{100 * x:.0f}%"
+
+
 def _pct(values: np.ndarray, q: float) -> float:
     return float(np.percentile(values, q)) if values.size else math.nan
 
@@ -516,6 +520,16 @@ class ComparisonResult:
         row["solve_p95_ms"] = _pct(st, 95)
         row["fallbacks"] = fallbacks
         row["fallback_rate"] = fallbacks / replans if replans else math.nan
+        row["optimal_rate"] = (
+            sum(e.get("optimal_replans", 0) for e in good) / replans if replans else math.nan
+        )
+        row["time_limit_rate"] = (
+            sum(e.get("time_limit_replans", 0) for e in good) / replans if replans else math.nan
+        )
+        for key in ("rounds_per_replan", "messages_per_replan"):
+            vals = [e.get(key, math.nan) for e in good]
+            vals = [v for v in vals if v == v]  # drop NaN (schedulers without consensus rounds)
+            row[key] = float(np.mean(vals)) if vals else math.nan
         row["wall_time_s_mean"] = (
             float(np.mean([e["wall_time_s"] for e in good])) if good else math.nan
         )
@@ -632,6 +646,17 @@ class ComparisonResult:
                 ">",
             ),
             ("fallbacks", lambda r: f"{r['fallbacks']}/{r['replans']}", ">"),
+            ("optimal", lambda r: _share(r["optimal_rate"]), ">"),
+            ("t-limit", lambda r: _share(r["time_limit_rate"]), ">"),
+            (
+                "rounds/msgs",
+                lambda r: (
+                    "-"
+                    if r["rounds_per_replan"] != r["rounds_per_replan"]
+                    else f"{r['rounds_per_replan']:.1f}/{r['messages_per_replan']:.0f}"
+                ),
+                ">",
+            ),
             ("wall s", lambda r: f"{r['wall_time_s_mean']:.2f}", ">"),
         ]
         cells = [[fn(r) for _, fn, _ in cols] for r in rows]
