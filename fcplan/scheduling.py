@@ -57,6 +57,10 @@ _BUILTIN = {
     "greedy": "solvers.greedy:GreedyScheduler",
     "idle": "solvers.baselines:IdleScheduler",
     "random": "solvers.baselines:RandomScheduler",
+    "routing": "solvers.routing:RoutingScheduler",
+    "milp": "solvers.milp:MilpScheduler",
+    "milp-cvxpy": "solvers.milp_cvxpy:MilpCvxpyScheduler",
+    "cbba": "solvers.cbba:CBBAScheduler",
 }
 _RUNTIME: dict[str, Callable[..., Any]] = {}
 

@@ -1,0 +1,138 @@
+"""Benchmark the ``routing`` scheduler: solve times and scores.
+
+Prints:
+
+* per-replan solve time (p50 / p95, ms, measured by :func:`fcplan.scheduling.solve`), statuses
+  and fallbacks over whole episodes of the shipped scenarios #1, #12 and #24 (seed 0, the default
+  100 ms limit);
+* solve time, model size and status on synthetic graphs of 10 x 100, 50 x 500 and 100 x 2000
+  (agents x tasks; several seeds; default settings, then deterministic mode);
+* the mean manual final score (and OFS) of ``routing`` and ``greedy`` over scenarios 1-24, seed 0,
+  played in a process pool of 2.
+
+Usage::
+
+    python bench/bench_routing.py                   # everything (~15 min on 2 cores)
+    python bench/bench_routing.py --scores-only --set fire_value_px=1000
+    python bench/bench_routing.py --no-scores --seeds 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import statistics
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+import fcplan
+from fcplan.scheduling import solve
+from fcplan.taskgraph import synthetic_task_graph
+from solvers.routing import RoutingScheduler
+
+
+def pct(a, q) -> float:
+    return float(np.percentile(a, q)) if len(a) else float("nan")
+
+
+def bench_episodes(settings: dict) -> None:
+    print("## Episodes (seed 0): per-replan solve time")
+    print(
+        f"{'scenario':<9} {'replans':>7} {'p50 ms':>7} {'p95 ms':>7} {'max ms':>7} "
+        f"{'fallbacks':>9}  statuses"
+    )
+    for sc in (1, 12, 24):
+        r = fcplan.run_episode(sc, RoutingScheduler(**settings), seed=0)
+        st = r.solve_times_s * 1e3
+        statuses = collections.Counter(s.status for s in r.solves)
+        print(
+            f"{sc!s:<9} {len(st):>7} {pct(st, 50):>7.1f} {pct(st, 95):>7.1f} {st.max():>7.1f} "
+            f"{r.fallbacks:>9}  {dict(statuses)}"
+        )
+
+
+def bench_synthetic(settings: dict, seeds: int) -> None:
+    print("\n## Synthetic graphs: wall time per replan (solve(), ms), model size, status")
+    print(
+        f"{'size':<10} {'mode':<13} {'p50 ms':>7} {'max ms':>7} {'vehicles':>8} {'nodes':>6}  "
+        f"statuses"
+    )
+    for n_agents, n_tasks in ((10, 100), (50, 500), (100, 2000)):
+        graphs = [
+            synthetic_task_graph(n_agents, n_tasks, np.random.default_rng(s)) for s in range(seeds)
+        ]
+        for mode, extra in (("time 100 ms", {}), ("deterministic", {"deterministic": True})):
+            sched = RoutingScheduler(**{**settings, **extra})
+            times, statuses, nodes = [], collections.Counter(), []
+            for g in graphs:
+                p = solve(sched, g, time_limit=None, rng=np.random.default_rng(0))
+                times.append(p.stats.wall_time_s * 1e3)
+                statuses[p.stats.status] += 1
+                nodes.append(p.stats.size.get("nodes", 0))
+            print(
+                f"{n_agents}x{n_tasks:<7} {mode:<13} {pct(times, 50):>7.1f} {max(times):>7.1f} "
+                f"{n_agents:>8} {statistics.mean(nodes):>6.0f}  {dict(statuses)}"
+            )
+
+
+def _score(job):
+    sc, name, settings = job
+    sched = RoutingScheduler(**settings) if name == "routing" else name
+    r = fcplan.run_episode(sc, sched, seed=0)
+    m = r.metrics["manual"]
+    return sc, name, m.final_score, m.overall_firefighting, r.fallbacks
+
+
+def bench_scores(settings: dict) -> None:
+    print("\n## Manual final score, scenarios 1-24, seed 0 (process pool of 2)")
+    jobs = [(sc, name, settings) for sc in range(1, 25) for name in ("routing", "greedy")]
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(2) as pool:
+        rows = list(pool.map(_score, jobs))
+    by = collections.defaultdict(dict)
+    for sc, name, final, ofs, fb in rows:
+        by[sc][name] = (final, ofs, fb)
+    print(f"{'scenario':>8} {'routing':>9} {'greedy':>9} {'r OFS':>7} {'g OFS':>7} {'fallbacks':>9}")
+    for sc in sorted(by):
+        r, g = by[sc]["routing"], by[sc]["greedy"]
+        print(f"{sc:>8} {r[0]:>9.2f} {g[0]:>9.2f} {r[1]:>7.2f} {g[1]:>7.2f} {r[2]:>9}")
+    mr = statistics.mean(by[sc]["routing"][0] for sc in by)
+    mg = statistics.mean(by[sc]["greedy"][0] for sc in by)
+    wins = sum(by[sc]["routing"][0] > by[sc]["greedy"][0] for sc in by)
+    print(f"mean final: routing {mr:.2f}, greedy {mg:.2f}; routing better on {wins}/24")
+    print(f"({time.perf_counter() - t0:.0f} s)")
+
+
+def _parse(v: str):
+    if v in ("True", "False", "None"):
+        return {"True": True, "False": False, "None": None}[v]
+    for cast in (int, float):
+        try:
+            return cast(v)
+        except ValueError:
+            pass
+    return v
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--set", action="append", default=[], help="scheduler setting key=value")
+    ap.add_argument("--seeds", type=int, default=3, help="synthetic graphs per size")
+    ap.add_argument("--scores-only", action="store_true")
+    ap.add_argument("--no-scores", action="store_true")
+    args = ap.parse_args()
+    settings = {}
+    for kv in args.set:
+        k, _, v = kv.partition("=")
+        settings[k] = _parse(v)
+    if not args.scores_only:
+        bench_episodes(settings)
+        bench_synthetic(settings, args.seeds)
+    if not args.no_scores:
+        bench_scores(settings)
+
+
+if __name__ == "__main__":
+    main()
