@@ -5,7 +5,7 @@ Prints:
 * per-replan solve time (p50 / p95, ms, measured by :func:`fcplan.scheduling.solve`), statuses
   and fallbacks over whole episodes of the shipped scenarios #1, #12 and #24 (seed 0, the default
   100 ms limit);
-* solve time, model size and status on synthetic graphs of 10 x 100, 50 x 500 and 100 x 2000
+* solve time, model size, task visits planned and status on synthetic graphs of 10 x 100, 50 x 500 and 100 x 2000
   (agents x tasks; several seeds; default settings, then deterministic mode);
 * the mean manual final score (and OFS) of ``routing`` and ``greedy`` over scenarios 1-24, seed 0,
   played in a process pool of 2.
@@ -56,8 +56,8 @@ def bench_episodes(settings: dict) -> None:
 def bench_synthetic(settings: dict, seeds: int) -> None:
     print("\n## Synthetic graphs: wall time per replan (solve(), ms), model size, status")
     print(
-        f"{'size':<10} {'mode':<13} {'p50 ms':>7} {'max ms':>7} {'vehicles':>8} {'nodes':>6}  "
-        f"statuses"
+        f"{'size':<10} {'mode':<13} {'p50 ms':>7} {'max ms':>7} {'vehicles':>8} {'nodes':>6} "
+        f"{'visits':>6}  statuses"
     )
     for n_agents, n_tasks in ((10, 100), (50, 500), (100, 2000)):
         graphs = [
@@ -65,15 +65,17 @@ def bench_synthetic(settings: dict, seeds: int) -> None:
         ]
         for mode, extra in (("time 100 ms", {}), ("deterministic", {"deterministic": True})):
             sched = RoutingScheduler(**{**settings, **extra})
-            times, statuses, nodes = [], collections.Counter(), []
+            times, statuses, nodes, visits = [], collections.Counter(), [], []
             for g in graphs:
                 p = solve(sched, g, time_limit=None, rng=np.random.default_rng(0))
                 times.append(p.stats.wall_time_s * 1e3)
                 statuses[p.stats.status] += 1
                 nodes.append(p.stats.size.get("nodes", 0))
+                visits.append(p.n_assignments)
             print(
                 f"{n_agents}x{n_tasks:<7} {mode:<13} {pct(times, 50):>7.1f} {max(times):>7.1f} "
-                f"{n_agents:>8} {statistics.mean(nodes):>6.0f}  {dict(statuses)}"
+                f"{n_agents:>8} {statistics.mean(nodes):>6.0f} {statistics.mean(visits):>6.0f}  "
+                f"{dict(statuses)}"
             )
 
 
@@ -94,7 +96,9 @@ def bench_scores(settings: dict) -> None:
     by = collections.defaultdict(dict)
     for sc, name, final, ofs, fb in rows:
         by[sc][name] = (final, ofs, fb)
-    print(f"{'scenario':>8} {'routing':>9} {'greedy':>9} {'r OFS':>7} {'g OFS':>7} {'fallbacks':>9}")
+    print(
+        f"{'scenario':>8} {'routing':>9} {'greedy':>9} {'r OFS':>7} {'g OFS':>7} {'fallbacks':>9}"
+    )
     for sc in sorted(by):
         r, g = by[sc]["routing"], by[sc]["greedy"]
         print(f"{sc:>8} {r[0]:>9.2f} {g[0]:>9.2f} {r[1]:>7.2f} {g[1]:>7.2f} {r[2]:>9}")

@@ -8,8 +8,8 @@ models, first the **action** model, then the **perception** model:
   recharges first, see :mod:`solvers._feasible`), and ends at its depot slot.
 * **Nodes** are the tasks that role can serve: fire tasks for action agents; search blocks *and*
   fire tasks for perception agents. Hybrids (camera and water) that still have water are action
-  vehicles (fires only, no altitude is set for them); hybrids with an empty tank are perception
-  vehicles.
+  vehicles (fires only, no altitude is set for them, as in ``greedy``); hybrids with an empty
+  tank are perception vehicles.
 * **Visits are optional** (prize collecting): leaving task ``k`` unvisited costs a drop penalty
   equal to its value converted to pixels (below). Each task is visited at most once per model.
 * **Dimensions**: ``distance`` (travel px) whose per-vehicle capacity is the agent's remaining
@@ -18,37 +18,43 @@ models, first the **action** model, then the **perception** model:
   capped by ``max_visits`` per vehicle and, for action vehicles, by the water left in the tank
   (each fire visit uses one dump). Per-vehicle capacities use
   ``RoutingModel.AddDimensionWithVehicleCapacity``; distances and visit counts are registered as
-  matrices/vectors (``RegisterTransitMatrix``, ``RegisterUnaryTransitVector``), never as Python
-  callbacks, so the search runs without calling back into Python. Tasks beyond a full-battery
-  round trip of an agent's depot slot, or that the agent cannot reach and still fly home from,
-  are removed from that node's vehicle variable (``VehicleVar(index).RemoveValues``).
+  a matrix / vector (``RegisterTransitMatrix``, ``RegisterUnaryTransitVector``), never as Python
+  callbacks, so the search never calls back into Python. Tasks beyond a full-battery round trip
+  of an agent's depot slot, or that the agent cannot reach and still fly home from, are removed
+  from that node's vehicle variable (``VehicleVar(index).RemoveValues``; in OR-Tools 9.15 the
+  Python wrapper of ``SetAllowedVehiclesForIndex`` rejects every argument).
 
-**Objective** (minimised): total travel in px plus the sum of the drop penalties of the tasks left
-out, both in px-equivalent units. OR-Tools needs integers: distances are scaled by
+**Objective** (minimised): total travel in px plus the sum of the drop penalties of the candidate
+tasks left out, both in px-equivalent units. OR-Tools needs integers: distances are scaled by
 ``scale`` (10: decimetres) and rounded *up* (so a route the solver accepts is within the battery
 in real px too), capacities are rounded down, penalties are rounded (at least 1, so a visit stays
-optional). The objective reported in :class:`fcplan.scheduling.SolveStats` is the sum over the
-models divided by ``scale``. With ``charge_return=False`` (default) the legs into the depot slots
-cost nothing (the agent replans long before it flies home; charging the return would bias the
-search towards the depot) but they still count in the battery dimension; with
-``charge_return=True`` the travel is the full path start -> tasks -> depot slot.
+optional). The objective in :class:`fcplan.scheduling.SolveStats` is the sum of the models'
+OR-Tools objectives divided by ``scale`` (px). With ``charge_return=False`` (default) the legs
+into the depot slots cost nothing (an agent replans every second, long before it would fly home;
+charging the way home would pull the search towards the depot) but they still count in the
+battery dimension; with ``charge_return=True`` the travel is the whole path start -> tasks ->
+depot slot.
 
-**Values** (drop penalties, in px a vehicle is willing to fly to serve the task):
+**Values** (drop penalties: how many px a vehicle would fly to serve the task):
 
 * action, fire ``k``: ``fire_base_px + fire_value_px * value_k * freshness_k`` where ``value_k``
   is the task's known cells weighted by the facilities it threatens and ``freshness_k`` is 1
   while the fire was sensed within ``fresh_s`` seconds, then decays as
   ``exp(-(staleness - fresh_s) / fresh_s)`` (as in ``greedy``). Action agents have nothing else
-  to do, so the base term (default 2000 px, more than most trips across the map) makes every
+  to do, so the base term (default 2000 px, more than most trips across a map) makes every
   reachable fire worth a visit while the tank and ``max_visits`` allow; the value term decides
   which fires when they do not, and travel decides the order;
-* perception, search block ``k``: ``search_value_px * value_k`` (its coverage age, more near
-  known fire);
-* perception, fire ``k`` ("watching"): ``watch_value_px * value_k * w_k`` with ``w_k = 1`` when
-  the fire is the *first* task of an action route of this replan (a dump is imminent: watching
-  senses the cells the fire adds, which only then can be pruned) and otherwise the staleness
-  share ``clip((staleness - fresh_s) / fresh_s, 0, 1)`` (a fire not sensed for a while is worth
-  refreshing for the action agents). This is why the action model is solved first.
+* perception, search block ``k``: ``search_value_px * value_k`` (its coverage age in s, more
+  near known fire), optionally discounted by ``h / (h + eta_k)`` (``search_horizon_s = h > 0``,
+  ``eta_k`` the earliest arrival of any perception vehicle; off by default: it did not help);
+* perception, fire ``k`` ("watching"): ``watch_value_px * value_k * w_k``. Only sensed cells can
+  be pruned, and a fire being fought keeps adding unsensed cells, so ``w_k = 1`` for the fires
+  a dump is imminent at: the *first* tasks of this replan's action routes (one per connected
+  fire, the most valuable, for at most ``max_watch_fraction`` of the perception vehicles, at least
+  one, so the others keep searching); this is why the action model is solved first. Other fires
+  get ``w_k = clip((staleness - fresh_s) / fresh_s, 0, 1)``: a fire not sensed for a while is
+  worth refreshing for the action agents. The default ``watch_value_px = 1000`` px per cell makes
+  watching beat searching almost always (100 px per cell did not: scores were lower).
 
 A perception route whose first task is a fire becomes a **watch**: the route is cut to that fire
 (the agent hovers over it until the next replan) at ``watch_altitude`` (low: reliable sensing);
@@ -56,28 +62,38 @@ other perception routes fly at ``search_altitude`` (high: a wide view). Altitude
 each agent's bounds. Agents with an empty route are not mentioned in the plan (they keep their
 current route), as in ``greedy``.
 
-**Model size and time**: each role's candidate nodes are the ``max_nodes`` most valuable tasks
-that some vehicle of the role can reach (ties broken by task order); on big task graphs this is
-what keeps a replan within its time limit (the rest are simply not offered this replan). Routes
-hold at most ``max_visits`` tasks. The search starts from ``first_solution`` (default
-``PARALLEL_CHEAPEST_INSERTION``, which accounts for drop penalties) and improves it with
-``metaheuristic`` (default ``GUIDED_LOCAL_SEARCH``) until the time limit: ``time_limit``
-seconds per replan (default 0.1 s; the ``time_limit`` argument of :meth:`RoutingScheduler.plan`
-overrides it when given), model building included. The action model gets a share of it in
-proportion to its node count (between 25 % and 50 %), the perception model what is left. A
-``branch_limit`` (a machine-independent count of search steps) ends the search of small models
-early, so they do not spin until the time limit. In
-that mode the result depends on the machine's speed. With ``deterministic=True`` the search stops
-after ``solution_limit`` solutions instead of a wall time, so the same graph gives the same plan
-run to run (for reproducible benchmarks), whatever the machine.
+**Model size**: each role's candidate nodes are its ``max(max_nodes, nodes_per_vehicle * V)``
+most valuable tasks that one of its ``V`` vehicles can reach (default 60, or 2 per vehicle on big
+teams); the others are not offered this replan. On big task graphs this is what keeps a replan
+within its time limit. Routes hold at most ``max_visits`` (4) tasks.
+
+**Search and time**: the search starts from ``first_solution`` (default
+``PARALLEL_CHEAPEST_INSERTION``, which weighs insertions against drop penalties) and improves it
+with ``metaheuristic`` (default ``GUIDED_LOCAL_SEARCH``):
+
+* default mode: until ``time_limit`` seconds per replan (default 0.1 s; the ``time_limit``
+  argument of :meth:`RoutingScheduler.plan` overrides it when given), model building included
+  and about 10 % (at most 5 ms) kept back for turning routes into the plan. The action model gets
+  a share in proportion to its node count (25 % to 50 %), the perception model the rest. A
+  ``branch_limit`` (search steps, a machine-independent count) ends the search of small models
+  early so they do not spin until the limit. If the limit ends a model's search before any
+  solution, the first-solution heuristic is run alone past the limit (about a millisecond;
+  ``rescue=True``, status ``time_limit``, noted in the message) rather than failing. The plan
+  depends on the machine's speed in this mode: it is **not** reproducible run to run;
+* ``deterministic=True``: the search stops after ``solution_limit`` solutions or
+  ``branch_limit`` branches, whichever comes first, never on a wall time (also the LNS
+  sub-searches' own time limit is made unreachable), so the same graph gives the same plan run
+  to run and on any machine: use it for reproducible benchmarks. It takes longer (about
+  0.05-0.5 s per replan on the shipped scenarios).
 
 **Status**: routing never proves optimality. ``feasible``: a solution was found and the local
-search reached a local optimum before the limit (OR-Tools ``ROUTING_SUCCESS``; with guided local
-search the search then continues until the limit); ``time_limit``: the limit stopped the search
-before the local search converged (``ROUTING_PARTIAL_SUCCESS_LOCAL_OPTIMUM_NOT_REACHED``, the
-worse of the two models is reported). If a model finds no solution within the limit,
-:class:`RoutingFailedError` is raised and :func:`fcplan.scheduling.solve` falls back to ``greedy``
-for that replan (``status="fallback"``).
+search reached a local optimum (OR-Tools ``ROUTING_SUCCESS``; guided local search then goes on
+until the limit), or the deterministic limits stopped it; ``time_limit``: the wall-time limit
+stopped the search before the local search converged
+(``ROUTING_PARTIAL_SUCCESS_LOCAL_OPTIMUM_NOT_REACHED``) or the plan was rescued; the worse of the
+two models is reported. If a model finds no solution (only possible with ``rescue=False``),
+:class:`RoutingFailedError` is raised and :func:`fcplan.scheduling.solve` falls back to
+``greedy`` for that replan (``status="fallback"``, the reason in the message).
 
 Examples
 --------
@@ -413,8 +429,9 @@ class RoutingScheduler:
         Search branches per model (both modes; ends the search of small models early).
     max_visits : int
         Most tasks per route.
-    max_nodes : int
-        Most candidate tasks per role per replan (the most valuable reachable ones).
+    max_nodes, nodes_per_vehicle : int
+        Candidate tasks per role per replan: the ``max(max_nodes, nodes_per_vehicle * V)`` most
+        valuable reachable ones, ``V`` the role's vehicles.
     fire_base_px : float
         Drop penalty (px) of any fire task for action agents, on top of the value term: action
         agents have nothing else to do, so every reachable fire is worth a trip this long.
@@ -457,9 +474,10 @@ class RoutingScheduler:
         branch_limit: int | None = 2000,
         max_visits: int = 4,
         max_nodes: int = 60,
+        nodes_per_vehicle: int = 2,
         fire_base_px: float = 2000.0,
         fire_value_px: float = 200.0,
-        watch_value_px: float = 100.0,
+        watch_value_px: float = 1000.0,
         search_value_px: float = 10.0,
         search_horizon_s: float = 0.0,
         fresh_s: float = 5.0,
@@ -487,6 +505,7 @@ class RoutingScheduler:
         self.branch_limit = None if branch_limit is None else int(branch_limit)
         self.max_visits = int(max_visits)
         self.max_nodes = int(max_nodes)
+        self.nodes_per_vehicle = int(nodes_per_vehicle)
         self.fire_base_px = float(fire_base_px)
         self.fire_value_px = float(fire_value_px)
         self.watch_value_px = float(watch_value_px)
@@ -535,7 +554,8 @@ class RoutingScheduler:
             self.search_value_px * graph.task_value[blocks],
         ]
         n_sense = min(
-            self.max_nodes, int((sense_value_guess > 0).sum()) if sensors.size else 0
+            self._n_candidates(sensors.size),
+            int((sense_value_guess > 0).sum()) if sensors.size else 0,
         )  # for the time split only
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}
@@ -595,7 +615,7 @@ class RoutingScheduler:
         )
         size = {
             "models": len(sols),
-            "vehicles": int(actors.size + sensors.size),
+            "vehicles": sum(s.size["vehicles"] for s in sols.values()),
             "nodes": sum(s.size["nodes"] for s in sols.values()),
             "dimensions": sum(s.size["dimensions"] for s in sols.values()),
             "agents": graph.n_agents,
@@ -636,6 +656,10 @@ class RoutingScheduler:
         out[np.isin(fires, ks[:n_watch])] = True
         return out
 
+    def _n_candidates(self, n_vehicles: int) -> int:
+        """Candidate nodes for a model with ``n_vehicles`` vehicles."""
+        return max(self.max_nodes, self.nodes_per_vehicle * n_vehicles)
+
     def _candidates(
         self,
         graph: TaskGraph,
@@ -646,8 +670,9 @@ class RoutingScheduler:
         budget: np.ndarray,
         trip: np.ndarray,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """(task rows, penalties px) of the ``max_nodes`` most valuable tasks some agent of
-        ``agents`` can serve (positive value, within a round trip, reachable with the way home)."""
+        """(task rows, penalties px) of the most valuable tasks (see :meth:`_n_candidates`) some
+        agent of ``agents`` can serve (positive value, within a round trip, reachable with the way
+        home)."""
         if agents.size == 0 or tasks.size == 0:
             return np.zeros(0, np.int64), np.zeros(0)
         d = (
@@ -656,7 +681,7 @@ class RoutingScheduler:
         )
         reach = (trip[np.ix_(agents, tasks)] & (d <= budget[agents, None])).any(axis=0)
         ok = np.flatnonzero(reach & (value > 0))
-        top = ok[np.argsort(-value[ok], kind="stable")[: self.max_nodes]]
+        top = ok[np.argsort(-value[ok], kind="stable")[: self._n_candidates(agents.size)]]
         top = np.sort(top)  # task order: the model does not depend on value ties
         return tasks[top], value[top]
 

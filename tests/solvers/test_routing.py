@@ -16,7 +16,7 @@ from fcplan.plan import Plan, validate_plan
 from fcplan.scheduling import SolveStats, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph, TaskKind, synthetic_task_graph
 from fcplan.team import Mode
-from solvers.routing import RoutingScheduler, solve_routes
+from solvers.routing import RoutingFailedError, RoutingScheduler, solve_routes
 from tests.solvers.graphs import SCENARIOS, episode_graphs
 from tests.solvers.test_greedy import known_fire_graph
 
@@ -54,7 +54,9 @@ def check_routing_plan(g: TaskGraph, plan: Plan, max_visits: int = 4) -> None:
             assert g.agent_can_sense[i], f"{a} cannot sense but got a search task"
         if g.agent_can_act[i] and g.agent_tank[i] > 0:
             assert all(k == TaskKind.FIRE for k in kinds), f"{a} acts, but got a search task"
-            assert len(route) <= g.agent_tank[i], f"{a}: {len(route)} fires > tank {g.agent_tank[i]}"
+            assert len(route) <= g.agent_tank[i], (
+                f"{a}: {len(route)} fires > tank {g.agent_tank[i]}"
+            )
             for t in route:
                 assert t not in fire_owner, f"{t} given to {fire_owner.get(t)} and {a}"
                 fire_owner[t] = a
@@ -257,6 +259,27 @@ def test_one_millisecond_limit_never_crashes(name):
             assert plan.stats.message
 
 
+def test_exhausted_limit_is_rescued_or_raises():
+    """When the wall-time limit ends the search before any solution, ``solve_routes`` returns
+    the first-solution heuristic's feasible routes flagged ``rescued`` with status
+    ``time_limit`` (default), or raises :class:`RoutingFailedError` with ``rescue=False``; the
+    scheduler's failure becomes a recorded greedy fallback in :func:`fcplan.scheduling.solve`."""
+    rng = np.random.default_rng(0)
+    start = rng.uniform(0, 1000, (3, 2))
+    pts = rng.uniform(0, 1000, (30, 2))
+    args = (start, start, pts, np.full(30, 500.0), np.full(3, 5000.0))
+    sol = solve_routes(*args, time_limit=1e-6, max_visits=4)
+    assert sol.rescued and sol.status == "time_limit"
+    assert all(len(r) <= 4 for r in sol.routes)
+    with pytest.raises(RoutingFailedError, match="no routing solution"):
+        solve_routes(*args, time_limit=1e-6, rescue=False)
+    g = known_fire_graph()
+    plan = solve(RoutingScheduler(rescue=False), g, time_limit=1e-6, rng=rng)
+    validate_plan(plan, g)
+    assert plan.stats.status == "fallback"
+    assert "RoutingFailedError" in plan.stats.message
+
+
 def test_registry_and_settings():
     """``make_scheduler("routing")`` builds the scheduler, passes settings, and rejects unknown
     settings and OR-Tools strategy names."""
@@ -277,7 +300,7 @@ def test_stats_report_size_and_objective():
     s = plan.stats
     assert s.size["models"] == 2
     assert s.size["vehicles"] == g.n_agents
-    assert 0 < s.size["nodes"] and s.size["dimensions"] >= 2
+    assert s.size["nodes"] > 0 and s.size["dimensions"] >= 2
     assert np.isfinite(s.objective) and s.objective > 0
 
 
