@@ -86,9 +86,7 @@ def full_bound(graph, limit_s: float = 20.0) -> float:
     or NaN when that model is too big to solve here (A x K > 5,000) or CP-SAT finds nothing."""
     if graph.n_agents * graph.n_tasks > 5_000:
         return math.nan
-    sched = make_scheduler(
-        "milp", fire_candidates=graph.n_tasks, search_candidates=graph.n_tasks
-    )
+    sched = make_scheduler("milp", fire_candidates=graph.n_tasks, search_candidates=graph.n_tasks)
     try:
         plan = sched.plan(graph, time_limit=limit_s, rng=None)
     except RuntimeError:
@@ -134,8 +132,12 @@ def main() -> None:
     ap.add_argument("--schedulers", default=",".join(DEFAULT))
     ap.add_argument("--quick", action="store_true", help="fewer scenarios, sizes and repeats")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    ap.add_argument("--time-limit", type=float, default=None,
-                    help="seconds per solve in the scaling study (default: each scheduler's own)")
+    ap.add_argument(
+        "--time-limit",
+        type=float,
+        default=None,
+        help="seconds per solve in the scaling study (default: each scheduler's own)",
+    )
     args = ap.parse_args()
     names = [n for n in args.schedulers.split(",") if n]
     missing = sorted(set(names) - set(available_schedulers()))
