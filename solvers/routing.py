@@ -83,8 +83,9 @@ with ``metaheuristic`` (default ``GUIDED_LOCAL_SEARCH``):
 * ``deterministic=True``: the search stops after ``solution_limit`` solutions or
   ``branch_limit`` branches, whichever comes first, never on a wall time (also the LNS
   sub-searches' own time limit is made unreachable), so the same graph gives the same plan run
-  to run and on any machine: use it for reproducible benchmarks. It takes longer (about
-  0.05-0.5 s per replan on the shipped scenarios).
+  to run and on any machine: use it for reproducible benchmarks. Its time per replan varies
+  with the model (p50 45-66 ms, p95 80-130 ms on scenarios #1, #12, #24; 0.2-0.7 s on synthetic
+  graphs of 10 x 100 to 100 x 2000 agents x tasks).
 
 **Status**: routing never proves optimality. ``feasible``: a solution was found and the local
 search reached a local optimum (OR-Tools ``ROUTING_SUCCESS``; guided local search then goes on
