@@ -366,9 +366,11 @@ def solve_routes(
     hit_time = time_left is not None and time.perf_counter() - t0 >= 0.95 * time_left
     status = model.status()
     rescued = False
-    if sol is None and rescue and status == _RSS.ROUTING_FAIL_TIMEOUT:
-        # the wall-time limit ended the search before a first solution: take the first-solution
-        # heuristic's answer without a wall-time limit (about a millisecond on these models)
+    if sol is None and rescue and time_left is not None:
+        # the wall-time limit ended the search before a first solution (OR-Tools reports this as
+        # ROUTING_FAIL_TIMEOUT or, when the limit is already spent at the start, ROUTING_FAIL):
+        # take the first-solution heuristic's answer without a wall-time limit (about a
+        # millisecond on these models); a truly infeasible model fails again and raises below
         params = _search_parameters(None, True, 1, first_solution, metaheuristic)
         sol = model.SolveWithParameters(params)
         status, rescued, hit_time = model.status(), sol is not None, True
