@@ -52,20 +52,16 @@ Examples
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 from ortools.sat.python import cp_model
 
-from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
-from fcplan.taskgraph import TaskGraph
-from solvers.milp_model import MilpModel, MilpParams, build_milp_model, decode_plan
+from solvers.milp_model import MilpModel, MilpSchedulerBase
 
 __all__ = ["MilpScheduler", "solve_cpsat"]
 
 
-class MilpScheduler:
+class MilpScheduler(MilpSchedulerBase):
     """Joint perception-action assignment MILP solved by CP-SAT (see the module docstring).
 
     Parameters
@@ -81,26 +77,10 @@ class MilpScheduler:
     """
 
     name = "milp"
+    default_time_limit = 0.2
 
-    def __init__(self, time_limit: float = 0.2, seed: int = 0, **model_settings) -> None:
-        self.time_limit = float(time_limit)
-        self.seed = int(seed)
-        self.params = MilpParams(**model_settings)
-
-    def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng=None) -> Plan:
-        """Build the model of ``graph``, solve it with CP-SAT and decode the plan.
-
-        Raises
-        ------
-        RuntimeError
-            If CP-SAT returns no solution within the limit.
-        """
-        t0 = time.perf_counter()
-        limit = self.time_limit if time_limit is None else float(time_limit)
-        model = build_milp_model(graph, self.params)
-        remaining = max(limit - (time.perf_counter() - t0), 1e-4)
-        x, stats = solve_cpsat(model, time_limit=remaining, seed=self.seed)
-        return decode_plan(model, x, graph, stats)
+    def _solve(self, model: MilpModel, *, time_limit: float, seed: int):
+        return solve_cpsat(model, time_limit=time_limit, seed=seed)
 
 
 def solve_cpsat(

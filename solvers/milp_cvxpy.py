@@ -40,21 +40,18 @@ Examples
 
 from __future__ import annotations
 
-import time
 import warnings
 
 import cvxpy as cp
 import numpy as np
 
-from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
-from fcplan.taskgraph import TaskGraph
-from solvers.milp_model import MilpModel, MilpParams, build_milp_model, decode_plan
+from solvers.milp_model import MilpModel, MilpSchedulerBase
 
 __all__ = ["MilpCvxpyScheduler", "solve_cvxpy"]
 
 
-class MilpCvxpyScheduler:
+class MilpCvxpyScheduler(MilpSchedulerBase):
     """Joint perception-action assignment MILP in cvxpy, solved by HiGHS.
 
     Parameters
@@ -68,26 +65,10 @@ class MilpCvxpyScheduler:
     """
 
     name = "milp-cvxpy"
+    default_time_limit = 0.5
 
-    def __init__(self, time_limit: float = 0.5, seed: int = 0, **model_settings) -> None:
-        self.time_limit = float(time_limit)
-        self.seed = int(seed)
-        self.params = MilpParams(**model_settings)
-
-    def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng=None) -> Plan:
-        """Build the model of ``graph``, solve it in cvxpy with HiGHS and decode the plan.
-
-        Raises
-        ------
-        RuntimeError
-            If HiGHS returns no solution within the limit.
-        """
-        t0 = time.perf_counter()
-        limit = self.time_limit if time_limit is None else float(time_limit)
-        model = build_milp_model(graph, self.params)
-        remaining = max(limit - (time.perf_counter() - t0), 1e-4)
-        x, stats = solve_cvxpy(model, time_limit=remaining, seed=self.seed)
-        return decode_plan(model, x, graph, stats)
+    def _solve(self, model: MilpModel, *, time_limit: float, seed: int):
+        return solve_cvxpy(model, time_limit=time_limit, seed=seed)
 
 
 def solve_cvxpy(
