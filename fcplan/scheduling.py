@@ -44,6 +44,7 @@ __all__ = [
     "SolveStats",
     "STATUSES",
     "make_scheduler",
+    "parse_scheduler_spec",
     "register_scheduler",
     "available_schedulers",
     "solve",
@@ -138,14 +139,57 @@ def _load(target: str) -> Callable[..., Scheduler]:
     return getattr(import_module(module), attr)
 
 
+def parse_scheduler_spec(spec: str) -> tuple[str, dict[str, Any]]:
+    """Split ``"name:key=value:key=value"`` into the name and its settings.
+
+    Values are read as ``true``/``false``, integers, floats, or else strings. This is how the
+    CLI (``fcplan run -s``, ``fcplan compare --schedulers``) passes settings to a scheduler.
+
+    Examples
+    --------
+    >>> parse_scheduler_spec("routing:deterministic=true:time_limit=0.05")
+    ('routing', {'deterministic': True, 'time_limit': 0.05})
+    >>> parse_scheduler_spec("greedy")
+    ('greedy', {})
+    """
+    name, *parts = spec.split(":")
+    settings: dict[str, Any] = {}
+    for part in parts:
+        key, sep, text = part.partition("=")
+        if not sep or not key.strip():
+            raise FcplanError(
+                f"scheduler spec {spec!r}: settings are written name:key=value[:key=value...]"
+            )
+        settings[key.strip()] = _parse_value(text.strip())
+    return name.strip(), settings
+
+
+def _parse_value(text: str) -> Any:
+    low = text.lower()
+    if low in ("true", "false"):
+        return low == "true"
+    for cast in (int, float):
+        try:
+            return cast(text)
+        except ValueError:
+            pass
+    return text
+
+
 def make_scheduler(name: str, **settings: Any) -> Scheduler:
     """Create a scheduler by registered name, passing ``settings`` to its factory.
+
+    ``name`` may carry settings as a spec, ``"routing:deterministic=true"``
+    (:func:`parse_scheduler_spec`); keyword ``settings`` override those.
 
     Raises
     ------
     fcplan.errors.UnknownNameError
         If no scheduler has that name (the message lists the known ones).
     """
+    if ":" in name:
+        name, spec_settings = parse_scheduler_spec(name)
+        settings = {**spec_settings, **settings}
     if name in _RUNTIME:
         factory = _RUNTIME[name]
     else:

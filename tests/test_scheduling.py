@@ -238,3 +238,23 @@ def test_episode_survives_an_always_failing_scheduler():
     assert all(s.status == "fallback" and "RuntimeError" in s.message for s in result.solves)
     assert result.summary()["fallbacks"] == result.fallbacks
     assert result.trace.sensed_ever[-1] > 0
+
+
+def test_scheduler_specs_carry_settings():
+    """A spec "name:key=value" creates the scheduler with those settings (bools, ints, floats,
+    strings parsed), keyword settings override the spec, and a malformed spec is a one-line
+    FcplanError."""
+    from fcplan.errors import FcplanError
+    from fcplan.scheduling import parse_scheduler_spec
+
+    assert parse_scheduler_spec("greedy:route_length=2:fresh_s=2.5:x=abc:y=TRUE") == (
+        "greedy",
+        {"route_length": 2, "fresh_s": 2.5, "x": "abc", "y": True},
+    )
+    g = make_scheduler("greedy:route_length=1:search_altitude=90")
+    assert g.route_length == 1 and g.search_altitude == 90.0
+    assert make_scheduler("greedy:route_length=1", route_length=4).route_length == 4
+    with pytest.raises(FcplanError, match="name:key=value"):
+        make_scheduler("greedy:route_length")
+    with pytest.raises(FcplanError, match="bad settings"):
+        make_scheduler("greedy:no_such_setting=1")

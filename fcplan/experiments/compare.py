@@ -173,7 +173,7 @@ def _check_schedulers(names: Sequence[str]) -> list[str]:
     for name in names:
         if not isinstance(name, str):
             raise FcplanError(f"schedulers are given by registered name, got {name!r}")
-        if name not in known:
+        if name.split(":")[0].strip() not in known:
             raise UnknownNameError(
                 f"unknown scheduler {name!r}; known schedulers: {', '.join(known)}"
             )

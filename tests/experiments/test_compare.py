@@ -315,3 +315,16 @@ def test_progress_printer_throttles(capsys):
     assert len(lines) == 2
     assert lines[0].startswith("compare: 1/5 episodes (20%)") and "ETA" in lines[0]
     assert lines[1].startswith("compare: 5/5 episodes (100%)") and "1 failed" in lines[1]
+
+
+def test_scheduler_specs_are_compared_as_separate_rows():
+    """Two specs of one scheduler with different settings are run and reported as two rows,
+    labelled by their specs."""
+    from fcplan.experiments import compare as run_compare
+    from fcplan.scenario import load_scenario
+
+    sc = load_scenario(3).replace(duration_s=10)
+    res = run_compare([sc], ["greedy", "greedy:route_length=1"], [0], jobs=1)
+    rows = {r["scheduler"]: r for r in res.table()}
+    assert set(rows) == {"greedy", "greedy:route_length=1"}
+    assert all(r["episodes"] == 1 and r["errors"] == 0 for r in rows.values())
