@@ -1,4 +1,4 @@
-"""Battery feasibility helpers shared by the built-in schedulers."""
+"""Feasibility helpers shared by the built-in schedulers (battery, altitude bounds)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import numpy as np
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
 
-__all__ = ["start_positions", "start_budget", "round_trip_ok"]
+__all__ = ["start_positions", "start_budget", "round_trip_ok", "clip_altitude"]
 
 
 def start_positions(graph: TaskGraph) -> np.ndarray:
@@ -26,3 +26,9 @@ def start_budget(graph: TaskGraph) -> np.ndarray:
 def round_trip_ok(graph: TaskGraph) -> np.ndarray:
     """(A, K) bool: the task is within a round trip from the agent's depot slot on a full battery."""
     return 2.0 * graph.task_home_distance <= graph.agent_full_range[:, None]
+
+
+def clip_altitude(graph: TaskGraph, i: int, z: float) -> float:
+    """Altitude ``z`` clipped to agent ``i``'s bounds."""
+    lo, hi = graph.agent_alt_range[i]
+    return float(min(max(z, lo), hi))

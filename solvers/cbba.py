@@ -144,7 +144,7 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers._feasible import round_trip_ok, start_budget, start_positions
+from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = ["CBBAScheduler", "CBBAResult", "CommGraph", "StageResult", "communication_graph"]
 
@@ -621,8 +621,7 @@ class CBBAScheduler:
             if res.service[i] == "sense":
                 watch = graph.task_kind[tasks[-1]] == TaskKind.FIRE
                 z = self.watch_altitude if watch else self.search_altitude
-                lo, hi = graph.agent_alt_range[i]
-                alts[agent] = float(min(max(z, lo), hi))
+                alts[agent] = clip_altitude(graph, i, z)
         comm = res.comm
         size = {
             "agents": graph.n_agents,

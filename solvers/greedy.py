@@ -36,7 +36,7 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
-from solvers._feasible import round_trip_ok, start_budget, start_positions
+from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = ["GreedyScheduler"]
 
@@ -147,7 +147,7 @@ class GreedyScheduler:
                 busy.add(i)
                 watched_clusters.add(cl)
                 routes[graph.agent_ids[i]] = (graph.task_ids[k],)
-                alts[graph.agent_ids[i]] = self._clip_alt(graph, i, self.watch_altitude)
+                alts[graph.agent_ids[i]] = clip_altitude(graph, i, self.watch_altitude)
 
         # 3. the others search
         searchers = np.array(
@@ -174,7 +174,7 @@ class GreedyScheduler:
             for row, tasks in picks.items():
                 if tasks:
                     routes[graph.agent_ids[row]] = tuple(graph.task_ids[k] for k in tasks)
-                    alts[graph.agent_ids[row]] = self._clip_alt(graph, row, self.search_altitude)
+                    alts[graph.agent_ids[row]] = clip_altitude(graph, row, self.search_altitude)
         return Plan(
             routes=routes,
             altitudes=alts,
@@ -186,11 +186,6 @@ class GreedyScheduler:
         )
 
     # ------------------------------------------------------------------ helpers
-    @staticmethod
-    def _clip_alt(graph: TaskGraph, i: int, z: float) -> float:
-        lo, hi = graph.agent_alt_range[i]
-        return float(min(max(z, lo), hi))
-
     def _assign(
         self,
         graph: TaskGraph,

@@ -125,7 +125,7 @@ import scipy.sparse as sp
 from fcplan.plan import Plan
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers._feasible import round_trip_ok, start_budget, start_positions
+from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = [
     "DUMP",
@@ -536,8 +536,7 @@ def decode_plan(model: MilpModel, x: np.ndarray, graph: TaskGraph, stats=None) -
         routes[aid] = tuple(graph.task_ids[k] for k in ks)
         if graph.agent_can_sense[a]:
             z = p.watch_altitude if graph.task_kind[ks[0]] == TaskKind.FIRE else p.search_altitude
-            lo, hi = graph.agent_alt_range[a]
-            alts[aid] = float(min(max(z, lo), hi))
+            alts[aid] = clip_altitude(graph, a, z)
     return Plan(routes=routes, altitudes=alts, stats=stats)
 
 

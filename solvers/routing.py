@@ -128,7 +128,7 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers._feasible import round_trip_ok, start_budget, start_positions
+from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = ["RoutingScheduler", "RouteSolution", "RoutingFailedError", "solve_routes"]
 
@@ -610,8 +610,7 @@ class RoutingScheduler:
                     else:
                         z = self.search_altitude
                     routes[graph.agent_ids[i]] = tuple(graph.task_ids[k] for k in ks)
-                    lo, hi = graph.agent_alt_range[i]
-                    alts[graph.agent_ids[i]] = float(min(max(z, lo), hi))
+                    alts[graph.agent_ids[i]] = clip_altitude(graph, i, z)
 
         status = (
             "time_limit" if any(s.status == "time_limit" for s in sols.values()) else "feasible"

@@ -16,7 +16,7 @@ from fcplan.plan import Plan, validate_plan
 from fcplan.taskgraph import TaskGraph, TaskKind, build_task_graph, synthetic_task_graph
 from fcplan.team import Command, Mode
 from solvers.greedy import GreedyScheduler
-from tests.solvers.graphs import SCENARIOS
+from tests.solvers.graphs import SCENARIOS, route_length_home
 from tests.solvers.graphs import episode_graphs as _episode_graphs
 
 #: every shipped scenario, plus the open-world example (hybrids, 1000 px map)
@@ -31,16 +31,6 @@ def episode_graphs(name) -> tuple[TaskGraph, ...]:
 
 def greedy_plan(g: TaskGraph, **settings) -> Plan:
     return GreedyScheduler(**settings).plan(g, time_limit=None, rng=np.random.default_rng(0))
-
-
-def route_length_home(g: TaskGraph, i: int, route) -> tuple[float, float]:
-    """(px of the route from the agent's start plus the way home, px it may fly)."""
-    if g.agent_mode[i] == Mode.RETURNING:
-        start, budget = g.agent_home[i], g.agent_full_range[i]
-    else:
-        start, budget = g.agent_pos[i], g.agent_battery[i] / 0.1
-    pts = np.vstack([start] + [g.task_pos[g.task_index[t]] for t in route] + [g.agent_home[i]])
-    return float(np.hypot(*np.diff(pts, axis=0).T).sum()), float(budget)
 
 
 def check_greedy_plan(g: TaskGraph, plan: Plan) -> None:

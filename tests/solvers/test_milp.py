@@ -26,7 +26,7 @@ from solvers.milp_model import (
     build_milp_model,
     decode_plan,
 )
-from tests.solvers.graphs import SCENARIOS
+from tests.solvers.graphs import SCENARIOS, route_length_home
 from tests.solvers.graphs import episode_graphs as _episode_graphs
 
 TICKS = (0, 100, 300, 600)
@@ -40,16 +40,6 @@ def episode_graphs(name) -> tuple[TaskGraph, ...]:
 
 def milp_plan(g: TaskGraph, backend=MilpScheduler, **settings) -> Plan:
     return backend(**settings).plan(g, time_limit=10.0, rng=np.random.default_rng(0))
-
-
-def route_length_home(g: TaskGraph, i: int, route) -> tuple[float, float]:
-    """(px of the route from the agent's start plus the way home, px it may fly)."""
-    if g.agent_mode[i] == Mode.RETURNING:
-        start, budget = g.agent_home[i], g.agent_full_range[i]
-    else:
-        start, budget = g.agent_pos[i], g.agent_battery[i] / 0.1
-    pts = np.vstack([start] + [g.task_pos[g.task_index[t]] for t in route] + [g.agent_home[i]])
-    return float(np.hypot(*np.diff(pts, axis=0).T).sum()), float(budget)
 
 
 def check_plan(g: TaskGraph, plan: Plan, params: MilpParams | None = None) -> None:

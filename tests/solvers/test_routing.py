@@ -17,7 +17,7 @@ from fcplan.scheduling import SolveStats, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph, TaskKind, synthetic_task_graph
 from fcplan.team import Mode
 from solvers.routing import RoutingFailedError, RoutingScheduler, solve_routes
-from tests.solvers.graphs import SCENARIOS, episode_graphs
+from tests.solvers.graphs import SCENARIOS, episode_graphs, route_length_home
 from tests.solvers.test_greedy import known_fire_graph
 
 #: replan ticks of the greedy episodes the real graphs come from (shared with test_greedy's cache)
@@ -25,16 +25,6 @@ TICKS = (0, 100, 300, 600)
 
 #: fast settings for feasibility tests (feasibility does not depend on the search effort)
 FAST = {"deterministic": True, "solution_limit": 20, "branch_limit": 1000}
-
-
-def route_length_home(g: TaskGraph, i: int, route) -> tuple[float, float]:
-    """(px of the route from the agent's start plus the way home, px it may fly)."""
-    if g.agent_mode[i] == Mode.RETURNING:
-        start, budget = g.agent_home[i], g.agent_full_range[i]
-    else:
-        start, budget = g.agent_pos[i], g.agent_battery[i] / 0.1
-    pts = np.vstack([start] + [g.task_pos[g.task_index[t]] for t in route] + [g.agent_home[i]])
-    return float(np.hypot(*np.diff(pts, axis=0).T).sum()), float(budget)
 
 
 def check_routing_plan(g: TaskGraph, plan: Plan, max_visits: int = 4) -> None:
