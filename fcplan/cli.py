@@ -23,104 +23,55 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from collections.abc import Sequence
 
+from fcplan.cliutil import (
+    CliError,
+    Parser,
+    check_output,
+    name_list,
+    positive_float,
+    positive_int,
+    scenario_list,
+    seed,
+    seed_list,
+)
 from fcplan.errors import FcplanError
 
-__all__ = ["main"]
+__all__ = ["COMMAND_MODULES", "main"]
 
-
-class _ArgumentError(FcplanError):
-    pass
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):  # one line, exit 2 (handled in main)
-        raise _ArgumentError(f"{self.prog}: {message}")
-
-
-def _positive_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
-    return v
-
-
-def _seed(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}")
-    return v
-
-
-def _positive_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}")
-    return v
-
-
-def _scenario_list(text: str) -> list:
-    from fcplan.experiments.compare import RangeError, parse_range
-
-    try:
-        return parse_range(text)
-    except RangeError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _seed_list(text: str) -> list:
-    from fcplan.experiments.compare import RangeError, parse_range
-
-    try:
-        return parse_range(text, names=False)
-    except RangeError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _name_list(text: str) -> list[str]:
-    names = [t.strip() for t in text.split(",")]
-    if not text.strip() or any(not t for t in names):
-        raise argparse.ArgumentTypeError(f"expected comma-separated names, got {text!r}")
-    return list(dict.fromkeys(names))
+#: Modules that add a sub-command. Each defines ``add_parser(sub)``, which adds its parser to the
+#: ``argparse`` sub-parsers object ``sub`` (built with ``parser_class=fcplan.cliutil.Parser``) and
+#: sets ``run=<function(args) -> int>`` as a default; heavy imports stay inside ``run``.
+COMMAND_MODULES: tuple[str, ...] = ()
 
 
 def _build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="fcplan", description="FireCommander multi-robot task assignment testbed")
+    p = Parser(prog="fcplan", description="FireCommander multi-robot task assignment testbed")
     p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     sub.add_parser("scenarios", help="list the shipped scenarios")
 
     sc = sub.add_parser("scenario", help="scenario file tools")
-    scs = sc.add_subparsers(dest="scenario_command", required=True, parser_class=_Parser)
+    scs = sc.add_subparsers(dest="scenario_command", required=True, parser_class=Parser)
     v = scs.add_parser("validate", help="validate scenario files and list manual limits exceeded")
     v.add_argument("files", nargs="+", help="TOML files or shipped scenario names")
 
     r = sub.add_parser("run", help="run one episode and print the manual's metrics")
     r.add_argument("scenario", help="practice, 1..24, or a TOML file")
     r.add_argument("--scheduler", "-s", default="greedy", help="registered scheduler name")
-    r.add_argument("--seed", type=_seed, default=0, help="random seed (integer >= 0)")
+    r.add_argument("--seed", type=seed, default=0, help="random seed (integer >= 0)")
     r.add_argument(
         "--replan-period",
-        type=_positive_float,
+        type=positive_float,
         default=1.0,
         help="simulated seconds between replans (default 1.0)",
     )
     r.add_argument(
         "--time-limit",
-        type=_positive_float,
+        type=positive_float,
         default=None,
         help="seconds per scheduler call (default: the scheduler's own)",
     )
@@ -132,31 +83,31 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     c.add_argument(
         "--schedulers",
-        type=_name_list,
+        type=name_list,
         required=True,
         help="comma-separated registered scheduler names, e.g. greedy,idle",
     )
     c.add_argument(
         "--scenarios",
-        type=_scenario_list,
+        type=scenario_list,
         default="1-24",
         help="scenarios as numbers, ranges and names, e.g. 1-24 or practice,1,3,5-7 (default 1-24)",
     )
     c.add_argument(
-        "--seeds", type=_seed_list, default="0-4", help="seeds, e.g. 0-4 or 0,7 (default 0-4)"
+        "--seeds", type=seed_list, default="0-4", help="seeds, e.g. 0-4 or 0,7 (default 0-4)"
     )
     c.add_argument(
-        "--jobs", "-j", type=_positive_int, default=None, help="worker processes (default: CPUs)"
+        "--jobs", "-j", type=positive_int, default=None, help="worker processes (default: CPUs)"
     )
     c.add_argument(
         "--time-limit",
-        type=_positive_float,
+        type=positive_float,
         default=None,
         help="seconds per scheduler call (default: each scheduler's own)",
     )
     c.add_argument(
         "--replan-period",
-        type=_positive_float,
+        type=positive_float,
         default=1.0,
         help="simulated seconds between replans (default 1.0)",
     )
@@ -164,6 +115,11 @@ def _build_parser() -> argparse.ArgumentParser:
     c.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
     c.add_argument("--by-difficulty", action="store_true", help="also print a table per difficulty")
     c.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
+
+    import importlib
+
+    for name in COMMAND_MODULES:
+        importlib.import_module(name).add_parser(sub)
     return p
 
 
@@ -247,24 +203,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_output(path: str | None, option: str) -> None:
-    """Fail before a long run, not after it, when an output file cannot be written."""
-    if path is None:
-        return
-    from pathlib import Path
-
-    p = Path(path)
-    if p.is_dir():
-        raise _ArgumentError(f"{option} {path}: is a directory")
-    if not p.parent.is_dir():
-        raise _ArgumentError(f"{option} {path}: no such directory {str(p.parent)!r}")
-
-
 def _cmd_compare(args: argparse.Namespace) -> int:
     from fcplan.experiments.compare import ProgressPrinter, compare
 
-    _check_output(args.json, "--json")
-    _check_output(args.csv, "--csv")
+    check_output(args.json, "--json")
+    check_output(args.csv, "--csv")
     result = compare(
         args.scenarios,
         args.schedulers,
@@ -283,7 +226,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             try:
                 write(path)
             except OSError as exc:
-                raise _ArgumentError(f"cannot write {path}: {exc.strerror or exc}") from None
+                raise CliError(f"cannot write {path}: {exc.strerror or exc}") from None
     for e in result.errors:
         print(
             f"fcplan: warning: episode {e['scenario']} {e['scheduler']} seed {e['seed']} "
@@ -313,7 +256,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _cmd_run(args)
         if args.command == "compare":
             return _cmd_compare(args)
-        raise _ArgumentError(f"unknown command {args.command!r}")  # pragma: no cover
+        if getattr(args, "run", None) is not None:
+            return int(args.run(args))
+        raise CliError(f"unknown command {args.command!r}")  # pragma: no cover
     except FcplanError as exc:
         if debug:
             raise
