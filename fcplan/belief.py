@@ -24,9 +24,14 @@ Examples
 
 from __future__ import annotations
 
+import math
+from functools import lru_cache
+
 import numpy as np
 
 __all__ = ["Belief"]
+
+_ZERO32 = np.int32(0)
 
 
 class Belief:
@@ -68,7 +73,9 @@ class Belief:
     def known_xy(self) -> np.ndarray:
         """(k, 2) int64 ``[x, y]`` of the known burning cells."""
         k = self.known
-        return np.stack([k // self.world_size, k % self.world_size], axis=1)
+        out = np.empty((k.size, 2), dtype=np.int64)
+        np.divmod(k, self.world_size, out=(out[:, 0], out[:, 1]))
+        return out
 
     def update(self, info) -> None:
         """Fold one tick's observations (a :class:`fcplan.world.StepInfo`) into the belief."""
@@ -88,15 +95,20 @@ class Belief:
 
     def _cover(self, fov: np.ndarray, tick: int) -> None:
         """Mark coarse cells whose centres lie inside a sensing agent's field of view."""
+        if not self._sensing_rows:
+            return
         c = self.coverage_px
         nc = self.coverage.shape[0]
+        cov = self.coverage
+        rects = fov.tolist()
         # coarse cell j has centre (j + 0.5) c; inside [a, b] iff ceil(a/c - 0.5) <= j <= floor(b/c - 0.5)
-        j0 = np.ceil(fov[:, [0, 2]] / c - 0.5).astype(np.int64)
-        j1 = np.floor(fov[:, [1, 3]] / c - 0.5).astype(np.int64)
-        j0 = np.clip(j0, 0, nc)
-        j1 = np.clip(j1 + 1, 0, nc)
         for k in self._sensing_rows:
-            self.coverage[j0[k, 0] : j1[k, 0], j0[k, 1] : j1[k, 1]] = tick
+            x0, x1, y0, y1 = rects[k]
+            i0 = min(max(math.ceil(x0 / c - 0.5), 0), nc)
+            i1 = min(max(math.floor(x1 / c - 0.5) + 1, 0), nc)
+            j0 = min(max(math.ceil(y0 / c - 0.5), 0), nc)
+            j1 = min(max(math.floor(y1 / c - 0.5) + 1, 0), nc)
+            cov[i0:i1, j0:j1] = tick
 
     def coverage_age_s(self, block_px: int) -> np.ndarray:
         """(B, B) mean seconds since the coarse cells of each ``block_px`` block were covered.
@@ -106,19 +118,32 @@ class Belief:
         Never-covered cells count as covered one minute before the start, so unexplored areas are
         the stalest.
         """
-        c = self.coverage_px
-        nc = self.coverage.shape[0]
-        nb = -(-self.world_size // int(block_px))
-        ticks = np.where(self.coverage >= 0, self.coverage, -60 * self.ticks_per_second)
+        nb, key, counts, empty, centre_cells = _block_layout(
+            self.world_size, self.coverage_px, self.coverage.shape[0], int(block_px)
+        )
+        never = np.int32(-60 * self.ticks_per_second)
+        ticks = np.where(self.coverage >= _ZERO32, self.coverage, never)
         age = (self.tick - ticks).astype(np.float64) / self.ticks_per_second
-        bi = np.minimum(((np.arange(nc) + 0.5) * c // block_px).astype(np.int64), nb - 1)
-        key = (bi[:, None] * nb + bi[None, :]).ravel()
         sums = np.bincount(key, weights=age.ravel(), minlength=nb * nb)
-        counts = np.bincount(key, minlength=nb * nb)
         out = sums / np.maximum(counts, 1)
-        empty = np.flatnonzero(counts == 0)
         if empty.size:
-            centre = (np.arange(nb) + 0.5) * block_px
-            ci = np.minimum((centre // c).astype(np.int64), nc - 1)
-            out[empty] = age[ci[empty // nb], ci[empty % nb]]
+            out[empty] = age.ravel()[centre_cells]
         return out.reshape(nb, nb)
+
+
+@lru_cache(maxsize=32)
+def _block_layout(w: int, c: int, nc: int, block_px: int):
+    """How coarse coverage cells fall into ``block_px`` blocks (constant per map): block count
+    per side, block of each coarse cell, coarse cells per block, blocks holding no coarse cell
+    centre, and for those the coarse cell under the block's centre."""
+    nb = -(-w // block_px)
+    bi = np.minimum(((np.arange(nc) + 0.5) * c // block_px).astype(np.int64), nb - 1)
+    key = (bi[:, None] * nb + bi[None, :]).ravel()
+    counts = np.bincount(key, minlength=nb * nb)
+    empty = np.flatnonzero(counts == 0)
+    centre = (np.arange(nb) + 0.5) * block_px
+    ci = np.minimum((centre // c).astype(np.int64), nc - 1)
+    centre_cells = ci[empty // nb] * nc + ci[empty % nb]
+    for a in (key, counts, empty, centre_cells):
+        a.flags.writeable = False
+    return nb, key, counts, empty, centre_cells

@@ -50,6 +50,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
+try:  # np.interp without its argument checks (same compiled routine, same results)
+    from numpy._core.multiarray import interp as _interp
+except ImportError:  # numpy < 2
+    from numpy.core.multiarray import interp as _interp
+
 __all__ = [
     "Fire",
     "spread_rate_ratio",
@@ -129,6 +134,7 @@ class Fire:
     ) -> None:
         w = int(world_size)
         self.world_size = w
+        self._w_float = np.float64(w)
         self.ticks_per_second = int(ticks_per_second)
         self.dt = REFERENCE_TPS / self.ticks_per_second
         self.rng = rng
@@ -142,8 +148,8 @@ class Fire:
         hi = np.array([[r.center[0] + r.half_width, r.center[1] + r.half_width] for r in regions])
         lo_f, hi_f = np.repeat(lo, n_per, axis=0), np.repeat(hi, n_per, axis=0)
         pts = rng.integers(lo_f.astype(np.int64), hi_f.astype(np.int64), size=(n, 2))
-        self.x = pts[:, 0].astype(np.float64)
-        self.y = pts[:, 1].astype(np.float64)
+        # positions as one (2, n) array: one numpy call moves both coordinates
+        self._xy = np.ascontiguousarray(pts.T, dtype=np.float64)
         self.alive = (self.x >= 0) & (self.x < w) & (self.y >= 0) & (self.y < w)
         per = np.array(
             [[r.fuel, r.wind_speed, math.radians(r.wind_dir_deg)] for r in regions], np.float64
@@ -155,6 +161,7 @@ class Fire:
             [math.ceil(r.delay_s * self.ticks_per_second - 1e-9) for r in regions], np.int64
         )
         self.region_active = np.zeros(len(regions), dtype=bool)
+        self._set_next_wake()
         # One terrain field for the map, padded by one cell so rounded positions never overflow.
         self.terrain = rng.random((w + 1, w + 1), dtype=np.float32)
         #: (W, W) uint8 cell state: UNBURNT, BURNING or PRUNED.
@@ -183,6 +190,24 @@ class Fire:
         self.n_ignited = 0
 
     # ------------------------------------------------------------------ queries
+    @property
+    def x(self) -> np.ndarray:
+        """(n,) float64 front x positions (a view: writing into it moves the fronts)."""
+        return self._xy[0]
+
+    @x.setter
+    def x(self, value) -> None:
+        self._xy[0] = value
+
+    @property
+    def y(self) -> np.ndarray:
+        """(n,) float64 front y positions (a view: writing into it moves the fronts)."""
+        return self._xy[1]
+
+    @y.setter
+    def y(self, value) -> None:
+        self._xy[1] = value
+
     @property
     def live(self) -> np.ndarray:
         """(n,) bool: fronts that move this tick (alive and their region active)."""
@@ -229,16 +254,28 @@ class Fire:
         b = self.block_burning[
             x0 // BLOCK : (x1 - 1) // BLOCK + 1, y0 // BLOCK : (y1 - 1) // BLOCK + 1
         ]
-        return bool(b.any())
+        return np.count_nonzero(b) > 0
 
     # ------------------------------------------------------------------ dynamics
-    def _ignite(self, flat: np.ndarray) -> np.ndarray:
-        """Set unburnt cells burning; return the newly burning ones (unique)."""
-        fresh = flat[self._state_flat[flat] == UNBURNT]
-        if fresh.size > 1:
-            fresh = np.unique(fresh)
+    def _ignite(self, flat: np.ndarray, state: np.ndarray | None = None) -> np.ndarray:
+        """Set unburnt cells burning; return the newly burning ones (unique). ``state``: the
+        current states of ``flat``, if the caller has them."""
+        if state is None:
+            state = self._state_flat[flat]
+        fresh = flat[state == _UNBURNT8]
+        n = fresh.size
+        if n == 0:
+            return fresh
+        if n <= _SMALL:  # a few cells (every tick of a normal fire): Python ints are cheaper
+            w, nblk, blocks = self.world_size, self._nblk, self._block_flat
+            cells = sorted(set(fresh.tolist())) if n > 1 else fresh.tolist()
+            for c in cells:
+                blocks[(c // w // BLOCK) * nblk + (c % w) // BLOCK] += 1
+            fresh = np.array(cells, dtype=np.int64)
+        else:
+            fresh = _unique(fresh)
+            np.add.at(self._block_flat, self._block_of(fresh), _ONE32)
         self._state_flat[fresh] = BURNING
-        np.add.at(self._block_flat, self._block_of(fresh), _ONE32)
         self.n_burning += int(fresh.size)
         self.n_ignited += int(fresh.size)
         return fresh
@@ -252,58 +289,75 @@ class Fire:
         w = self.world_size
         self.tick += 1
         new = _EMPTY
-        if not self.region_active.all():
+        if self.tick >= self._next_wake:
             waking = (~self.region_active) & (self.delay_ticks <= self.tick)
             if waking.any():
                 self.region_active |= waking
                 self._moving = None
                 new = self._ignite(self.cell[self.alive & waking[self.region]])
+            self._set_next_wake()
         z = self.rng.standard_normal((2, self.n_fronts))
         if self._moving is None:
             self._refresh_moving()
         idx = self._moving
         if idx.size == 0:
             return new
-        if self._all_moving:  # common case: no gathers, update the position arrays in place
+        all_moving = self._all_moving
+        if all_moving:  # common case: no gathers, update the positions in place
             np.add.at(self._visits_flat, self.cell, _ONE)
-            xm, ym, zz = self.x, self.y, z
+            xy, zs = self._xy, z
         else:
             np.add.at(self._visits_flat, self.cell[idx], _ONE)
-            xm, ym, zz = self.x[idx], self.y[idx], z[:, idx]
-        theta = self._m_theta + WIND_DIR_SD_RAD * zz[1]
-        fuel = self.terrain[np.rint(xm).astype(np.int64), np.rint(ym).astype(np.int64)]
-        c = fuel * self._m_fuel_dt * _ratio(self._m_wind + WIND_SPEED_SD * zz[0])
-        xm += c * np.sin(theta)
-        ym += c * np.cos(theta)
-        if not self._all_moving:
-            self.x[idx] = xm
-            self.y[idx] = ym
-        inside = (np.minimum(xm, ym) >= 0.0) & (np.maximum(xm, ym) < w)
-        if not inside.all():
+            # gathers through flat indices (1-D takes are much cheaper than 2-D fancy indexing)
+            idx2 = self._m_idx2
+            xy = self._xy.reshape(-1)[idx2].reshape(2, -1)
+            zs = z.reshape(-1)[idx2].reshape(2, -1)
+        ut = self._m_wind_theta + _SD * zs  # rows: U = U_avg + 2 N, Theta = theta_avg + 2 N
+        cell_xy = np.rint(xy).astype(np.int64)
+        fuel = self.terrain[cell_xy[0], cell_xy[1]]
+        c = fuel * self._m_fuel_dt * _ratio(ut[0])
+        move = np.empty_like(xy)
+        np.sin(ut[1], out=move[0])
+        np.cos(ut[1], out=move[1])
+        move *= c
+        xy += move  # x += C sin(Theta), y += C cos(Theta)
+        if not all_moving:
+            self._xy.reshape(-1)[idx2] = xy.reshape(-1)
+        ge, lt = xy >= _ZERO, xy < self._w_float
+        if np.count_nonzero(ge) == xy.size and np.count_nonzero(lt) == xy.size:  # all inside
+            if all_moving:
+                idx = slice(None)
+        else:
+            inside = (ge & lt).all(axis=0)
             self.alive[idx[~inside]] = False
             self._moving = None
-            idx, xm, ym = idx[inside], xm[inside], ym[inside]
-        elif self._all_moving:
-            idx = slice(None)
-        flat = xm.astype(np.int64) * w + ym.astype(np.int64)
+            idx, xy = idx[inside], xy[:, inside]
+        cell_xy = xy.astype(np.int64)
+        flat = cell_xy[0] * w + cell_xy[1]
         self.cell[idx] = flat
         # A front that stepped into a pruned cell freezes there (and does not burn it).
-        into_pruned = self._state_flat[flat] == PRUNED
-        if into_pruned.any():
+        st = self._state_flat[flat]
+        into_pruned = st == _PRUNED8
+        if np.count_nonzero(into_pruned):
             self.frozen[
                 self._moving[into_pruned] if isinstance(idx, slice) else idx[into_pruned]
             ] = True
             self._moving = None
-        fresh = self._ignite(flat)
+        fresh = self._ignite(flat, st)
         return fresh if new.size == 0 else np.concatenate([new, fresh])
+
+    def _set_next_wake(self) -> None:
+        """Tick at which the next inactive region activates (never: a huge number)."""
+        waiting = self.delay_ticks[~self.region_active]
+        self._next_wake = int(waiting.min()) if waiting.size else _NEVER
 
     def _refresh_moving(self) -> None:
         """Cache the fronts that move (alive, region active, not frozen) and their parameters."""
         idx = np.flatnonzero(self.alive & self.region_active[self.region] & ~self.frozen)
         self._moving = idx
         self._all_moving = idx.size == self.n_fronts
-        self._m_wind = self._wind[idx]
-        self._m_theta = self._theta[idx]
+        self._m_wind_theta = np.stack([self._wind[idx], self._theta[idx]])
+        self._m_idx2 = np.concatenate([idx, idx + self.n_fronts])  # rows 0 and 1 of (2, n)
         self._m_fuel_dt = self._fuel[idx] * self.dt
 
     def prune(self, flat: np.ndarray) -> np.ndarray:
@@ -327,6 +381,15 @@ class Fire:
 
 
 _EMPTY = np.zeros(0, dtype=np.int64)
+
+
+def _unique(a: np.ndarray) -> np.ndarray:
+    """``np.unique`` of a 1-D array (sorted distinct values), with less call overhead."""
+    s = np.sort(a)
+    keep = np.empty(s.size, dtype=bool)
+    keep[:1] = True
+    np.not_equal(s[1:], s[:-1], out=keep[1:])
+    return s[keep]
 
 
 def _ratio_grid() -> np.ndarray:
@@ -358,7 +421,7 @@ _UNI_SLOPE = np.diff(_UNI_TABLE, append=_UNI_TABLE[-1])
 def _ratio(u: np.ndarray) -> np.ndarray:
     """Tabulated :func:`spread_rate_ratio` for the per-tick hot path."""
     if u.size <= 256:
-        return np.interp(u, _U_GRID, _RATIO_TABLE)
+        return _interp(u, _U_GRID, _RATIO_TABLE, None, None)
     pos = (u - _U_LO) * (1.0 / _U_STEP)
     np.clip(pos, 0.0, _U_N - 1.0, out=pos)
     i = pos.astype(np.int64)
@@ -367,3 +430,8 @@ def _ratio(u: np.ndarray) -> np.ndarray:
 
 _ONE = np.uint32(1)
 _ONE32 = np.int32(1)
+_NEVER = 2**62
+_ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
+_SD = np.array([[WIND_SPEED_SD], [WIND_DIR_SD_RAD]])  # (2, 1) draw scales: wind speed, direction
+_UNBURNT8, _BURNING8, _PRUNED8 = np.uint8(UNBURNT), np.uint8(BURNING), np.uint8(PRUNED)
+_SMALL = 32  # up to this many fresh cells, _ignite works on Python ints

@@ -297,14 +297,68 @@ def _rect_distance(points: np.ndarray, rects: np.ndarray) -> np.ndarray:
 
 def default_tile(team) -> tuple[float, float]:
     """90 % of the smallest dump field of view among action/hybrid agents."""
+    return _default_tile(team.can_act.tobytes(), team.role.tobytes(), team.alt_lo.tobytes())
+
+
+@lru_cache(maxsize=64)
+def _default_tile(can_act: bytes, role: bytes, alt_lo: bytes) -> tuple[float, float]:
     from fcplan.team import ACTION_ALTITUDE
 
-    acting = np.flatnonzero(team.can_act)
+    acting = np.flatnonzero(np.frombuffer(can_act, dtype=bool))
     if acting.size == 0:
         return (54.0, 31.0)
-    z = np.where(team.role[acting] == 1, ACTION_ALTITUDE, team.alt_lo[acting])
+    role_a = np.frombuffer(role, dtype=np.int8)[acting]
+    z = np.where(role_a == 1, ACTION_ALTITUDE, np.frombuffer(alt_lo, dtype=np.float64)[acting])
     hx, hy = fov_half_extent(z.min())
     return (float(np.floor(1.8 * hx)), float(np.floor(1.8 * hy)))
+
+
+@dataclass(frozen=True, eq=False)
+class _ScenarioConsts:
+    """What a task graph needs from a scenario that never changes during an episode."""
+
+    fac_pos: np.ndarray
+    fac_rect: np.ndarray
+    fac_pen: np.ndarray
+    fac_kinds: tuple[str, ...]
+    depot_pos: np.ndarray
+    max_fuel: float
+
+
+_CONSTS: dict[int, tuple[object, _ScenarioConsts]] = {}
+
+
+def _scenario_consts(scenario) -> _ScenarioConsts:
+    """Per-scenario constants, cached by identity (scenarios are immutable)."""
+    hit = _CONSTS.get(id(scenario))
+    if hit is not None and hit[0] is scenario:
+        return hit[1]
+    facilities = scenario.scored_facilities
+    consts = _ScenarioConsts(
+        fac_pos=np.array([f.center for f in facilities], dtype=np.float64).reshape(-1, 2),
+        fac_rect=np.array([f.footprint for f in facilities], dtype=np.float64).reshape(-1, 4),
+        fac_pen=np.array([f.penalty for f in facilities], dtype=np.float64),
+        fac_kinds=tuple(f.kind for f in facilities),
+        depot_pos=np.asarray(scenario.depot.center, dtype=np.float64),
+        max_fuel=max((r.fuel for r in scenario.regions), default=1.0),
+    )
+    if len(_CONSTS) >= 32:
+        _CONSTS.pop(next(iter(_CONSTS)))
+    _CONSTS[id(scenario)] = (scenario, consts)
+    return consts
+
+
+@lru_cache(maxsize=16)
+def _search_grid(w: int, blk: int) -> np.ndarray:
+    """(nb * nb, 2) centres of the search blocks (x-major), clipped to the map (read-only)."""
+    nb = -(-w // blk)
+    bx, by = np.meshgrid(np.arange(nb), np.arange(nb), indexing="ij")
+    bx, by = bx.ravel(), by.ravel()
+    pos = np.stack(
+        [np.minimum((bx + 0.5) * blk, w - 1.0), np.minimum((by + 0.5) * blk, w - 1.0)], axis=1
+    )
+    pos.flags.writeable = False
+    return pos
 
 
 def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = None) -> TaskGraph:
@@ -326,20 +380,18 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     tile = p.tile_px or default_tile(team)
     tw, th = float(tile[0]), float(tile[1])
 
-    facilities = scenario.scored_facilities
-    fac_pos = np.array([f.center for f in facilities], dtype=np.float64).reshape(-1, 2)
-    fac_rect = np.array([f.footprint for f in facilities], dtype=np.float64).reshape(-1, 4)
-    fac_pen = np.array([f.penalty for f in facilities], dtype=np.float64)
+    consts = _scenario_consts(scenario)
+    fac_pos, fac_rect, fac_pen = (
+        consts.fac_pos.copy(),
+        consts.fac_rect.copy(),
+        consts.fac_pen.copy(),
+    )
 
     # ---- search blocks
     blk = int(p.search_block_px)
     nb = -(-w // blk)
     age = belief.coverage_age_s(blk)  # (nb, nb) indexed [bx, by]
-    bx, by = np.meshgrid(np.arange(nb), np.arange(nb), indexing="ij")
-    bx, by = bx.ravel(), by.ravel()
-    search_pos = np.stack(
-        [np.minimum((bx + 0.5) * blk, w - 1.0), np.minimum((by + 0.5) * blk, w - 1.0)], axis=1
-    )
+    search_pos = _search_grid(w, blk)
     search_age = age.ravel()
 
     # ---- fire tiles from known cells
@@ -351,7 +403,10 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         key = tx * (int(np.ceil(w / th)) + 1) + ty
         order = np.argsort(key, kind="stable")
         ks = key[order]
-        starts = np.flatnonzero(np.r_[True, ks[1:] != ks[:-1]])
+        first = np.empty(len(ks), dtype=bool)
+        first[:1] = True
+        np.not_equal(ks[1:], ks[:-1], out=first[1:])
+        starts = first.nonzero()[0]
         xs, ys = xy[order, 0].astype(np.float64), xy[order, 1].astype(np.float64)
         seen = belief.last_seen[xy[order, 0], xy[order, 1]]
         x0 = np.minimum.reduceat(xs, starts)
@@ -359,8 +414,10 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         y0 = np.minimum.reduceat(ys, starts)
         y1 = np.maximum.reduceat(ys, starts)
         last = np.maximum.reduceat(seen, starts)
-        counts = np.diff(np.r_[starts, len(ks)])
-        fire_pos = np.stack([(x0 + x1) / 2.0, (y0 + y1) / 2.0], axis=1)
+        counts = np.empty_like(starts)  # tile sizes: gaps between starts
+        np.subtract(starts[1:], starts[:-1], out=counts[:-1])
+        counts[-1] = len(ks) - starts[-1]
+        fire_pos = _columns((x0 + x1) / 2.0, (y0 + y1) / 2.0)
         fire_stale = (tick - last) / tps
         tile_x, tile_y = tx[order][starts], ty[order][starts]
         cluster = _clusters(tile_x, tile_y, ntx, int(np.ceil(w / th)) + 1)
@@ -374,9 +431,9 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     # threat: penalty-weighted closeness of each fire tile to each facility footprint
     if n_fire and len(fac_pos):
         d_fac = _rect_distance(fire_pos, fac_rect)
-        close = np.clip(1.0 - d_fac / p.threat_radius_px, 0.0, 1.0)
+        close = np.minimum(np.maximum(1.0 - d_fac / p.threat_radius_px, 0.0), 1.0)
         threat = close @ fac_pen
-        fuel = max((r.fuel for r in scenario.regions), default=1.0)
+        fuel = consts.max_fuel
         speed = max(0.24 * fuel * 10.0, 1e-9)  # px/s, first-tick spread at wind 5 (fastest)
         threat_time = np.where(d_fac < p.threat_radius_px, d_fac / speed, np.inf)
     else:
@@ -392,12 +449,11 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         ).astype(np.int64)
         near = np.bincount(fb, weights=counts, minlength=nb * nb).reshape(nb, nb)
         # spread to the 8 neighbours: fire grows across block borders
-        padded = np.pad(near, 1)
-        near_fire = sum(
-            padded[1 + dx : 1 + dx + nb, 1 + dy : 1 + dy + nb]
-            for dx in (-1, 0, 1)
-            for dy in (-1, 0, 1)
-        ).ravel()
+        padded = np.zeros((nb + 2, nb + 2))
+        padded[1:-1, 1:-1] = near
+        # 3 x 3 box sum, separably (sums of whole cell counts: exact in any order)
+        rows = padded[:-2] + padded[1:-1] + padded[2:]
+        near_fire = (rows[:, :-2] + rows[:, 1:-1] + rows[:, 2:]).ravel()
         fire_block = n_fire + fb
     else:
         fire_block = np.zeros(0, dtype=np.int64)
@@ -414,20 +470,22 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))
 
     k_total = n_fire + len(search_pos)
-    task_kind = np.r_[np.full(n_fire, TaskKind.FIRE), np.full(len(search_pos), TaskKind.SEARCH)]
-    zeros_s = np.zeros(len(search_pos))
+    n_search = len(search_pos)
+    task_kind = np.full(k_total, int(TaskKind.SEARCH), dtype=np.int8)
+    task_kind[:n_fire] = int(TaskKind.FIRE)
+    minus_s = np.full(n_search, -1, dtype=np.int64)
 
     range_px = team.range_px()
-    return TaskGraph(
+    return _task_graph(
         tick=tick,
         time_s=tick / tps,
         world_size=w,
-        depot_pos=np.asarray(scenario.depot.center, dtype=np.float64),
+        depot_pos=consts.depot_pos.copy(),
         agent_ids=team.ids,
         agent_role=team.role.copy(),
         agent_pos=team.pos.copy(),
         agent_z=team.z.copy(),
-        agent_alt_range=np.stack([team.alt_lo, team.alt_hi], axis=1),
+        agent_alt_range=_columns(team.alt_lo, team.alt_hi),
         agent_speed=team.speed * tps,
         agent_range=range_px,
         agent_full_range=team.battery_capacity / DRAIN_PER_PX,
@@ -439,15 +497,15 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         agent_can_sense=team.can_sense.copy(),
         agent_can_act=team.can_act.copy(),
         task_ids=fire_ids + search_ids,
-        task_kind=task_kind.astype(np.int8),
+        task_kind=task_kind,
         task_pos=np.concatenate([fire_pos, search_pos]).reshape(k_total, 2),
-        task_value=np.r_[counts * (1.0 + threat), search_value],
-        task_cells=np.r_[counts, np.zeros(len(search_pos), dtype=np.int64)].astype(np.int64),
-        task_staleness=np.r_[fire_stale, search_age],
-        task_threat=np.r_[threat, zeros_s],
-        task_cluster=np.r_[cluster, np.full(len(search_pos), -1)].astype(np.int64),
-        task_block=np.r_[fire_block, np.full(len(search_pos), -1)].astype(np.int64),
-        facility_kinds=tuple(f.kind for f in facilities),
+        task_value=np.concatenate([counts * (1.0 + threat), search_value]),
+        task_cells=_cat_int(counts, np.zeros(n_search, dtype=np.int64)),
+        task_staleness=np.concatenate([fire_stale, search_age]),
+        task_threat=np.concatenate([threat, np.zeros(n_search)]),
+        task_cluster=_cat_int(cluster, minus_s),
+        task_block=_cat_int(fire_block, minus_s),
+        facility_kinds=consts.fac_kinds,
         facility_pos=fac_pos,
         facility_rect=fac_rect,
         facility_penalty=fac_pen,
@@ -456,6 +514,27 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         known_cells=int(counts.sum()),
         comm_range=scenario.comm_range,
     )
+
+
+def _columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.stack([a, b], axis=1)`` for two 1-D arrays of the same dtype, cheaper."""
+    out = np.empty((len(a), 2), dtype=a.dtype)
+    out[:, 0] = a
+    out[:, 1] = b
+    return out
+
+
+def _task_graph(**fields) -> TaskGraph:
+    """``TaskGraph(**fields)`` given every field, without the frozen dataclass's per-field
+    ``object.__setattr__`` calls (a graph is built every replan)."""
+    graph = object.__new__(TaskGraph)
+    graph.__dict__.update(fields)
+    return graph
+
+
+def _cat_int(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Concatenation as int64 (as ``np.r_[a, b].astype(np.int64)``)."""
+    return np.concatenate([a, b]).astype(np.int64)
 
 
 @lru_cache(maxsize=16)
@@ -467,13 +546,18 @@ def _search_ids(nb: int, blk: int) -> tuple[str, ...]:
     return tuple(f"search:{a}:{b}" for a in range(nb) for b in range(nb))
 
 
+_EIGHT = np.ones((3, 3), dtype=bool)  # 8-connectivity
+
+
 def _clusters(tx: np.ndarray, ty: np.ndarray, nx_: int, ny_: int) -> np.ndarray:
     """Connected-fire labels of occupied tiles (8-connectivity)."""
+    if len(tx) == 1:
+        return np.zeros(1, dtype=np.int64)
     from scipy.ndimage import label
 
     grid = np.zeros((nx_ + 1, ny_ + 1), dtype=bool)
     grid[tx, ty] = True
-    labels, _ = label(grid, structure=np.ones((3, 3), dtype=bool))
+    labels, _ = label(grid, structure=_EIGHT)
     return labels[tx, ty].astype(np.int64) - 1
 
 

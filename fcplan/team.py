@@ -176,6 +176,12 @@ class Team:
         self.prune_confidence = np.array([a.prune_confidence for a in agents], dtype=np.float64)
         span = self.alt_hi - self.alt_lo
         self._inv_span = np.where(span > 0, 1.0 / np.where(span > 0, span, 1.0), 0.0)
+        # per-tick constants (same expressions, same rounding, as the rules they come from)
+        self._hover_drain = DRAIN_PER_HOVER_TICK * self.tick_scale
+        self._hover_margin = 2.0 * DRAIN_PER_HOVER_TICK * self.tick_scale
+        self._speed_margin = 2.0 * DRAIN_PER_PX * self.speed  # (speed is fixed per team)
+        self._climb = CLIMB_PER_TICK * self.tick_scale
+        self._is_action = self.role == _ROLE_ACTION
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -219,18 +225,24 @@ class Team:
 
     def fov_rects(self) -> np.ndarray:
         """(N, 4) float64 ``[x0, x1, y0, y1]`` inclusive field-of-view bounds of every agent."""
-        hx, hy = fov_half_extent(self.z)
-        x, y = self.pos[:, 0], self.pos[:, 1]
-        return np.stack([x - hx, x + hx, y - hy, y + hy], axis=1)
+        # [x, x, y, y] + z [-tan_x, tan_x, -tan_y, tan_y]: z (-t) is exactly -(t z), and
+        # x + (-h) is exactly x - h, so this equals [x - hx, x + hx, y - hy, y + hy]
+        return self.pos.repeat(2, axis=1) + self.z[:, None] * _FOV_SCALE
 
     def sensing_confidence(self) -> np.ndarray:
         """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""
         c = 1.0 - 0.6 * (self.z - self.alt_lo) * self._inv_span
         return np.minimum(np.maximum(c, 0.4), 1.0) * self.can_sense
 
+    def _sensing_confidence_of(self, i: int) -> float:
+        """:meth:`sensing_confidence` of row ``i`` (same IEEE operations, on Python floats)."""
+        c = 1.0 - 0.6 * (float(self.z[i]) - float(self.alt_lo[i])) * float(self._inv_span[i])
+        return min(max(c, 0.4), 1.0) * bool(self.can_sense[i])
+
     def return_cost(self) -> np.ndarray:
         """(N,) battery needed to fly straight home from where each agent is."""
-        return DRAIN_PER_PX * np.hypot(*(self.home - self.pos).T)
+        d = self.home - self.pos
+        return DRAIN_PER_PX * np.hypot(d[:, 0], d[:, 1])
 
     # ------------------------------------------------------------------ commands
     def apply(self, commands: Mapping[str | int, Command] | None) -> None:
@@ -241,10 +253,12 @@ class Team:
         for key, cmd in commands.items():
             i = self.index(key)
             if cmd.altitude is not None and self.can_sense[i]:
-                self.z_target[i] = float(np.clip(cmd.altitude, self.alt_lo[i], self.alt_hi[i]))
+                # np.clip on one value: min(max(a, lo), hi), NaN propagating
+                self.z_target[i] = float(min(max(cmd.altitude, self.alt_lo[i]), self.alt_hi[i]))
+            mode = int(self.mode[i])
             if cmd.home:
-                if self.mode[i] != Mode.IDLE or not self.at_home[i]:
-                    self.mode[i] = Mode.HOMING
+                if mode != _IDLE or not self._at_home(i):
+                    self.mode[i] = _HOMING
                 self.routes[i] = np.zeros((0, 2))
                 self.goal_index[i] = 0
                 self.patrol[i] = False
@@ -259,52 +273,86 @@ class Team:
             self.goal_index[i] = 0
             self.patrol[i] = bool(cmd.patrol) and len(route) > 1
             self.hover_s[i] = 0.0
-            if self.mode[i] == Mode.RETURNING:
+            if mode == _RETURNING:
                 continue
             if len(route) == 0:
                 self.has_goal[i] = False
-                if self.mode[i] == Mode.HOMING:
+                if mode == _HOMING:
                     continue
-                self.mode[i] = Mode.ACTIVE if not self.at_home[i] else Mode.IDLE
+                self.mode[i] = _ACTIVE if not self._at_home(i) else _IDLE
                 continue
-            self.mode[i] = Mode.ACTIVE
+            self.mode[i] = _ACTIVE
             self.has_goal[i] = True
             self.goal[i] = route[0]
+
+    def _at_home(self, i: int) -> bool:
+        """Row ``i`` of :attr:`at_home`."""
+        p, h = self.pos[i], self.home[i]
+        return bool(p[0] == h[0] and p[1] == h[1])
 
     # ------------------------------------------------------------------ dynamics
     def move(self) -> np.ndarray:
         """Move every agent one tick; return the rows that arrived at a route goal this tick."""
+        # (np.count_nonzero is the cheapest "any" on these tiny arrays)
         mode = self.mode
-        active = mode == _ACTIVE
-        going_home = (mode == _RETURNING) | (mode == _HOMING)
-        target = np.where(going_home[:, None], self.home, self.goal)
+        active = mode == _ACTIVE8
+        going_home = mode >= _RETURNING8  # RETURNING or HOMING
         flying = going_home | (active & self.has_goal)
-        d = target - self.pos
-        dist = np.hypot(d[:, 0], d[:, 1])
-        arrive = flying & (dist <= self.speed)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            unit = np.where(dist[:, None] > 0, d / dist[:, None], 0.0)
-        step = np.where(arrive, dist, np.where(flying, self.speed, 0.0))
-        self.pos = np.where(arrive[:, None], target, self.pos + unit * step[:, None])
-        self.distance += step
-        hovering = active & ~flying
-        self.battery -= DRAIN_PER_PX * step + DRAIN_PER_HOVER_TICK * self.tick_scale * hovering
-        self.hover_s = np.where(hovering, self.hover_s + self.dt_s, 0.0)
+        # (a zero coordinate also takes the full path, which turns -0.0 into +0.0 exactly as
+        # moving by a zero step does)
+        if np.count_nonzero(flying) or np.count_nonzero(self.pos == _ZERO):
+            arrive = self._fly(flying, going_home, active)
+        else:  # nobody flies: positions stay, hovering agents drain and their hover clocks run
+            arrive = None
+            if np.count_nonzero(active):
+                self.battery -= self._hover_drain * active
+                self.hover_s = np.where(active, self.hover_s + self.dt_s, 0.0)
+            else:
+                self.hover_s = np.zeros(self.n)
         # altitude
-        climb = CLIMB_PER_TICK * self.tick_scale
-        dz = np.minimum(np.maximum(self.z_target - self.z, -climb), climb)
-        self.z += dz * self.can_sense
+        z, zt = self.z, self.z_target
+        if np.count_nonzero(zt != z):
+            dz = np.minimum(np.maximum(zt - z, -self._climb), self._climb)
+            self.z += dz * self.can_sense
 
-        if arrive.any():
-            for i in np.flatnonzero(arrive & going_home):
-                self._dock(int(i))
-            arrived_goal = np.flatnonzero(arrive & active)
-            for i in arrived_goal:
-                self._next_goal(int(i))
+        if arrive is not None and np.count_nonzero(arrive):
+            for i in (arrive & going_home).nonzero()[0].tolist():
+                self._dock(i)
+            arrived_goal = (arrive & active).nonzero()[0]
+            for i in arrived_goal.tolist():
+                self._next_goal(i)
+            self._rules()  # docking changed modes
         else:
             arrived_goal = _NO_ROWS
-        self._rules()
+            self._rules(active)
         return arrived_goal
+
+    def _fly(self, flying: np.ndarray, going_home: np.ndarray, active: np.ndarray) -> np.ndarray:
+        """One step toward each flying agent's target; return the (N,) bool rows that arrived."""
+        if np.count_nonzero(going_home):
+            target = np.where(going_home[:, None], self.home, self.goal)
+        else:
+            target = self.goal  # only read below
+        pos = self.pos
+        d = target - pos
+        dist = np.hypot(d[:, 0], d[:, 1])
+        speed = self.speed
+        arrive = flying & (dist <= speed)
+        # dist == 0 implies d == 0, and any positive double is >= the smallest one, so this is
+        # d / dist, or the zero direction where dist == 0
+        unit = d / np.maximum(dist, _TINY)[:, None]
+        step = np.where(arrive, dist, speed * flying)
+        moved = pos + unit * step[:, None]
+        self.pos = np.where(arrive[:, None], target, moved) if np.count_nonzero(arrive) else moved
+        self.distance += step
+        hovering = np.greater(active, flying)  # active & ~flying, in one call
+        if np.count_nonzero(hovering):
+            self.battery -= DRAIN_PER_PX * step + self._hover_drain * hovering
+            self.hover_s = np.where(hovering, self.hover_s + self.dt_s, 0.0)
+        else:  # x + 0.0 == x: the hover term adds nothing
+            self.battery -= DRAIN_PER_PX * step
+            self.hover_s = np.zeros(self.n)
+        return arrive
 
     def _next_goal(self, i: int) -> None:
         if self.can_act[i] and self.tank[i] > 0:
@@ -342,27 +390,25 @@ class Team:
             self.patrol[i] = False
         self.armed[i] = False
 
-    def _rules(self) -> None:
-        """Battery reserve, and the 3-second rule for action agents."""
-        active = self.mode == _ACTIVE
-        if not active.any():
+    def _rules(self, active: np.ndarray | None = None) -> None:
+        """Battery reserve, and the 3-second rule for action agents (``active``: the rows in
+        ACTIVE mode, if the caller has them)."""
+        if active is None:
+            active = self.mode == _ACTIVE8
+        if not np.count_nonzero(active):
             return
         # Reserve: after one more step (which can also lengthen the way home by one step) the
         # agent must still afford the flight home, plus one hover tick of margin.
-        reserve = (
-            self.return_cost()
-            + 2.0 * DRAIN_PER_PX * self.speed
-            + 2.0 * DRAIN_PER_HOVER_TICK * self.tick_scale
-        )
+        reserve = self.return_cost() + self._speed_margin + self._hover_margin
         low = active & (self.battery <= reserve)
-        if low.any():
+        if np.count_nonzero(low):
             self.mode[low] = _RETURNING
-        idle_action = (
-            (self.mode == _ACTIVE)
-            & (self.role == _ROLE_ACTION)
-            & (self.hover_s >= ACTION_IDLE_LIMIT_S - 1e-9)
-        )
-        if idle_action.any():
+            active = self.mode == _ACTIVE8
+        long_hover = self.hover_s >= _IDLE_LIMIT
+        if not np.count_nonzero(long_hover):  # (the usual case)
+            return
+        idle_action = active & self._is_action & long_hover
+        if np.count_nonzero(idle_action):
             self.mode[idle_action] = _HOMING
             self.has_goal[idle_action] = False
 
@@ -377,7 +423,13 @@ class Team:
     def range_px(self) -> np.ndarray:
         """(N,) px each agent can still fly away from home and back (battery / drain, minus the
         current way home)."""
-        return np.maximum(self.battery / DRAIN_PER_PX - np.hypot(*(self.home - self.pos).T), 0.0)
+        d = self.home - self.pos
+        return np.maximum(self.battery / DRAIN_PER_PX - np.hypot(d[:, 0], d[:, 1]), 0.0)
 
 
 _NO_ROWS = np.zeros(0, dtype=np.int64)
+_ACTIVE8, _RETURNING8 = np.int8(_ACTIVE), np.int8(_RETURNING)
+_IDLE_LIMIT = np.float64(ACTION_IDLE_LIMIT_S - 1e-9)
+_ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
+_TINY = np.float64(5e-324)  # smallest positive double
+_FOV_SCALE = np.array([-FOV_TAN_X, FOV_TAN_X, -FOV_TAN_Y, FOV_TAN_Y])

@@ -39,13 +39,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fcplan.fire import BURNING, Fire
+from fcplan.fire import _BURNING8, BLOCK, Fire, _unique
 from fcplan.team import Command, Team
 from fcplan.trace import AgentTrace, Trace
 
 __all__ = ["World", "StepInfo"]
 
 _EMPTY = np.zeros(0, dtype=np.int64)
+_EMPTY16 = np.zeros(0, dtype=np.int16)
+_ZERO16 = np.int16(0)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -63,8 +65,9 @@ class StepInfo:
     arrived: tuple[int, ...]  # rows of agents that reached a route goal
 
 
-def _rect_slices(rect: np.ndarray, w: int) -> tuple[int, int, int, int] | None:
-    """Integer cell range covered by an inclusive rectangle, clipped to the map, or None."""
+def _cell_range(rect: list[float], w: int) -> tuple[int, int, int, int] | None:
+    """Cell range ``(x0, x1, y0, y1)`` (end-exclusive) covered by an inclusive rectangle
+    ``[x0, x1, y0, y1]`` of Python floats, clipped to the map, or None."""
     x0 = max(math.ceil(rect[0]), 0)
     x1 = min(math.floor(rect[1]), w - 1)
     y0 = max(math.ceil(rect[2]), 0)
@@ -72,6 +75,29 @@ def _rect_slices(rect: np.ndarray, w: int) -> tuple[int, int, int, int] | None:
     if x1 < x0 or y1 < y0:
         return None
     return x0, x1 + 1, y0, y1 + 1
+
+
+def _burning_box(
+    blocks: np.ndarray, x0: int, x1: int, y0: int, y1: int
+) -> tuple[int, int, int, int] | None:
+    """The part of the cell range ``[x0, x1) x [y0, y1)`` that can hold burning cells (the
+    bounding box of its ``BLOCK``-sized blocks that hold one), or None if none does.
+
+    Every burning cell of the range lies in the box, so scanning the box row-major finds the same
+    cells in the same order as scanning the whole range.
+    """
+    i0, j0 = x0 // BLOCK, y0 // BLOCK
+    b = blocks[i0 : (x1 - 1) // BLOCK + 1, j0 : (y1 - 1) // BLOCK + 1]
+    if not np.count_nonzero(b):
+        return None
+    bi, bj = np.nonzero(b)
+    bj = bj.tolist()
+    return (
+        max(x0, (i0 + int(bi[0])) * BLOCK),
+        min(x1, (i0 + int(bi[-1]) + 1) * BLOCK),
+        max(y0, (j0 + min(bj)) * BLOCK),
+        min(y1, (j0 + max(bj) + 1) * BLOCK),
+    )
 
 
 class World:
@@ -115,6 +141,8 @@ class World:
         self.world_size = w
         self.fire = Fire(scenario.regions, w, scenario.ticks_per_second, rng_fire)
         self.team = Team(scenario)
+        self._tps = scenario.ticks_per_second
+        self._sensing_rows = np.flatnonzero(self.team.can_sense).tolist()
         self.sensed = np.zeros((w, w), dtype=bool)
         self._sensed_flat = self.sensed.reshape(-1)
         facilities = scenario.scored_facilities
@@ -229,47 +257,51 @@ class World:
         self._record()
         return StepInfo(
             tick=self.tick,
-            time_s=self.time_s,
+            time_s=self.tick / self._tps,
             ignited=ignited,
             sensed=sensed,
             newly_sensed=newly,
             pruned=pruned,
             fov=fov,
             dumped=tuple(dumped),
-            arrived=tuple(int(i) for i in arrived),
+            arrived=tuple(arrived.tolist()),
         )
 
     def _count_facilities(self, flat: np.ndarray, sign: int) -> np.ndarray:
         lab = self._labels_flat[flat]
-        lab = lab[lab >= 0]
-        if lab.size == 0:
-            return lab
+        inside = lab >= _ZERO16
+        if not np.count_nonzero(inside):  # (the usual case: no facility there)
+            return _EMPTY16
+        lab = lab[inside]
         counts = np.bincount(lab, minlength=self.n_facilities)
         self.facility_burning += sign * counts
         return counts
 
     def _sense(self, fov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        team, w = self.team, self.world_size
-        conf = team.sensing_confidence()
         fire = self.fire
-        state = fire.state
+        if fire.n_burning == 0:  # nothing to sense (and no random draws, as in the loop below)
+            return _EMPTY, _EMPTY
+        team, w = self.team, self.world_size
+        state, blocks = fire.state, fire.block_burning
+        rects = fov.tolist()
         parts = []
-        for i in np.flatnonzero(team.can_sense):
-            sl = _rect_slices(fov[i], w)
+        for i in self._sensing_rows:
+            sl = _cell_range(rects[i], w)
             if sl is None:
                 continue
-            x0, x1, y0, y1 = sl
-            if not fire.any_burning_in(x0, x1, y0, y1):
+            box = _burning_box(blocks, *sl)
+            if box is None:
                 continue
-            bx, by = np.nonzero(state[x0:x1, y0:y1] == BURNING)
+            x0, x1, y0, y1 = box
+            bx, by = np.nonzero(state[x0:x1, y0:y1] == _BURNING8)
             if bx.size == 0:
                 continue
-            keep = self.rng_sense.random(bx.size) < conf[i]
-            if keep.any():
-                parts.append((bx[keep] + x0) * w + (by[keep] + y0))
+            keep = self.rng_sense.random(bx.size) < team._sensing_confidence_of(i)
+            if np.count_nonzero(keep):
+                parts.append(((bx + x0) * w + (by + y0))[keep])
         if not parts:
             return _EMPTY, _EMPTY
-        sensed = parts[0] if len(parts) == 1 else np.unique(np.concatenate(parts))
+        sensed = parts[0] if len(parts) == 1 else _unique(np.concatenate(parts))
         newly = sensed[~self._sensed_flat[sensed]]
         if newly.size:
             self._sensed_flat[newly] = True
@@ -279,20 +311,24 @@ class World:
 
     def _prune(self, fov: np.ndarray) -> tuple[np.ndarray, list[int]]:
         team, w = self.team, self.world_size
+        if not np.count_nonzero(team.armed):
+            return _EMPTY, []
         armed = np.flatnonzero(team.armed & team.can_act & (team.tank > 0))
         if armed.size == 0:
             return _EMPTY, []
         reference_gate = self.scenario.action_gate == "reference"
-        state, sensed = self.fire.state, self.sensed
+        state, sensed, blocks = self.fire.state, self.sensed, self.fire.block_burning
+        rects = fov.tolist()
         parts, dumped = [], []
-        for i in armed:
-            sl = _rect_slices(fov[i], w)
+        for i in armed.tolist():
+            sl = _cell_range(rects[i], w)
             if sl is None:
                 continue
-            x0, x1, y0, y1 = sl
-            if not self.fire.any_burning_in(x0, x1, y0, y1):
+            box = _burning_box(blocks, *sl)
+            if box is None:
                 continue
-            burning = state[x0:x1, y0:y1] == BURNING
+            x0, x1, y0, y1 = box
+            burning = state[x0:x1, y0:y1] == _BURNING8
             seen = burning & sensed[x0:x1, y0:y1]
             if reference_gate:
                 if not (seen.any() or self.n_sensed_active == 0) or not burning.any():
@@ -312,8 +348,8 @@ class World:
                     self.facility_pruned += counts
                 self.n_sensed_active -= int(self._sensed_flat[hit].sum())
                 parts.append(hit)
-            team.record_dump(int(i))
-            dumped.append(int(i))
+            team.record_dump(i)
+            dumped.append(i)
         if not parts:
             return _EMPTY, dumped
         return (parts[0] if len(parts) == 1 else np.concatenate(parts)), dumped
