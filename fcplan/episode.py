@@ -111,6 +111,7 @@ def run_episode(
     time_limit: float | None = None,
     graph_params: TaskGraphParams | None = None,
     event_replans: bool = True,
+    record=None,
 ) -> EpisodeResult:
     """Play one episode of ``scenario`` with ``scheduler``.
 
@@ -129,6 +130,8 @@ def run_episode(
     graph_params : TaskGraphParams, optional
     event_replans : bool
         Also replan at once when fire is sensed outside every current fire task.
+    record : str or os.PathLike, optional
+        Write a complete recording of the episode to this ``.npz`` file (:mod:`fcplan.recording`).
 
     Returns
     -------
@@ -155,6 +158,20 @@ def run_episode(
     commands = None
     next_periodic = 0
     new_fire = False
+    recorder = None
+    if record is not None:
+        from fcplan.recording import Recorder, scheduler_settings
+
+        settings = dict(
+            replan_period=replan_period,
+            time_limit=time_limit,
+            event_replans=event_replans,
+            graph_params=graph_params,
+            scheduler=scheduler_settings(scheduler),
+        )
+        recorder = Recorder(
+            scenario, seed, source=getattr(scheduler, "name", "?"), settings=settings
+        )
     while not world.done:
         if world.tick >= next_periodic or new_fire:
             graph = build_task_graph(scenario, world.team, belief, graph_params)
@@ -168,7 +185,13 @@ def run_episode(
             if world.tick >= next_periodic:
                 next_periodic = world.tick + period
             new_fire = False
+            if recorder is not None:
+                recorder.on_replan(world.tick, plan)
+        if recorder is not None:
+            recorder.on_commands(world.tick, commands)
         info = world.step(commands)
+        if recorder is not None:
+            recorder.on_step(world, info)
         commands = None
         belief.update(info)
         if event_replans and info.newly_sensed.size and tile is not None:
@@ -176,6 +199,8 @@ def run_episode(
             xy = np.stack([info.newly_sensed // w, info.newly_sensed % w], axis=1)
             new_fire = bool((~np.isin(_tile_keys(xy, tile, w), tile_keys)).any())
     trace = world.trace()
+    if recorder is not None:
+        recorder.save(record)
     return EpisodeResult(
         scenario=scenario.name,
         scheduler=getattr(scheduler, "name", type(scheduler).__name__),
