@@ -1,0 +1,161 @@
+"""The pygame front end of ``fcplan play``: window, event loop, clock and screenshots.
+
+:func:`run_app` opens the window, turns pygame events into the abstract events of
+:class:`~fcplan.game.screens.App` (left clicks, key presses with their pygame key names), advances
+the game by the wall time since the last frame (the scenario's ``ticks_per_second`` times the
+``speed`` factor; in fast mode a fixed number of ticks per frame, never waiting), draws with
+:mod:`fcplan.game.view` and, if asked, saves a screenshot of the window once the game reaches a
+given simulated time. Headless use (tests, screenshots on a server) needs
+``SDL_VIDEODRIVER=dummy``.
+
+``script`` feeds recorded-style input dicts (``{"tick": 12, "type": "click", "map": [x, y]}``) to
+the game at their ticks, exactly as if they had been clicked: that is how the README screenshot
+is made (``docs/game_inputs.json``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable, Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+from fcplan.errors import FcplanError
+from fcplan.game.screens import WINDOW, App
+
+__all__ = ["run_app", "GameError", "require_display", "load_script"]
+
+
+class GameError(FcplanError):
+    """The game cannot start (no pygame, no display) or a script file is malformed."""
+
+
+def _import_pygame():
+    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+    try:
+        import pygame
+    except ImportError:
+        raise GameError('the game needs pygame: pip install "fcplan[game]"') from None
+    return pygame
+
+
+def require_display() -> None:
+    """Raise :class:`GameError` when no display is available (and no SDL driver is forced)."""
+    if os.environ.get("SDL_VIDEODRIVER"):
+        return
+    import sys
+
+    if sys.platform.startswith("linux") and not (
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    ):
+        raise GameError(
+            "no display found (DISPLAY is not set); to run headless set SDL_VIDEODRIVER=dummy"
+        )
+
+
+def load_script(path: str | os.PathLike) -> list[dict[str, Any]]:
+    """Read a JSON list of input dicts, each with an integer ``"tick"`` and a ``"type"``."""
+    try:
+        data = json.loads(Path(path).read_text())
+    except OSError as exc:
+        raise GameError(f"{path}: cannot read the input script: {exc.strerror or exc}") from None
+    except json.JSONDecodeError as exc:
+        raise GameError(f"{path}: not valid JSON: {exc.msg} (line {exc.lineno})") from None
+    if not isinstance(data, list):
+        raise GameError(f"{path}: expected a JSON list of input events")
+    for k, ev in enumerate(data):
+        if not (isinstance(ev, dict) and isinstance(ev.get("tick"), int) and "type" in ev):
+            raise GameError(f"{path}: event [{k}] needs an integer 'tick' and a 'type'")
+    return data
+
+
+def _translate(pygame, ev) -> dict[str, Any] | None:
+    if ev.type == pygame.QUIT:
+        return {"type": "quit"}
+    if ev.type == pygame.MOUSEBUTTONDOWN and getattr(ev, "button", 1) == 1:
+        return {"type": "click", "pos": tuple(ev.pos)}
+    if ev.type == pygame.MOUSEMOTION:
+        return {"type": "move", "pos": tuple(ev.pos)}
+    if ev.type == pygame.KEYDOWN:
+        name = pygame.key.name(ev.key)
+        if len(name) == 3 and name[0] == "[" and name[1].isdigit():  # keypad digits
+            name = name[1]
+        return {"type": "key", "key": name, "char": getattr(ev, "unicode", "")}
+    return None
+
+
+def run_app(
+    app: App,
+    *,
+    fps: int = 30,
+    script: Iterable[Mapping[str, Any]] = (),
+    screenshot: str | os.PathLike | None = None,
+    screenshot_at_s: float | None = None,
+    quit_after_screenshot: bool = False,
+    on_frame: Callable[[App], None] | None = None,
+) -> App:
+    """Run the game window until the player quits (or the app stops itself); return the app.
+
+    Parameters
+    ----------
+    app : App
+        The state machine to show (e.g. ``App(scenario, seed=0)`` to start in a game).
+    fps : int
+        Frame-rate cap when playing in real time (the game's pace comes from the clock, not fps).
+    script : iterable of dict
+        Input dicts with a ``"tick"``, fed to the game when it reaches that tick.
+    screenshot : path, optional
+        Save the window as PNG once the game reaches ``screenshot_at_s`` simulated seconds (or at
+        the first game frame if None).
+    quit_after_screenshot : bool
+        Stop (ending and saving the game) right after the screenshot.
+    on_frame : callable, optional
+        Called with the app after every frame (tests use it to post pygame events).
+    """
+    pygame = _import_pygame()
+    require_display()
+    try:
+        pygame.display.init()
+        pygame.font.init()
+        surf = pygame.display.set_mode(WINDOW)
+    except pygame.error as exc:
+        raise GameError(
+            f"cannot open a window ({exc}); to run headless set SDL_VIDEODRIVER=dummy"
+        ) from None
+    pygame.display.set_caption("fcplan play - FireCommander")
+    from fcplan.game import view
+
+    view.reset_fonts()
+    app.set_script(script)
+    shot_done = screenshot is None
+    clock = pygame.time.Clock()
+    clock.tick()
+    try:
+        while app.running:
+            for ev in pygame.event.get():
+                abstract = _translate(pygame, ev)
+                if abstract is not None:
+                    app.handle(abstract)
+            s = app.session
+            dt = clock.tick(0 if app.fast else fps) / 1000.0
+            app.advance(dt)
+            if not app.running:
+                break
+            view.draw(surf, app)
+            pygame.display.flip()
+            if not shot_done and app.screen == "game" and s is not None:
+                due = screenshot_at_s is None or s.world.time_s >= screenshot_at_s
+                if due:
+                    Path(screenshot).parent.mkdir(parents=True, exist_ok=True)
+                    pygame.image.save(surf, str(screenshot))
+                    shot_done = True
+                    if quit_after_screenshot:
+                        app.quit()
+            if on_frame is not None:
+                on_frame(app)
+    finally:
+        if app.screen == "game" and app.session is not None:
+            app.end_game(show=False)  # Ctrl-C or an error: keep the recording
+        pygame.display.quit()
+    return app
