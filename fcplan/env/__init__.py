@@ -1,0 +1,112 @@
+"""Learner interfaces: PettingZoo environments, a Gymnasium view, scheduler demonstrations.
+
+Two levels of control over the same simulator:
+
+``mode="task"`` (:mod:`fcplan.env.task`)
+    One step is one replan period (1 simulated second by default). Each UAV picks one of its
+    ``k`` most relevant tasks of the current task graph, or no-op. Observations are a ``Dict``
+    of the agent's own state, a ``k x F`` task-feature table and an ``action_mask``.
+``mode="motion"`` (:mod:`fcplan.env.motion`)
+    One step is one tick: moves, altitude, dump, with local field-of-view observations.
+
+Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with a centralised
+joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any
+registered scheduler, stored as npz without pickle) and :mod:`fcplan.env.bc` (a small numpy
+behaviour-cloning baseline). Everything is imported lazily, so ``import fcplan.env`` is cheap
+and does not need PettingZoo until an environment is made.
+
+Examples
+--------
+>>> from fcplan.env import parallel_env
+>>> env = parallel_env("practice", k=4)
+>>> obs, infos = env.reset(seed=0)
+>>> env.agents
+['P1', 'P2', 'A1', 'A2']
+>>> obs["A1"]["tasks"].shape, obs["A1"]["action_mask"].shape
+((4, 17), (5,))
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+from fcplan.errors import FcplanError
+
+__all__ = [
+    "EnvError",
+    "MODES",
+    "parallel_env",
+    "aec_env",
+    "gym_env",
+    "TaskEnv",
+    "TaskGymEnv",
+    "demonstrations",
+    "load_demonstrations",
+    "Demonstrations",
+    "replay_actions",
+]
+
+#: Environment levels accepted by :func:`parallel_env`.
+MODES = ("task", "motion")
+
+
+class EnvError(FcplanError, ValueError):
+    """Bad environment argument or action (the message names the argument/agent and the
+    allowed range)."""
+
+
+_LAZY = {
+    "TaskEnv": "fcplan.env.task",
+    "TaskGymEnv": "fcplan.env.gym_view",
+    "gym_env": "fcplan.env.gym_view",
+    "demonstrations": "fcplan.env.demonstrations",
+    "load_demonstrations": "fcplan.env.demonstrations",
+    "Demonstrations": "fcplan.env.demonstrations",
+    "replay_actions": "fcplan.env.demonstrations",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'fcplan.env' has no attribute {name!r}")
+
+
+def parallel_env(scenario, mode: str = "task", **kwargs: Any):
+    """Make a PettingZoo ``ParallelEnv`` on ``scenario``.
+
+    Parameters
+    ----------
+    scenario : Scenario or str or int
+        A scenario or a name/path for :func:`fcplan.load_scenario`.
+    mode : {"task", "motion"}
+        ``"task"``: :class:`fcplan.env.task.TaskEnv` (one step per replan period);
+        ``"motion"``: :func:`fcplan.env.motion.parallel_env` (one step per tick).
+    **kwargs
+        Passed to the environment (see its module docstring).
+
+    Raises
+    ------
+    EnvError
+        If ``mode`` is not one of :data:`MODES`.
+    """
+    if mode == "task":
+        from fcplan.env.task import TaskEnv
+
+        return TaskEnv(scenario, **kwargs)
+    if mode == "motion":
+        from fcplan.env.motion import parallel_env as motion_env
+
+        return motion_env(scenario, **kwargs)
+    raise EnvError(f"mode: must be one of {', '.join(MODES)} (got {mode!r})")
+
+
+def aec_env(scenario, mode: str = "task", **kwargs: Any):
+    """The same environment as :func:`parallel_env`, as a PettingZoo ``AECEnv``
+    (``pettingzoo.utils.parallel_to_aec``)."""
+    from pettingzoo.utils import parallel_to_aec
+
+    return parallel_to_aec(parallel_env(scenario, mode, **kwargs))

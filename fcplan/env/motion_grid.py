@@ -1,0 +1,238 @@
+"""Coarse maps and egocentric crops for the motion-level environment.
+
+The motion environment observes the 1-px world through **coarse cells** of ``cell_px`` px. The
+maps it crops from are kept per coarse cell and updated *incrementally* from each tick's
+:class:`fcplan.world.StepInfo` (cells ignited, sensed for the first time, pruned; fields of view),
+so a tick never scans the full grid. All agents' crops come from one fancy-indexed gather on a
+``sliding_window_view`` of a padded stack of maps.
+
+Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px) + 2 r``,
+``r = view // 2`` cells of padding):
+
+===  ==============  =====================================================================
+ 0   ``known``       known burning px in the cell (sensed, not yet pruned)
+ 1   ``pruned``      pruned px in the cell
+ 2   ``seen``        minus the tick the cell last overlapped a sensing agent's field of view,
+                     times ``seen_scale`` (``+inf``: never, and outside the map), so that
+                     ``min(1, seen + tick * seen_scale)`` is the cell's staleness
+ 3   ``agents``      agents in the cell (all of them; see :meth:`CoarseMaps.place_agents`)
+ 4   ``outside``     share of the cell outside the map (1 in the padding)
+ 5   ``lake``        share of the cell covered by a lake
+ 6   ``facility``    share of the cell inside a scored facility (incl. the depot),
+                     weighted by its penalty / 5
+ 7   ``burning``     true burning px in the cell (global state only; read it through
+                     :meth:`CoarseMaps.burning_layer`)
+===  ==============  =====================================================================
+
+Examples
+--------
+>>> import numpy as np
+>>> from fcplan import World, load_scenario
+>>> world = World().reset(load_scenario("practice"), seed=0)
+>>> maps = CoarseMaps(world.scenario, cell_px=20, view=5)
+>>> maps.grid.shape
+(8, 64, 64)
+>>> info = world.step()
+>>> maps.update(info, world)
+>>> win = maps.gather(np.array([[0.0, 0.0]]))  # (L, N, view, view) around (0, 0)
+>>> win.shape, float(win[OUTSIDE, 0, 0, 0]), float(win[OUTSIDE, 0, 2, 2])
+((8, 1, 5, 5), 1.0, 0.0)
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+__all__ = [
+    "CoarseMaps",
+    "KNOWN",
+    "PRUNED",
+    "LAST_SEEN",
+    "AGENTS",
+    "OUTSIDE",
+    "LAKE",
+    "FACILITY",
+    "BURNING",
+]
+
+KNOWN, PRUNED, LAST_SEEN, AGENTS, OUTSIDE, LAKE, FACILITY, BURNING = range(8)
+N_LAYERS = 8
+#: changes of up to this many cells are applied one by one (cheaper than np.add.at)
+_SMALL = 16
+#: maps up to this many px use a cached px -> coarse-cell lookup table (4 bytes per px)
+_LUT_MAX_PX = 2048 * 2048
+
+
+@lru_cache(maxsize=4)
+def _lookup(w: int, c: int, r: int, h: int) -> np.ndarray:
+    """(W * W,) int32: flat px index ``x * W + y`` -> flat index of its cell in a padded layer."""
+    cx = np.arange(w, dtype=np.int32) // c + r
+    return ((cx[:, None] * h) + cx[None, :]).reshape(-1)
+
+
+def _block_share(mask: np.ndarray, c: int, nc: int) -> np.ndarray:
+    """(nc, nc) share of each ``c x c`` block of a (W, W) array that is set (cells past the
+    map edge count as unset)."""
+    w = mask.shape[0]
+    pad = np.zeros((nc * c, nc * c), dtype=np.float64)
+    pad[:w, :w] = mask
+    return pad.reshape(nc, c, nc, c).sum(axis=(1, 3)) / float(c * c)
+
+
+class CoarseMaps:
+    """Padded coarse maps of one episode, updated once per tick.
+
+    Parameters
+    ----------
+    scenario : fcplan.scenario.Scenario
+    cell_px : int
+        Side of a coarse cell in px.
+    view : int
+        Side of the square crop in coarse cells (odd).
+    seen_scale : float
+        Staleness per tick (``1 / ticks to become fully stale``).
+    """
+
+    def __init__(self, scenario, cell_px: int, view: int, seen_scale: float = 1.0) -> None:
+        w = scenario.world_size
+        c = int(cell_px)
+        self.world_size, self.cell_px, self.view = w, c, int(view)
+        self.seen_scale = float(seen_scale)
+        self.radius = r = self.view // 2
+        self.nc = nc = -(-w // c)
+        self.grid = np.zeros((N_LAYERS, nc + 2 * r, nc + 2 * r), dtype=np.float32)
+        #: (L, nc, nc) view of the map part of :attr:`grid`
+        self.inner = self.grid[:, r : r + nc, r : r + nc]
+        self._static = self._static_layers(scenario)
+        #: (L, H-view+1, H-view+1, view, view) windows; a crop is ``windows[:, cx, cy]``
+        self.windows = sliding_window_view(self.grid, (self.view, self.view), axis=(1, 2))
+        h = self.grid.shape[1]
+        self._h = h
+        #: per layer, a flat view of the padded grid
+        self.flat = [self.grid[k].reshape(-1) for k in range(N_LAYERS)]
+        self._lut = _lookup(w, c, r, h) if w * w <= _LUT_MAX_PX else None
+        self._agent_cells: list[int] = []
+        self._pending: list[tuple[np.ndarray, float]] = []
+        #: per agent, whether its field of view counts as camera coverage
+        self._sensing = [a.role.can_sense for a in scenario.agents]
+        self.reset()
+
+    def _static_layers(self, scenario) -> np.ndarray:
+        w, c, nc = self.world_size, self.cell_px, self.nc
+        static = np.zeros((3, nc, nc), dtype=np.float32)
+        inside = np.ones((w, w), dtype=bool)
+        static[0] = 1.0 - _block_share(inside, c, nc)
+        xs = np.arange(w, dtype=np.float64)
+        lake = np.zeros((w, w), dtype=bool)
+        for lk in scenario.lakes:
+            for cx, cy, rad in lk.circles:
+                dx = (xs - cx)[:, None] ** 2
+                dy = (xs - cy)[None, :] ** 2
+                lake |= dx + dy <= rad * rad
+        static[1] = _block_share(lake, c, nc)
+        fac = np.zeros((w, w), dtype=np.float64)
+        for f in scenario.scored_facilities:
+            x0, x1, y0, y1 = f.footprint
+            inx = (xs > x0) & (xs < x1)
+            iny = (xs > y0) & (xs < y1)
+            fac = np.maximum(fac, (inx[:, None] & iny[None, :]) * min(f.penalty / 5.0, 1.0))
+        static[2] = _block_share(fac, c, nc)
+        return static
+
+    def reset(self) -> None:
+        """Empty fire layers, never-seen cells, static layers restored."""
+        g = self.grid
+        g[:] = 0.0
+        g[OUTSIDE] = 1.0
+        g[LAST_SEEN] = np.inf
+        self.inner[OUTSIDE : FACILITY + 1] = self._static
+        self._agent_cells: list[int] = []
+        self._pending: list[tuple[np.ndarray, float]] = []
+
+    def padded_index(self, flat: np.ndarray) -> np.ndarray:
+        """Flat px indices ``x * W + y`` -> flat indices into one padded layer of :attr:`grid`."""
+        if self._lut is not None:
+            return self._lut[flat]
+        w, c, r = self.world_size, self.cell_px, self.radius
+        return (flat // w // c + r) * self._h + (flat % w // c + r)
+
+    def _add(self, layer: int, flat: np.ndarray, sign: float) -> None:
+        n = flat.size
+        if n == 0:
+            return
+        idx = self.padded_index(flat)
+        if n > _SMALL:
+            np.add.at(self.flat[layer], idx, sign)
+            return
+        grid = self.flat[layer]  # a few cells: scalar updates beat np.add.at's setup
+        for j in idx.tolist():
+            grid[j] += sign
+
+    def update(self, info, world) -> None:
+        """Fold one tick (:class:`fcplan.world.StepInfo`) of ``world`` into the maps."""
+        if info.ignited.size:  # the burning layer is folded in on demand (burning_layer)
+            self._pending.append((info.ignited, 1.0))
+        self._add(KNOWN, info.newly_sensed, 1.0)
+        pruned = info.pruned
+        if pruned.size:
+            self._pending.append((pruned, -1.0))
+            self._add(PRUNED, pruned, 1.0)
+            seen = pruned[world.sensed.reshape(-1)[pruned]]
+            self._add(KNOWN, seen, -1.0)
+        self.cover(info.fov.tolist(), info.tick, self._sensing)
+        if len(self._pending) > 512:
+            self.burning_layer()
+
+    def burning_layer(self) -> np.ndarray:
+        """(nc, nc) true burning px per coarse cell (a view of :attr:`grid`, brought up to
+        date first: per tick the changes are only queued, as observations do not need them)."""
+        for flat, sign in self._pending:
+            self._add(BURNING, flat, sign)
+        self._pending.clear()
+        return self.inner[BURNING]
+
+    def cover(self, rects: list, tick: int, which: list | None = None) -> None:
+        """Mark the coarse cells overlapping each ``[x0, x1, y0, y1]`` rectangle as seen now
+        (only the rectangles whose flag in ``which`` is true, if given)."""
+        c = self.cell_px
+        seen = self.inner[LAST_SEEN]  # slicing stops at the map's far edges by itself
+        value = -float(self.stamp(tick))
+        for j, (x0, x1, y0, y1) in enumerate(rects):
+            if which is not None and not which[j]:
+                continue
+            if x1 < 0 or y1 < 0:
+                continue
+            seen[
+                max(int(x0 // c), 0) : int(x1 // c) + 1, max(int(y0 // c), 0) : int(y1 // c) + 1
+            ] = value
+
+    def stamp(self, tick: int) -> np.float32:
+        """``tick * seen_scale`` as float32 (add it to the ``seen`` layer to get staleness)."""
+        return np.float32(tick * self.seen_scale)
+
+    def place_agents(self, cx: list, cy: list) -> None:
+        """Put the agents of coarse cells ``(cx[i], cy[i])`` (lists of int) on the ``agents``
+        layer, replacing the previous placement (a loop over agents: a handful of scalar
+        writes beat numpy's fancy indexing here)."""
+        layer = self.flat[AGENTS]
+        for c in self._agent_cells:
+            layer[c] = 0.0
+        h, off = self._h, self.radius * (self._h + 1)
+        cells = [x * h + y + off for x, y in zip(cx, cy, strict=True)]
+        for c in cells:
+            layer[c] += 1.0
+        self._agent_cells = cells
+
+    def cells(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Coarse cell (cx, cy) of each position (clipped to the map)."""
+        idx = (pos // self.cell_px).astype(np.int64)
+        np.clip(idx, 0, self.nc - 1, out=idx)
+        return idx[:, 0], idx[:, 1]
+
+    def gather(self, pos: np.ndarray) -> np.ndarray:
+        """(L, N, view, view) crops centred on the coarse cells of ``pos`` (a fresh array)."""
+        cx, cy = self.cells(pos)
+        return self.windows[:, cx, cy]

@@ -1,0 +1,174 @@
+"""Actions of the task-level environment: to a :class:`fcplan.plan.Plan`, and back from one.
+
+Agent ``i``'s action ``a`` in ``0..k`` means: ``a < k`` fly to the task in candidate slot ``a``;
+``a == k`` is the **no-op**: the plan does not mention the agent, so it *holds its course*
+(keeps flying its current route, keeps hovering, keeps going home; the 3-second rule and the
+battery and tank rules still apply as in any episode).
+
+Conflicts
+    At most one agent **per role** (perception, action, hybrid) may take a task in a step, so a
+    perception agent can watch the fire an action agent is sent to, but two action agents never
+    waste two dumps on one tile. When several agents of one role pick the same task, the one that
+    gets there first (smallest flight time from where its route starts; ties: lower agent row)
+    keeps it and the others get the no-op. The losers are reported (``infos[agent]["conflict"]``).
+
+Illegal actions
+    A masked-out slot (padding) or an out-of-range action is the no-op when
+    ``illegal_action="noop"`` (reported as ``infos[agent]["illegal"]``) and raises
+    :class:`fcplan.env.EnvError` when ``illegal_action="raise"``.
+
+Altitude
+    A perception-only agent sent to a fire watches it at ``watch_altitude`` (low: high sensing
+    confidence), sent to a search block it flies at ``search_altitude`` (a wide view). A hybrid
+    flies at ``watch_altitude`` over fires and ``search_altitude`` over blocks too. Both are
+    clipped to the agent's bounds; action-only agents fly at their fixed altitude.
+
+Plans to actions (:func:`plan_to_actions`, used by the demonstrations)
+    The first task of each agent's route becomes the slot that holds it. A task outside the
+    agent's ``k`` candidates becomes the legal candidate of the same kind (fire/search) nearest to
+    it, or the no-op if the agent has none (counted as ``outside_top_k``). An agent the plan does
+    not mention, with an empty route or sent home, gets the no-op (``home`` counted apart).
+
+Examples
+--------
+>>> import numpy as np
+>>> from fcplan.taskgraph import synthetic_task_graph
+>>> from fcplan.env.task_candidates import rank_candidates
+>>> g = synthetic_task_graph(3, 10, np.random.default_rng(0))
+>>> c = rank_candidates(g, 4)
+>>> noop = np.full(3, 4)
+>>> rows, illegal, conflict = decode_actions(g, c, noop)
+>>> rows.tolist(), int(illegal.sum()), int(conflict.sum())
+([-1, -1, -1], 0, 0)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from fcplan.env.task_candidates import Candidates
+from fcplan.plan import Plan
+from fcplan.taskgraph import TaskGraph, TaskKind
+
+__all__ = ["decode_actions", "actions_plan", "plan_to_actions", "MappingCounts"]
+
+_FIRE = int(TaskKind.FIRE)
+
+
+def decode_actions(
+    graph: TaskGraph, cand: Candidates, actions: np.ndarray, *, illegal: str = "noop"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Chosen task rows per agent after masking and conflict resolution.
+
+    Parameters
+    ----------
+    graph, cand
+        The step's graph and candidates.
+    actions : ndarray, (A,) int
+        One action per agent row (``k`` = no-op).
+    illegal : {"noop", "raise"}
+
+    Returns
+    -------
+    rows : ndarray, (A,) int64
+        Task row per agent, ``-1`` for the no-op.
+    illegal, conflict : ndarray, (A,) bool
+        Agents whose action was illegal / lost a conflict.
+    """
+    n_a, k = cand.rows.shape
+    ar = np.arange(n_a)
+    a = np.asarray(actions, dtype=np.int64).reshape(n_a)
+    ok = (a >= 0) & (a < k)
+    slot = np.where(ok, a, 0)
+    ok &= cand.valid[ar, slot]
+    bad = ~ok & (a != k)
+    if illegal == "raise" and bad.any():
+        from fcplan.env import EnvError
+
+        i = int(np.flatnonzero(bad)[0])
+        legal = np.flatnonzero(np.r_[cand.valid[i], True]).tolist()
+        raise EnvError(
+            f"agent {graph.agent_ids[i]}: action {int(a[i])} is illegal (legal now: {legal}; "
+            f"{k} is the no-op)"
+        )
+    rows = np.where(ok, cand.rows[ar, slot], -1)
+    conflict = np.zeros(n_a, dtype=bool)
+    chosen = np.flatnonzero(ok)
+    if chosen.size > 1:
+        role = graph.agent_role[chosen].astype(np.int64)
+        key = rows[chosen] * 8 + role
+        if np.unique(key).size < key.size:  # rare: resolve by arrival time
+            eta = cand.start_distance[chosen, rows[chosen]] / graph.agent_speed[chosen]
+            order = np.lexsort((chosen, eta, key))
+            ks = key[order]
+            losers = chosen[order][np.r_[False, ks[1:] == ks[:-1]]]
+            rows[losers] = -1
+            conflict[losers] = True
+    return rows, bad, conflict
+
+
+def actions_plan(
+    graph: TaskGraph,
+    rows: np.ndarray,
+    *,
+    watch_altitude: float = 35.0,
+    search_altitude: float = 70.0,
+) -> Plan:
+    """A one-task-per-agent :class:`Plan` from chosen task rows (``-1``: not mentioned)."""
+    routes: dict[str, tuple[str, ...]] = {}
+    alts: dict[str, float] = {}
+    ids, tids = graph.agent_ids, graph.task_ids
+    fire = (graph.task_kind == _FIRE).tolist()
+    lo, hi = graph.agent_alt_range[:, 0].tolist(), graph.agent_alt_range[:, 1].tolist()
+    sense = graph.agent_can_sense.tolist()
+    rows_l = rows.tolist()
+    for i in np.flatnonzero(rows >= 0).tolist():
+        t = rows_l[i]
+        routes[ids[i]] = (tids[t],)
+        if sense[i]:
+            z = watch_altitude if fire[t] else search_altitude
+            alts[ids[i]] = float(min(max(z, lo[i]), hi[i]))
+    return Plan(routes=routes, altitudes=alts)
+
+
+class MappingCounts(dict):
+    """Counts of how a scheduler's plans mapped onto actions: ``exact`` (first task is a
+    candidate), ``outside_top_k`` (replaced by the nearest candidate of its kind or the no-op),
+    ``noop`` (agent not mentioned or empty route), ``home`` (sent home: no-op)."""
+
+    def __init__(self) -> None:
+        super().__init__(exact=0, outside_top_k=0, noop=0, home=0)
+
+
+def plan_to_actions(
+    plan: Plan, graph: TaskGraph, cand: Candidates, counts: MappingCounts | None = None
+) -> np.ndarray:
+    """(A,) int64 env actions for a scheduler's ``plan`` (module docstring: "Plans to actions")."""
+    n_a, k = cand.rows.shape
+    out = np.full(n_a, k, dtype=np.int64)
+    counts = MappingCounts() if counts is None else counts
+    tidx = graph.task_index
+    routes: Mapping[str, tuple[str, ...]] = plan.routes
+    for i, agent in enumerate(graph.agent_ids):
+        route = routes.get(agent)
+        if agent in plan.home:
+            counts["home"] += 1
+            continue
+        if not route:
+            counts["noop"] += 1
+            continue
+        t = tidx[route[0]]
+        hit = np.flatnonzero(cand.rows[i] == t)
+        if hit.size:
+            out[i] = int(hit[0])
+            counts["exact"] += 1
+            continue
+        counts["outside_top_k"] += 1
+        same = cand.valid[i] & (graph.task_kind[np.maximum(cand.rows[i], 0)] == graph.task_kind[t])
+        if same.any():
+            p = graph.task_pos[np.maximum(cand.rows[i], 0)]
+            d = np.hypot(*(p - graph.task_pos[t]).T)
+            out[i] = int(np.argmin(np.where(same, d, np.inf)))
+    return out

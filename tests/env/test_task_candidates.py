@@ -1,0 +1,120 @@
+"""Tests for fcplan.env.task_candidates and task_actions: masks match validate_plan, ranking,
+features, plan <-> action mapping."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fcplan.env.task_actions import MappingCounts, actions_plan, decode_actions, plan_to_actions
+from fcplan.env.task_candidates import (
+    FEATURE_BOUND,
+    TASK_FEATURES,
+    agent_features,
+    legal_tasks,
+    rank_candidates,
+    task_features,
+)
+from fcplan.errors import PlanError
+from fcplan.plan import Plan, validate_plan
+from fcplan.taskgraph import TaskKind, synthetic_task_graph
+from fcplan.team import Mode
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    n_agents=st.integers(2, 7),
+    n_tasks=st.integers(0, 40),
+    k=st.integers(1, 12),
+    seed=st.integers(0, 2**31 - 1),
+    battery=st.floats(60.0, 600.0),
+)
+def test_mask_is_exactly_validate_plan(n_agents, n_tasks, k, seed, battery):
+    """Every legal (agent, task) pair passes validate_plan as a one-task route and every
+    illegal one fails; candidates are legal, distinct, role-appropriate and fill k slots when
+    enough tasks are legal; the no-op is always legal; features are finite and bounded."""
+    rng = np.random.default_rng(seed)
+    g = synthetic_task_graph(n_agents, n_tasks, rng, battery=battery)
+    mode = rng.choice([int(m) for m in Mode], size=n_agents).astype(np.int8)
+    object.__setattr__(g, "agent_mode", mode)
+    legal = legal_tasks(g)
+    for i, a in enumerate(g.agent_ids):
+        for t in range(g.n_tasks):
+            try:
+                validate_plan(Plan(routes={a: (g.task_ids[t],)}), g)
+                ok = True
+            except PlanError:
+                ok = False
+            assert ok == legal[i, t]
+    c = rank_candidates(g, k)
+    mask = c.action_mask()
+    assert mask.shape == (n_agents, k + 1) and (mask[:, -1] == 1).all()
+    for i in range(n_agents):
+        rows = c.rows[i][c.valid[i]]
+        assert (c.rows[i][~c.valid[i]] == -1).all()
+        assert len(set(rows.tolist())) == rows.size
+        assert legal[i, rows].all()
+        assert rows.size == min(k, int(legal[i].sum()))
+        if not g.agent_can_sense[i]:
+            assert (g.task_kind[rows] == TaskKind.FIRE).all()
+        # valid slots come first
+        assert not (np.diff(c.valid[i].astype(int)) > 0).any()
+    f = task_features(g, c, np.full((n_agents, 2), np.nan))
+    s = agent_features(g, c, 0.5)
+    assert f.shape == (n_agents, k, len(TASK_FEATURES)) and f.dtype == np.float32
+    for x in (f, s):
+        assert np.isfinite(x).all() and (np.abs(x) <= FEATURE_BOUND).all()
+    assert (f[~c.valid] == 0).all()
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n_agents=st.integers(2, 6), k=st.integers(1, 8))
+def test_any_masked_choice_is_a_valid_plan(seed, n_agents, k):
+    """Any choice of legal actions gives a plan validate_plan accepts, with at most one agent
+    per (task, role), and mapping that plan back gives the surviving actions."""
+    rng = np.random.default_rng(seed)
+    g = synthetic_task_graph(n_agents, 20, rng)
+    c = rank_candidates(g, k)
+    mask = c.action_mask()
+    act = np.array([rng.choice(np.flatnonzero(m)) for m in mask])
+    rows, illegal, conflict = decode_actions(g, c, act)
+    assert not illegal.any()
+    plan = actions_plan(g, rows)
+    validate_plan(plan, g)
+    chosen = rows >= 0
+    pairs = list(zip(rows[chosen].tolist(), g.agent_role[chosen].tolist(), strict=True))
+    assert len(pairs) == len(set(pairs))
+    counts = MappingCounts()
+    back = plan_to_actions(plan, g, c, counts)
+    assert np.array_equal(back, np.where(conflict, k, act))
+    assert counts["outside_top_k"] == 0
+
+
+def test_ranking_is_deterministic_and_prefers_value_per_time():
+    """Equal inputs rank equally; a more valuable task at the same distance ranks first."""
+    g = synthetic_task_graph(4, 30, np.random.default_rng(1))
+    a, b = rank_candidates(g, 6), rank_candidates(g, 6)
+    assert np.array_equal(a.rows, b.rows)
+    for i in range(4):
+        p = a.priority[i, a.rows[i][a.valid[i]]]
+        fire = g.task_kind[a.rows[i][a.valid[i]]] == TaskKind.FIRE
+        for kind in (fire, ~fire):
+            assert (np.diff(p[kind]) <= 0).all()
+
+
+def test_outside_top_k_maps_to_nearest_candidate_of_its_kind():
+    """A plan task outside the candidates maps to the nearest legal candidate of the same kind
+    and is counted."""
+    g = synthetic_task_graph(3, 30, np.random.default_rng(2))
+    c = rank_candidates(g, 2)
+    i = int(np.flatnonzero(g.agent_can_act)[0])
+    outside = [t for t in np.flatnonzero(legal_tasks(g)[i]) if t not in c.rows[i]]
+    t = int(outside[0])
+    counts = MappingCounts()
+    act = plan_to_actions(Plan(routes={g.agent_ids[i]: (g.task_ids[t],)}), g, c, counts)
+    assert counts["outside_top_k"] == 1 and counts["noop"] == g.n_agents - 1
+    slot = int(act[i])
+    assert g.task_kind[c.rows[i, slot]] == g.task_kind[t]
+    d = np.hypot(*(g.task_pos[c.rows[i][c.valid[i]]] - g.task_pos[t]).T)
+    assert d[slot] == d.min()
