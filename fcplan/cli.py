@@ -44,7 +44,12 @@ __all__ = ["COMMAND_MODULES", "main"]
 #: Modules that add a sub-command. Each defines ``add_parser(sub)``, which adds its parser to the
 #: ``argparse`` sub-parsers object ``sub`` (built with ``parser_class=fcplan.cliutil.Parser``) and
 #: sets ``run=<function(args) -> int>`` as a default; heavy imports stay inside ``run``.
-COMMAND_MODULES: tuple[str, ...] = ()
+COMMAND_MODULES: tuple[str, ...] = (
+    "fcplan.game.cli",
+    "fcplan.experiments.commands",
+    "fcplan.replay",
+    "fcplan.legacy",
+)
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -76,6 +81,9 @@ def _build_parser() -> argparse.ArgumentParser:
         help="seconds per scheduler call (default: the scheduler's own)",
     )
     r.add_argument("--json", action="store_true", help="print the results as JSON")
+    r.add_argument(
+        "--record", metavar="PATH", help="write a recording of the episode (.npz) for fcplan replay"
+    )
 
     c = sub.add_parser(
         "compare",
@@ -164,6 +172,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from fcplan.scenario import load_scenario
     from fcplan.scheduling import make_scheduler
 
+    check_output(args.record, "--record")
     scenario = load_scenario(args.scenario)
     scheduler = make_scheduler(args.scheduler)
     res = run_episode(
@@ -172,6 +181,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
         seed=args.seed,
         replan_period=args.replan_period,
         time_limit=args.time_limit,
+        record=args.record,
     )
     if args.json:
         out = {
@@ -200,6 +210,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     )
     print()
     print(format_metrics(res.metrics))
+    if args.record:
+        print(f"\nrecording written to {args.record} (fcplan replay {args.record})")
     return 0
 
 

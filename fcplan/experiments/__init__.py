@@ -11,7 +11,16 @@ cores, and summarises the outcomes with confidence intervals.
 * :mod:`~fcplan.experiments.stats`: the mean and Student-t confidence interval of the mean, and
   paired differences.
 
-More is planned here: sweeps over scheduler settings, result stores and reports.
+* :mod:`~fcplan.experiments.sweep`: :func:`sweep` runs a TOML grid (scenarios x schedulers and
+  their settings x seeds x scenario overrides, :mod:`~fcplan.experiments.config`) on a local
+  process pool or a Dask cluster (:mod:`~fcplan.experiments.backends`), storing each finished
+  episode at once in a Parquet results folder (:mod:`~fcplan.experiments.results`);
+  :func:`load_results` reads it back as a pandas DataFrame. Re-running resumes.
+* :mod:`~fcplan.experiments.report`: :func:`report` turns a results folder into Markdown, PNG and
+  HTML: tables with confidence intervals, paired Wilcoxon comparisons, plots.
+
+pandas/pyarrow (``fcplan[parquet]``), dask (``fcplan[dask]``) and matplotlib (``fcplan[plot]``)
+are imported only when needed.
 
 Examples
 --------
@@ -21,7 +30,11 @@ Examples
 """
 
 from fcplan.experiments.compare import ComparisonResult, RangeError, compare, parse_range
+from fcplan.experiments.config import SweepConfigError, load_sweep_config
+from fcplan.experiments.report import report
+from fcplan.experiments.results import ResultsError, load_results
 from fcplan.experiments.stats import MeanCI, mean_ci, paired_mean_ci
+from fcplan.experiments.sweep import SweepSummary, sweep
 
 __all__ = [
     "compare",
@@ -31,4 +44,11 @@ __all__ = [
     "MeanCI",
     "mean_ci",
     "paired_mean_ci",
+    "sweep",
+    "SweepSummary",
+    "SweepConfigError",
+    "load_sweep_config",
+    "load_results",
+    "ResultsError",
+    "report",
 ]

@@ -52,19 +52,24 @@ import json
 import math
 import os
 import re
-import signal
-import sys
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 import numpy as np
 
 from fcplan.errors import FcplanError, UnknownNameError
+from fcplan.experiments.progress import ProgressPrinter
 from fcplan.experiments.stats import MeanCI, mean_ci, paired_mean_ci
+from fcplan.experiments.workers import (
+    default_jobs,
+    init_worker,
+    runtime_factories,
+    stop_workers,
+)
 
 __all__ = [
     "compare",
@@ -224,13 +229,6 @@ def _positive(name: str, value: Any, *, allow_none: bool) -> float | None:
     return v
 
 
-def _default_jobs() -> int:
-    try:
-        return max(len(os.sched_getaffinity(0)), 1)
-    except AttributeError:  # pragma: no cover - not Linux
-        return os.cpu_count() or 1
-
-
 # --------------------------------------------------------------------------------------------
 # workers
 
@@ -243,16 +241,6 @@ class _Task:
     seed: int
     time_limit: float | None
     replan_period: float
-
-
-def _init_worker(runtime: dict[str, Callable[..., Any]]) -> None:
-    """Worker start-up: leave Ctrl-C to the parent; re-register run-time schedulers."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if runtime:
-        from fcplan.scheduling import register_scheduler
-
-        for name, factory in runtime.items():
-            register_scheduler(name, factory)
 
 
 def _run_task(task: _Task) -> tuple[int, dict[str, Any], list[float]]:
@@ -289,30 +277,6 @@ def run_episode(*args: Any, **kwargs: Any):
     from fcplan.episode import run_episode as _run
 
     return _run(*args, **kwargs)
-
-
-def _runtime_factories(names: Sequence[str]) -> dict[str, Callable[..., Any]]:
-    """Run-time registrations (:func:`fcplan.register_scheduler`) the workers need again."""
-    from fcplan import scheduling
-
-    runtime = getattr(scheduling, "_RUNTIME", {})
-    return {n: runtime[n] for n in names if n in runtime}
-
-
-def _stop_workers(executor: ProcessPoolExecutor, futures: Iterable[Future]) -> None:
-    for f in futures:
-        f.cancel()
-    terminate = getattr(executor, "terminate_workers", None)  # Python >= 3.14
-    if terminate is not None:  # pragma: no cover - depends on the Python version
-        terminate()
-        return
-    procs = list((getattr(executor, "_processes", None) or {}).values())
-    for p in procs:
-        if p.is_alive():
-            p.terminate()
-    executor.shutdown(wait=True, cancel_futures=True)
-    for p in procs:
-        p.join(timeout=5)
 
 
 # --------------------------------------------------------------------------------------------
@@ -372,7 +336,7 @@ def compare(
     tl = _positive("time_limit", time_limit, allow_none=True)
     rp = _positive("replan_period", replan_period, allow_none=False)
     if jobs is None:
-        jobs = _default_jobs()
+        jobs = default_jobs()
     if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
         raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
     tasks = [
@@ -401,7 +365,7 @@ def compare(
             record(_run_task(task))
     else:
         executor = ProcessPoolExecutor(
-            max_workers=jobs, initializer=_init_worker, initargs=(_runtime_factories(names),)
+            max_workers=jobs, initializer=init_worker, initargs=(runtime_factories(names),)
         )
         futures: dict[Future, _Task] = {}
         try:
@@ -423,7 +387,7 @@ def compare(
                         }
                         record((t.index, row, []))
         except BaseException:
-            _stop_workers(executor, futures)
+            stop_workers(executor, futures)
             raise
         executor.shutdown(wait=True)
     return ComparisonResult(
@@ -748,55 +712,3 @@ def _nan_to_none(x: Any) -> Any:
     if isinstance(x, np.generic):
         return _nan_to_none(x.item())
     return x
-
-
-# --------------------------------------------------------------------------------------------
-# progress
-
-
-class ProgressPrinter:
-    """A ``progress`` callback for :func:`compare` that prints plain lines, throttled.
-
-    Each line reads ``compare: 12/40 episodes (30%), 2.1/s, elapsed 0:06, ETA 0:13`` (plus the
-    number of failed episodes, if any). At most one line per ``interval`` seconds, and always one
-    for the last episode.
-
-    Parameters
-    ----------
-    stream : file, optional
-        Where to print (default ``sys.stderr``).
-    interval : float
-        Minimum seconds between lines.
-    """
-
-    def __init__(self, stream: IO[str] | None = None, interval: float = 1.0):
-        self.stream = stream
-        self.interval = interval
-        self._t0 = time.perf_counter()
-        self._last = -math.inf
-        self._errors = 0
-
-    def __call__(self, done: int, total: int, row: dict[str, Any]) -> None:
-        if row.get("error"):
-            self._errors += 1
-        now = time.perf_counter()
-        if done < total and now - self._last < self.interval:
-            return
-        self._last = now
-        elapsed = now - self._t0
-        rate = done / elapsed if elapsed > 0 else math.inf
-        eta = (total - done) / rate if rate > 0 and math.isfinite(rate) else 0.0
-        text = (
-            f"compare: {done}/{total} episodes ({100 * done / total:.0f}%), {rate:.1f}/s, "
-            f"elapsed {_clock(elapsed)}, ETA {_clock(eta)}"
-        )
-        if self._errors:
-            text += f", {self._errors} failed"
-        print(text, file=self.stream or sys.stderr, flush=True)
-
-
-def _clock(seconds: float) -> str:
-    s = int(round(seconds))
-    h, rem = divmod(s, 3600)
-    m, s = divmod(rem, 60)
-    return f"{h}:{m:02d}:{s:02d}" if h else f"{m}:{s:02d}"

@@ -1,0 +1,573 @@
+"""Sweep configurations: a TOML grid of scenarios, schedulers, seeds and scenario overrides.
+
+A sweep file (``fcplan sweep study.toml``) describes a grid; every combination is one episode::
+
+    name = "team-size study"          # optional, free text
+    scenarios = ["practice", "1-3"]   # names, numbers, ranges "1-24", or TOML file paths
+                                      #   (relative paths are relative to this file)
+    seeds = "0-4"                     # a range string or a list of integers >= 0
+    replan_period = 1.0               # simulated s between replans; a list makes it a grid axis
+    time_limit = 0.1                  # s per scheduler call; omit for each scheduler's own;
+                                      #   a list makes it an axis
+
+    schedulers = ["greedy", "routing:time_limit=0.05"]   # names or name:key=value specs
+    # or, with labels, fixed settings and setting grids:
+    # [[schedulers]]
+    # name = "milp"
+    # label = "milp"                  # optional (default: the spec, e.g. "milp:slots=3")
+    # settings = { time_limit = 0.2 } # fixed settings
+    # grid = { slots = [2, 3] }       # one variant per value (per combination)
+
+    [overrides]                       # dotted paths into the scenario's TOML document
+    "team.perception.count" = [2, 3, 4]           # a list is an axis: one value per episode
+    "fire.regions[*].wind_speed" = [5, 15]        # [*]: every region; [0]: the first one
+    duration_s = 60                               # a scalar applies to every episode
+    "team.perception.count+team.action.count" = [1, 2]  # "+": one axis setting both paths
+    "team.perception.altitude" = [[10, 60]]       # a list-valued field: wrap it in a list
+
+Expansion order: scenario, overrides (in file order, last varying fastest), replan period, time
+limit, scheduler variant, seed. Every override combination is applied to every scenario and
+validated *before* anything runs; errors (:class:`SweepConfigError`) name the sweep file, the field
+and what is allowed.
+
+Each :class:`EpisodeSpec` has a ``key``: a hash of everything that determines the episode (the
+scenario document after overrides, the scheduler name, label and settings, the seed, the replan
+period and the time limit). Results are stored by key, so a re-run skips what is done even if the
+file was reordered or extended. Episodes are pure functions of their spec: the same key gives the
+same metrics on any machine, worker or backend.
+
+Examples
+--------
+>>> cfg = load_sweep_config({"scenarios": ["practice"], "schedulers": ["greedy", "random"],
+...                          "seeds": "0-1", "overrides": {"duration_s": 10}})
+>>> [(e.scenario.name, e.label, e.seed) for e in cfg.episodes()]  # doctest: +NORMALIZE_WHITESPACE
+[('practice', 'greedy', 0), ('practice', 'greedy', 1), ('practice', 'random', 0),
+ ('practice', 'random', 1)]
+>>> cfg.episodes()[0].scenario.duration_s
+10.0
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+import os
+import re
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fcplan.errors import FcplanError
+
+__all__ = [
+    "EpisodeSpec",
+    "SchedulerVariant",
+    "SweepConfig",
+    "SweepConfigError",
+    "apply_overrides",
+    "load_sweep_config",
+]
+
+_TOP_KEYS = ("name", "scenarios", "schedulers", "seeds", "replan_period", "time_limit", "overrides")
+_SCHEDULER_KEYS = ("name", "label", "settings", "grid")
+
+
+class SweepConfigError(FcplanError, ValueError):
+    """A sweep file (or dict) is malformed: the message names the file, the field and what is
+    allowed."""
+
+
+def _canon(obj: Any) -> str:
+    return json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
+
+
+def short_hash(obj: Any, n: int = 16) -> str:
+    """Hex digest (first ``n`` characters) of ``obj``'s canonical JSON."""
+    return hashlib.sha256(_canon(obj).encode()).hexdigest()[:n]
+
+
+@dataclass(frozen=True)
+class SchedulerVariant:
+    """One scheduler with fixed settings; ``label`` names it in results and reports."""
+
+    label: str
+    name: str
+    settings: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, eq=False)
+class EpisodeSpec:
+    """Everything one episode needs (picklable; sent to workers).
+
+    Attributes
+    ----------
+    key : str
+        Content hash (see the module docstring).
+    scenario : Scenario
+        With the overrides applied.
+    base_scenario : str
+        The scenario as named in the sweep (e.g. ``"#3"``).
+    label, scheduler : str
+        The variant's label and its registered scheduler name.
+    settings, overrides : dict
+        Scheduler settings; the override values of this episode (dotted path -> value).
+    seed : int
+    replan_period : float
+    time_limit : float or None
+    """
+
+    key: str
+    scenario: Any
+    base_scenario: str
+    label: str
+    scheduler: str
+    settings: dict[str, Any]
+    overrides: dict[str, Any]
+    seed: int
+    replan_period: float
+    time_limit: float | None
+
+
+@dataclass(frozen=True, eq=False)
+class SweepConfig:
+    """A validated sweep grid (see the module docstring); :meth:`episodes` expands it."""
+
+    scenarios: tuple[Any, ...]  # Scenario objects, in the order given
+    schedulers: tuple[SchedulerVariant, ...]
+    seeds: tuple[int, ...]
+    overrides: dict[str, tuple[Any, ...]]
+    replan_periods: tuple[float, ...] = (1.0,)
+    time_limits: tuple[float | None, ...] = (None,)
+    name: str = ""
+    source: str = "<sweep>"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The normalised grid as JSON-ready data (scenarios by name)."""
+        return {
+            "name": self.name,
+            "scenarios": [s.name for s in self.scenarios],
+            "schedulers": [
+                {"label": v.label, "name": v.name, "settings": v.settings} for v in self.schedulers
+            ],
+            "seeds": list(self.seeds),
+            "overrides": {k: list(v) for k, v in self.overrides.items()},
+            "replan_period": list(self.replan_periods),
+            "time_limit": list(self.time_limits),
+        }
+
+    @property
+    def config_hash(self) -> str:
+        """Hash of the grid, including the full scenario documents (12 hex characters)."""
+        d = self.to_dict()
+        d["scenarios"] = [s.to_dict() for s in self.scenarios]
+        return short_hash(d, 12)
+
+    def override_combinations(self) -> list[dict[str, Any]]:
+        """Every combination of override values (one dict per combination)."""
+        keys = list(self.overrides)
+        return [
+            dict(zip(keys, vals, strict=True))
+            for vals in itertools.product(*(self.overrides[k] for k in keys))
+        ]
+
+    def episodes(self) -> list[EpisodeSpec]:
+        """The grid as episode specs, in expansion order (see the module docstring).
+
+        Raises
+        ------
+        SweepConfigError
+            If an override combination makes a scenario invalid (the message names the sweep
+            file, the override and the scenario's own error).
+        """
+        out = []
+        for scen in self.scenarios:
+            for combo in self.override_combinations():
+                s = apply_overrides(scen, combo, source=self.source)
+                doc = s.to_dict()
+                for rp, tl, var, seed in itertools.product(
+                    self.replan_periods, self.time_limits, self.schedulers, self.seeds
+                ):
+                    key = short_hash(
+                        {
+                            "scenario": doc,
+                            "scheduler": var.name,
+                            "label": var.label,
+                            "settings": var.settings,
+                            "seed": seed,
+                            "replan_period": rp,
+                            "time_limit": tl,
+                        }
+                    )
+                    out.append(
+                        EpisodeSpec(
+                            key=key,
+                            scenario=s,
+                            base_scenario=scen.name,
+                            label=var.label,
+                            scheduler=var.name,
+                            settings=dict(var.settings),
+                            overrides=dict(combo),
+                            seed=seed,
+                            replan_period=rp,
+                            time_limit=tl,
+                        )
+                    )
+        return out
+
+
+# --------------------------------------------------------------------------------------------
+# overrides
+
+_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[(?:\*|\d+)\])*)$")
+
+
+def _set_path(node: Any, parts: list[str], value: Any, path: str) -> None:
+    """Set ``value`` at the dotted ``parts`` inside ``node`` (dicts and lists)."""
+    head, rest = parts[0], parts[1:]
+    m = _PART.match(head)
+    if m is None:
+        raise FcplanError(f"malformed path element {head!r} (use key, key[0] or key[*])")
+    key, idx_text = m.group(1), m.group(2)
+    indices = re.findall(r"\[(\*|\d+)\]", idx_text)
+    if not isinstance(node, dict):
+        raise FcplanError(f"{path}: {key!r} is not inside a table")
+    if not indices and not rest:
+        node[key] = copy.deepcopy(value)
+        return
+    if key not in node:
+        raise FcplanError(
+            f"{path}: no field {key!r} here; fields: {', '.join(sorted(node)) or '(none)'}"
+        )
+    slots: list[tuple[Any, Any]] = [(node, key)]  # (container, index) pairs to descend into
+    for ix in indices:
+        nxt = []
+        for parent, k in slots:
+            t = parent[k]
+            if not isinstance(t, list):
+                raise FcplanError(f"{path}: {key!r} is not a list, so [{ix}] does not apply")
+            if ix == "*":
+                nxt.extend((t, i) for i in range(len(t)))
+            elif int(ix) < len(t):
+                nxt.append((t, int(ix)))
+            else:
+                raise FcplanError(f"{path}: index {ix} out of range 0..{len(t) - 1}")
+        slots = nxt
+    for parent, k in slots:
+        if rest:
+            _set_path(parent[k], rest, value, path)
+        else:
+            parent[k] = copy.deepcopy(value)
+
+
+def apply_overrides(scenario: Any, overrides: Mapping[str, Any], *, source: str = "") -> Any:
+    """A copy of ``scenario`` with dotted-path ``overrides`` applied to its TOML document.
+
+    Paths are keys separated by dots; ``key[i]`` indexes a list and ``key[*]`` means every item,
+    e.g. ``"team.perception.count"``, ``"fire.regions[*].wind_speed"``, ``"duration_s"``. In
+    ``uniform`` fire mode the region parameters live in ``fire`` itself (``"fire.wind_speed"``).
+    Several paths joined by ``+`` all receive the value (``"team.perception.count+team.action.count"``).
+
+    Raises
+    ------
+    SweepConfigError
+        A path that does not exist in the document, or a value the scenario rejects (the
+        scenario's validation message is included).
+
+    Examples
+    --------
+    >>> from fcplan.scenario import load_scenario
+    >>> s = apply_overrides(load_scenario(12), {"fire.regions[*].wind_speed": 15})
+    >>> [r.wind_speed for r in s.regions]
+    [15.0, 15.0]
+    """
+    from fcplan.scenario import Scenario
+
+    if not overrides:
+        return scenario
+    doc = copy.deepcopy(scenario.to_dict())
+    where = f"{source}: " if source else ""
+    for path, value in overrides.items():
+        try:
+            for one in path.split("+"):
+                _set_path(doc, one.strip().split("."), value, path)
+        except FcplanError as exc:
+            raise SweepConfigError(f"{where}overrides: scenario {scenario.name}: {exc}") from None
+    try:
+        return Scenario.from_dict(doc, source=scenario.source)
+    except FcplanError as exc:
+        shown = ", ".join(f"{k}={v!r}" for k, v in overrides.items())
+        raise SweepConfigError(
+            f"{where}overrides {shown} make scenario {scenario.name} invalid: {exc}"
+        ) from None
+
+
+# --------------------------------------------------------------------------------------------
+# loading and validation
+
+
+def _err(source: str, field_: str, problem: str, got: Any = ...) -> SweepConfigError:
+    msg = f"{source}: {field_}: {problem}"
+    if got is not ...:
+        msg += f" (got {got!r})"
+    return SweepConfigError(msg)
+
+
+def _number_axis(
+    source: str, field_: str, value: Any, default: Any, *, allow_none: bool
+) -> tuple[Any, ...]:
+    if value is None:
+        return (default,)
+    values = value if isinstance(value, list) else [value]
+    if not values:
+        raise _err(source, field_, "must not be an empty list")
+    out = []
+    for v in values:
+        ok = (
+            isinstance(v, (int, float))
+            and not isinstance(v, bool)
+            and math.isfinite(float(v))
+            and v > 0
+        )
+        if not ok:
+            raise _err(source, field_, "must be a number > 0 or a list of them", v)
+        out.append(float(v))
+    return tuple(dict.fromkeys(out))
+
+
+def _seeds(source: str, value: Any) -> tuple[int, ...]:
+    from fcplan.experiments.compare import RangeError, parse_range
+
+    if value is None:
+        raise _err(source, "seeds", 'is required, e.g. seeds = "0-4" or seeds = [0, 7]')
+    if isinstance(value, int) and not isinstance(value, bool):
+        value = [value]
+    if isinstance(value, str):
+        try:
+            return tuple(parse_range(value, names=False))  # type: ignore[arg-type]
+        except RangeError as exc:
+            raise _err(source, "seeds", str(exc)) from None
+    if not isinstance(value, list) or not value:
+        raise _err(source, "seeds", 'must be a range string like "0-4" or a list of integers')
+    for v in value:
+        if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+            raise _err(source, "seeds", "must be integers >= 0", v)
+    return tuple(dict.fromkeys(value))
+
+
+def _scenarios(source: str, value: Any, base_dir: Path | None) -> tuple[Any, ...]:
+    from fcplan.experiments.compare import RangeError, parse_range
+    from fcplan.scenario import Scenario, load_scenario
+
+    if value is None:
+        raise _err(source, "scenarios", 'is required, e.g. scenarios = ["practice", "1-24"]')
+    items = value if isinstance(value, list) else [value]
+    if not items:
+        raise _err(source, "scenarios", "must not be empty")
+    names: list[Any] = []
+    for item in items:
+        if isinstance(item, Scenario) or (isinstance(item, int) and not isinstance(item, bool)):
+            names.append(item)
+        elif isinstance(item, str):
+            try:
+                names.extend(parse_range(item))
+            except RangeError as exc:
+                raise _err(source, "scenarios", str(exc)) from None
+        else:
+            raise _err(source, "scenarios", "items must be names, numbers, ranges or paths", item)
+    out = []
+    for n in names:
+        if isinstance(n, Scenario):
+            out.append(n)
+            continue
+        target: Any = n
+        if isinstance(n, str) and base_dir is not None and n.endswith(".toml"):
+            p = Path(n)
+            target = p if p.is_absolute() else base_dir / p
+        try:
+            out.append(load_scenario(target))
+        except FcplanError as exc:
+            raise SweepConfigError(f"{source}: scenarios: {exc}") from None
+    seen: dict[str, Any] = {}
+    for s in out:
+        if s.name in seen:
+            if s.to_dict() != seen[s.name].to_dict():
+                raise _err(source, "scenarios", "two different scenarios share a name", s.name)
+            continue
+        seen[s.name] = s
+    return tuple(seen.values())
+
+
+def _schedulers(source: str, value: Any) -> tuple[SchedulerVariant, ...]:
+    from fcplan.scheduling import available_schedulers, make_scheduler, parse_scheduler_spec
+
+    if value is None:
+        raise _err(source, "schedulers", 'is required, e.g. schedulers = ["greedy", "random"]')
+    items = value if isinstance(value, list) else [value]
+    if not items:
+        raise _err(source, "schedulers", "must not be empty")
+    known = available_schedulers()
+    variants: list[SchedulerVariant] = []
+    for i, item in enumerate(items):
+        where = f"schedulers[{i}]"
+        if isinstance(item, str):
+            try:
+                name, settings = parse_scheduler_spec(item)
+            except FcplanError as exc:
+                raise _err(source, where, str(exc)) from None
+            entries = [(item.strip() if settings else name, name, settings)]
+        elif isinstance(item, Mapping):
+            extra = set(item) - set(_SCHEDULER_KEYS)
+            if extra:
+                raise _err(
+                    source,
+                    where,
+                    f"unknown key(s) {sorted(extra)}; allowed: " + ", ".join(_SCHEDULER_KEYS),
+                )
+            name = item.get("name")
+            if not isinstance(name, str) or not name:
+                raise _err(source, f"{where}.name", "is required (a registered scheduler name)")
+            settings = item.get("settings", {})
+            grid = item.get("grid", {})
+            for k, v in (("settings", settings), ("grid", grid)):
+                if not isinstance(v, Mapping):
+                    raise _err(source, f"{where}.{k}", "must be a table of key = value", v)
+            for k, v in grid.items():
+                if not isinstance(v, list) or not v:
+                    raise _err(source, f"{where}.grid.{k}", "must be a non-empty list of values", v)
+            label = item.get("label")
+            if label is not None and (not isinstance(label, str) or not label):
+                raise _err(source, f"{where}.label", "must be a non-empty string", label)
+            entries = []
+            keys = list(grid)
+            for vals in itertools.product(*(grid[k] for k in keys)):
+                s = {**settings, **dict(zip(keys, vals, strict=True))}
+                spec = name + "".join(f":{k}={_fmt(v)}" for k, v in s.items())
+                lab = spec if label is None else label
+                if label is not None and keys:
+                    lab = label + "".join(
+                        f":{k}={_fmt(v)}" for k, v in zip(keys, vals, strict=True)
+                    )
+                entries.append((lab, name, s))
+        else:
+            raise _err(source, where, "must be a name, a name:key=value spec or a table", item)
+        for label, name, settings in entries:
+            if name not in known:
+                raise _err(
+                    source, f"{where}", f"unknown scheduler {name!r}; known: {', '.join(known)}"
+                )
+            try:
+                make_scheduler(name, **settings)
+            except FcplanError as exc:
+                raise _err(source, where, str(exc)) from None
+            except Exception as exc:  # noqa: BLE001 - any construction failure, one line
+                raise _err(
+                    source,
+                    where,
+                    f"scheduler {name!r} cannot be created: {type(exc).__name__}: {exc}",
+                ) from None
+            if any(v.label == label for v in variants):
+                raise _err(source, where, "duplicate scheduler label", label)
+            variants.append(SchedulerVariant(label, name, dict(settings)))
+    return tuple(variants)
+
+
+def _fmt(v: Any) -> str:
+    return str(v).lower() if isinstance(v, bool) else str(v)
+
+
+def _overrides(source: str, value: Any) -> dict[str, tuple[Any, ...]]:
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise _err(source, "overrides", "must be a table of dotted.path = value or [values]")
+    out: dict[str, tuple[Any, ...]] = {}
+    for path, v in _flatten(value):
+        values = v if isinstance(v, list) else [v]
+        if not values:
+            raise _err(source, f"overrides.{path}", "must not be an empty list")
+        out[path] = tuple(values)
+    return out
+
+
+def _flatten(d: Mapping[str, Any], prefix: str = "") -> list[tuple[str, Any]]:
+    """``{"team": {"action": {"count": [1, 2]}}}`` -> ``[("team.action.count", [1, 2])]``
+    (TOML may write a dotted key unquoted, which makes nested tables)."""
+    out = []
+    for k, v in d.items():
+        path = f"{prefix}{k}"
+        if isinstance(v, Mapping):
+            out.extend(_flatten(v, path + "."))
+        else:
+            out.append((path, v))
+    return out
+
+
+def load_sweep_config(
+    config: str | os.PathLike[str] | Mapping[str, Any] | SweepConfig,
+) -> SweepConfig:
+    """Read and validate a sweep file (TOML path) or the same document as a dict.
+
+    Scenario names, scheduler names and settings, seeds and numbers are all checked here, and
+    every override combination is applied to every scenario (so an invalid one fails now, not
+    mid-sweep).
+
+    Raises
+    ------
+    SweepConfigError
+        With the file, the field and what is allowed.
+    """
+    if isinstance(config, SweepConfig):
+        return config
+    base_dir = None
+    if isinstance(config, Mapping):
+        doc, source = dict(config), "<sweep config>"
+    else:
+        path = Path(config)
+        source = str(path)
+        try:
+            doc = tomllib.loads(path.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise SweepConfigError(f"{source}: no such sweep file") from None
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SweepConfigError(f"{source}: cannot read: {exc}") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise SweepConfigError(f"{source}: not valid TOML: {exc}") from None
+        base_dir = path.resolve().parent
+    unknown = set(doc) - set(_TOP_KEYS)
+    if unknown:
+        raise _err(
+            source, ", ".join(sorted(unknown)), "unknown key(s); allowed: " + ", ".join(_TOP_KEYS)
+        )
+    name = doc.get("name", "")
+    if not isinstance(name, str):
+        raise _err(source, "name", "must be a string", name)
+    if "time_limit" in doc and doc["time_limit"] is None:
+        doc.pop("time_limit")
+    cfg = SweepConfig(
+        scenarios=_scenarios(source, doc.get("scenarios"), base_dir),
+        schedulers=_schedulers(source, doc.get("schedulers")),
+        seeds=_seeds(source, doc.get("seeds")),
+        overrides=_overrides(source, doc.get("overrides")),
+        replan_periods=_number_axis(
+            source, "replan_period", doc.get("replan_period"), 1.0, allow_none=False
+        ),
+        time_limits=_number_axis(
+            source, "time_limit", doc.get("time_limit"), None, allow_none=True
+        ),
+        name=name,
+        source=source,
+    )
+    for scen in cfg.scenarios:  # validate every override combination up front
+        for combo in cfg.override_combinations():
+            apply_overrides(scen, combo, source=source)
+    return cfg
+
+
+def episode_keys(specs: Sequence[EpisodeSpec]) -> list[str]:
+    """The keys of ``specs`` (duplicates would mean two identical episodes)."""
+    return [s.key for s in specs]

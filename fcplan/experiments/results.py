@@ -1,0 +1,195 @@
+"""Sweep results: a folder of small Parquet files, one per finished episode.
+
+Layout of a results folder (``fcplan sweep ... --results DIR``)::
+
+    DIR/<key>.parquet          one row: a finished episode (completed or failed), named by its key
+    DIR/manifest-<hash>.json   the normalised grid of each sweep run into this folder
+    DIR/.<key>.<pid>.tmp       a write in progress (ignored; removed by the next sweep)
+    DIR/<subfolder>/           ignored (e.g. the report's default output, DIR/report/)
+
+Crash safety. A row is written to a hidden temporary file, flushed to disk, then renamed over
+``<key>.parquet`` (:func:`os.replace`, atomic on POSIX and Windows), so a reader sees either the
+whole row or nothing: a killed sweep leaves no partial rows, at most a stray ``.tmp`` file. Because
+the file name is the episode key, an episode is stored at most once, whatever retries happen.
+
+Each file carries the schema metadata key ``fcplan`` = ``{"format": "fcplan-sweep-episode",
+"version": 1}``. :func:`load_results` refuses (with :class:`ResultsError` naming the file) a
+Parquet file without it, a file that is not valid Parquet, and any other file in the folder.
+
+Examples
+--------
+>>> import tempfile
+>>> d = tempfile.mkdtemp()
+>>> write_row(d, {"key": "abc123", "status": "ok", "error": "", "score": 1.5})  # doctest: +ELLIPSIS
+PosixPath('.../abc123.parquet')
+>>> load_results(d)[["key", "score"]].to_dict("records")
+[{'key': 'abc123', 'score': 1.5}]
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import re
+import uuid
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from fcplan.errors import FcplanError
+from fcplan.experiments.optional import require
+
+__all__ = ["ResultsError", "load_results", "stored_status", "write_row", "write_manifest"]
+
+FORMAT = {"format": "fcplan-sweep-episode", "version": 1}
+_META_KEY = b"fcplan"
+_ROW_FILE = re.compile(r"^[0-9A-Za-z_-]+\.parquet$")
+_MANIFEST = re.compile(r"^manifest-[0-9a-f]+\.json$")
+_TMP = re.compile(r"^\..+\.tmp$")
+
+
+class ResultsError(FcplanError):
+    """A results folder is missing, or holds a file that is not a sweep result (named)."""
+
+
+def write_row(directory: str | os.PathLike[str], row: dict[str, Any]) -> Path:
+    """Write ``row`` atomically as ``directory/<row["key"]>.parquet`` (replacing an older one).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    pa = require("pyarrow", "parquet")
+    pq = require("pyarrow.parquet", "parquet")
+    d = Path(directory)
+    key = str(row["key"])
+    if not _ROW_FILE.match(f"{key}.parquet"):
+        raise ResultsError(f"episode key {key!r} is not a valid file name")
+    table = pa.Table.from_pylist([row])
+    table = table.replace_schema_metadata({_META_KEY: json.dumps(FORMAT).encode()})
+    final = d / f"{key}.parquet"
+    tmp = d / f".{key}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp"
+    try:
+        with open(tmp, "wb") as fh:
+            pq.write_table(table, fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, final)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+    return final
+
+
+def write_manifest(directory: str | os.PathLike[str], config_hash: str, doc: dict) -> Path:
+    """Write the sweep's normalised grid as ``manifest-<config_hash>.json`` (atomically)."""
+    path = Path(directory) / f"manifest-{config_hash}.json"
+    tmp = Path(directory) / f".manifest-{config_hash}.{os.getpid()}.tmp"
+    tmp.write_text(json.dumps(doc, indent=1, sort_keys=True, default=str) + "\n", "utf-8")
+    os.replace(tmp, path)
+    return path
+
+
+def remove_stale_temporaries(directory: str | os.PathLike[str]) -> int:
+    """Delete ``.tmp`` files left by a killed writer; returns how many."""
+    n = 0
+    for p in Path(directory).iterdir():
+        if p.is_file() and _TMP.match(p.name):
+            with contextlib.suppress(FileNotFoundError):
+                p.unlink()
+                n += 1
+    return n
+
+
+def _row_files(directory: str | os.PathLike[str]) -> Iterator[Path]:
+    d = Path(directory)
+    if not d.exists():
+        raise ResultsError(f"{d}: no such results folder")
+    if not d.is_dir():
+        raise ResultsError(f"{d}: not a folder (results are a folder of Parquet files)")
+    for p in sorted(d.iterdir()):
+        if p.is_dir() or _TMP.match(p.name) or _MANIFEST.match(p.name):
+            continue
+        if not _ROW_FILE.match(p.name):
+            raise ResultsError(
+                f"{p}: foreign file in a results folder (expected <key>.parquet episode files "
+                "and manifest-*.json); move it elsewhere"
+            )
+        yield p
+
+
+def _read(path: Path, columns: list[str] | None = None):
+    pq = require("pyarrow.parquet", "parquet")
+    try:
+        pf = pq.ParquetFile(path)
+        meta = pf.schema_arrow.metadata or {}
+        table = pf.read(columns=columns)
+    except Exception as exc:  # noqa: BLE001 - any reader failure means a damaged file
+        raise ResultsError(
+            f"{path}: not a readable Parquet file ({type(exc).__name__}: {exc}); delete it to "
+            "re-run that episode"
+        ) from None
+    try:
+        fmt = json.loads(meta.get(_META_KEY, b"{}"))
+    except ValueError:
+        fmt = {}
+    if fmt.get("format") != FORMAT["format"]:
+        raise ResultsError(f"{path}: a Parquet file not written by fcplan sweep (foreign file)")
+    if fmt.get("version", 0) > FORMAT["version"]:
+        raise ResultsError(
+            f"{path}: written by a newer fcplan (results format version {fmt.get('version')})"
+        )
+    if table.num_rows != 1:
+        raise ResultsError(f"{path}: expected one episode row, found {table.num_rows}")
+    return table
+
+
+def stored_status(directory: str | os.PathLike[str]) -> dict[str, str]:
+    """``{key: status}`` (``ok`` or ``failed``) of every episode stored in ``directory``.
+
+    An absent folder has no episodes (``{}``); damaged or foreign files raise
+    :class:`ResultsError`.
+    """
+    if not Path(directory).exists():
+        return {}
+    out = {}
+    for p in _row_files(directory):
+        t = _read(p, ["key", "status"])
+        out[t.column("key")[0].as_py()] = t.column("status")[0].as_py()
+    return out
+
+
+def load_results(directory: str | os.PathLike[str]):
+    """All episodes in a results folder as a :class:`pandas.DataFrame` (one row per episode).
+
+    Rows are sorted by ``finished_at`` when present (then by key). Columns are those of
+    :mod:`fcplan.experiments.play`; a failed episode has ``status = "failed"``, its ``error``,
+    and NaN metrics.
+
+    Raises
+    ------
+    ResultsError
+        The folder does not exist, or a file in it is damaged or foreign (named in the message).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> len(load_results(tempfile.mkdtemp()))
+    0
+    """
+    pd = require("pandas", "parquet")
+    pa = require("pyarrow", "parquet")
+    tables = [_read(p) for p in _row_files(directory)]
+    if not tables:
+        return pd.DataFrame({"key": pd.Series(dtype=str), "status": pd.Series(dtype=str)})
+    try:
+        table = pa.concat_tables(
+            [t.replace_schema_metadata(None) for t in tables], promote_options="permissive"
+        )
+    except pa.ArrowInvalid as exc:
+        raise ResultsError(f"{directory}: episode files with incompatible columns: {exc}") from None
+    df = table.to_pandas()
+    order = [c for c in ("finished_at", "key") if c in df.columns]
+    return df.sort_values(order, kind="stable").reset_index(drop=True)

@@ -1,0 +1,224 @@
+"""Sweeps: expand a grid into episodes, run them anywhere, store each result as it finishes.
+
+:func:`sweep` reads a sweep file (:mod:`fcplan.experiments.config`), skips the episodes already
+stored in the results folder, runs the rest on a backend (:mod:`fcplan.experiments.backends`:
+in-process, a local process pool, or Dask) and writes every finished episode at once as its own
+Parquet file (:mod:`fcplan.experiments.results`). ``fcplan sweep CONFIG.toml`` is a thin layer
+over it.
+
+Resume and failures.
+
+* Re-running the same sweep (or an extended one) into the same folder skips every episode whose
+  key is stored, so an interrupted sweep (Ctrl-C, a crash, a killed machine) resumes where it
+  stopped, having lost at most the episodes that were in flight.
+* An episode that raises is stored as a *failed* row (``status = "failed"`` and the ``error``
+  text) and the sweep runs on. Episodes are deterministic, so by default a re-run does **not**
+  retry failed episodes (it would fail again); ``retry_failed=True`` (``--retry-failed``) plays
+  them again, e.g. after fixing a scheduler, and the new row replaces the failed one.
+* An episode whose worker process died (killed, out of memory) is *lost*: nothing is stored and
+  a re-run plays it. :attr:`SweepSummary.lost` counts them.
+
+Examples
+--------
+>>> import tempfile
+>>> config = {"scenarios": ["practice"], "schedulers": ["greedy", "idle"], "seeds": [0],
+...           "overrides": {"duration_s": 5}}
+>>> out = tempfile.mkdtemp()
+>>> s = sweep(config, out, jobs=1, progress=False)
+>>> s.ran, s.skipped, s.failed
+(2, 0, 0)
+>>> sweep(config, out, jobs=1, progress=False).skipped  # resumed: nothing left to do
+2
+>>> sorted(s.load()["scheduler"])
+['greedy', 'idle']
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fcplan.errors import FcplanError
+from fcplan.experiments.config import SweepConfig, load_sweep_config
+from fcplan.experiments.progress import make_progress
+from fcplan.experiments.results import (
+    ResultsError,
+    load_results,
+    remove_stale_temporaries,
+    stored_status,
+    write_manifest,
+    write_row,
+)
+from fcplan.experiments.workers import default_jobs, runtime_factories
+
+__all__ = ["SweepSummary", "sweep"]
+
+
+@dataclass
+class SweepSummary:
+    """What one :func:`sweep` call did.
+
+    Attributes
+    ----------
+    results : Path
+        The results folder.
+    config_hash : str
+    backend : str
+        ``serial``, ``pool`` or ``dask:<address>``.
+    total : int
+        Episodes in the grid.
+    skipped : int
+        Already stored (not run again).
+    ran : int
+        Played and stored now (completed or failed).
+    failed : int
+        Of ``ran``, episodes stored as failed.
+    lost : list of str
+        ``"<label> <scenario> seed <n>: <why>"`` for episodes that produced nothing.
+    errors : list of str
+        ``"<label> <scenario> seed <n>: <error>"`` for the failed episodes.
+    wall_time_s : float
+    """
+
+    results: Path
+    config_hash: str
+    backend: str
+    total: int
+    skipped: int = 0
+    ran: int = 0
+    failed: int = 0
+    lost: list[str] = field(default_factory=list)
+    errors: list[str] = field(default_factory=list)
+    wall_time_s: float = 0.0
+
+    def load(self):
+        """:func:`~fcplan.experiments.load_results` of the results folder."""
+        return load_results(self.results)
+
+    def format(self) -> str:
+        """One paragraph for the terminal."""
+        rate = 60 * self.ran / self.wall_time_s if self.wall_time_s > 0 else 0.0
+        text = (
+            f"sweep {self.config_hash}: {self.total} episodes; {self.skipped} already stored, "
+            f"{self.ran} run now ({self.failed} failed, {len(self.lost)} lost) on {self.backend} "
+            f"in {self.wall_time_s:.1f} s ({rate:.1f} episodes/min); results in {self.results}"
+        )
+        if self.lost:
+            text += (
+                f"\n{len(self.lost)} episode(s) lost, re-run to play them; first: {self.lost[0]}"
+            )
+        return text
+
+
+def _describe(spec: Any) -> str:
+    extra = f" {spec.overrides}" if spec.overrides else ""
+    return f"{spec.label} {spec.base_scenario} seed {spec.seed}{extra}"
+
+
+def sweep(
+    config: str | os.PathLike[str] | Mapping[str, Any] | SweepConfig,
+    results: str | os.PathLike[str] = "results",
+    *,
+    jobs: int | None = None,
+    dask: str | None = None,
+    retry_failed: bool = False,
+    progress: bool | Callable[[int, int, dict[str, Any]], None] = True,
+) -> SweepSummary:
+    """Run a sweep, storing each finished episode in ``results`` at once.
+
+    Parameters
+    ----------
+    config : path, dict or SweepConfig
+        A sweep TOML file, the same document as a dict, or a loaded config (validated before
+        anything runs; :class:`~fcplan.experiments.config.SweepConfigError` otherwise).
+    results : path
+        The results folder (created if needed). Episodes already in it are skipped.
+    jobs : int, optional
+        Worker processes (default: one per core). ``jobs=1`` without ``dask`` plays in this
+        process.
+    dask : str, optional
+        ``"local"`` to start a Dask LocalCluster of ``jobs`` workers, or the address of an
+        existing Dask scheduler (``"tcp://host:8786"``).
+    retry_failed : bool
+        Also re-run episodes stored as failed (see the module docstring).
+    progress : bool or callable
+        ``True``: a progress bar on stderr (plain lines when stderr is not a terminal);
+        ``False``: silent; or a ``progress(done, total, row)`` callback.
+
+    Returns
+    -------
+    SweepSummary
+
+    Raises
+    ------
+    SweepConfigError, ResultsError
+        A bad config; a results folder holding damaged or foreign files.
+    KeyboardInterrupt
+        On Ctrl-C, after stopping the workers; everything finished so far is stored.
+    """
+    cfg = load_sweep_config(config)
+    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1):
+        raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
+    if dask is not None and (not isinstance(dask, str) or not dask.strip()):
+        raise FcplanError(f"dask must be 'local' or a scheduler address, got {dask!r}")
+    jobs = jobs or default_jobs()
+    specs = list({s.key: s for s in cfg.episodes()}.values())
+    out = Path(results)
+    if out.exists() and not out.is_dir():
+        raise ResultsError(f"{out}: exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ResultsError(f"{out}: cannot create the results folder: {exc}") from None
+    remove_stale_temporaries(out)
+    status = stored_status(out)
+    todo = [s for s in specs if s.key not in status or (retry_failed and status[s.key] != "ok")]
+    h = cfg.config_hash
+    write_manifest(out, h, {"config_hash": h, "source": cfg.source, **cfg.to_dict()})
+    runtime = runtime_factories([v.name for v in cfg.schedulers])
+    if dask is not None:
+        from fcplan.experiments.backends import iter_dask
+
+        backend = f"dask:{dask}"
+        outcomes = iter_dask(todo, dask, jobs, runtime) if todo else iter([])
+    elif jobs == 1 or len(todo) <= 1:
+        from fcplan.experiments.backends import iter_serial
+
+        backend = "serial"
+        outcomes = iter_serial(todo, runtime)
+    else:
+        from fcplan.experiments.backends import iter_pool
+
+        backend = f"pool:{min(jobs, len(todo))}"
+        outcomes = iter_pool(todo, jobs, runtime)
+    report = make_progress(sys.stderr, label="sweep") if progress is True else progress or None
+    summary = SweepSummary(out, h, backend, total=len(specs), skipped=len(specs) - len(todo))
+    t0 = time.perf_counter()
+    done = 0
+    try:
+        for spec, row, lost in outcomes:
+            done += 1
+            if row is None:
+                summary.lost.append(f"{_describe(spec)}: {lost}")
+                row = {"error": lost}
+            else:
+                row["config_hash"] = h
+                row["sweep"] = cfg.name
+                write_row(out, row)
+                summary.ran += 1
+                if row.get("status") != "ok":
+                    summary.failed += 1
+                    summary.errors.append(f"{_describe(spec)}: {row.get('error')}")
+            if report is not None:
+                report(done, len(todo), row)
+    finally:
+        close = getattr(outcomes, "close", None)
+        if close is not None:
+            close()
+        summary.wall_time_s = time.perf_counter() - t0
+    return summary
