@@ -55,9 +55,17 @@ class Belief:
         self._known_mask = np.zeros(w * w, dtype=bool)
         self._known = np.zeros(0, dtype=np.int64)
         self._dirty = False
-        self.coverage = np.full((nc, nc), -1, dtype=np.int32)
+        self._coverage = np.full((nc, nc), -1, dtype=np.int32)
+        n_s = sum(1 for a in scenario.agents if a.role.can_sense)
+        #: per sensing agent: its last field of view, the coarse box it covered, and the tick of
+        #: a deferred write of that box (None: nothing deferred)
+        self._last_rect: list[list | None] = [None] * n_s
+        self._last_box: list[tuple[int, int, int, int]] = [(0, 0, 0, 0)] * n_s
+        self._pending: list[int | None] = [None] * n_s
+        self._lazy = True
         self.n_pruned = 0
         self.tick = 0
+        self._tick_covered = 0
         self.new_fire_since_plan = False
         #: rows of the agents that carry a camera (perception and hybrid)
         self._sensing_rows = [i for i, a in enumerate(scenario.agents) if a.role.can_sense]
@@ -93,22 +101,53 @@ class Belief:
             self._dirty = True
         self._cover(info.fov, info.tick)
 
+    @property
+    def coverage(self) -> np.ndarray:
+        """(nc, nc) int32: the tick each coarse cell's centre was last inside a sensing agent's
+        field of view (-1: never)."""
+        self._flush()
+        return self._coverage
+
     def _cover(self, fov: np.ndarray, tick: int) -> None:
-        """Mark coarse cells whose centres lie inside a sensing agent's field of view."""
-        if not self._sensing_rows:
+        """Mark coarse cells whose centres lie inside a sensing agent's field of view.
+
+        An agent whose field of view is exactly the last tick's (hovering) would rewrite the same
+        cells: the write is deferred until it moves or the coverage is read. Ticks never
+        decrease, so a cell's value is the largest tick of the writes covering it, and a deferred
+        write is applied as a maximum (if time ever goes backwards, writes are eager again).
+        """
+        rows = self._sensing_rows
+        if not rows:
             return
+        if tick < self._tick_covered:  # time went backwards: no deferral from here on
+            self._flush()
+            self._lazy = False
+        self._tick_covered = tick
         c = self.coverage_px
-        nc = self.coverage.shape[0]
-        cov = self.coverage
+        cov = self._coverage
+        nc = cov.shape[0]
         rects = fov.tolist()
-        # coarse cell j has centre (j + 0.5) c; inside [a, b] iff ceil(a/c - 0.5) <= j <= floor(b/c - 0.5)
-        for k in self._sensing_rows:
-            x0, x1, y0, y1 = rects[k]
-            i0 = min(max(math.ceil(x0 / c - 0.5), 0), nc)
-            i1 = min(max(math.floor(x1 / c - 0.5) + 1, 0), nc)
-            j0 = min(max(math.ceil(y0 / c - 0.5), 0), nc)
-            j1 = min(max(math.floor(y1 / c - 0.5) + 1, 0), nc)
+        last, boxes, pending = self._last_rect, self._last_box, self._pending
+        lazy = self._lazy
+        for slot, k in enumerate(rows):
+            rect = rects[k]
+            if lazy and rect == last[slot]:
+                pending[slot] = tick
+                continue
+            if pending[slot] is not None:
+                _raise_to(cov, boxes[slot], pending[slot])
+                pending[slot] = None
+            i0, i1, j0, j1 = box = _coarse_box(rect, c, nc)
             cov[i0:i1, j0:j1] = tick
+            last[slot], boxes[slot] = rect, box
+
+    def _flush(self) -> None:
+        """Apply the deferred coverage writes."""
+        pending = self._pending
+        for slot, t in enumerate(pending):
+            if t is not None:
+                _raise_to(self._coverage, self._last_box[slot], t)
+                pending[slot] = None
 
     def coverage_age_s(self, block_px: int) -> np.ndarray:
         """(B, B) mean seconds since the coarse cells of each ``block_px`` block were covered.
@@ -118,29 +157,51 @@ class Belief:
         Never-covered cells count as covered one minute before the start, so unexplored areas are
         the stalest.
         """
+        cov = self.coverage
         nb, key, counts, empty, centre_cells = _block_layout(
-            self.world_size, self.coverage_px, self.coverage.shape[0], int(block_px)
+            self.world_size, self.coverage_px, cov.shape[0], int(block_px)
         )
         never = np.int32(-60 * self.ticks_per_second)
-        ticks = np.where(self.coverage >= _ZERO32, self.coverage, never)
+        ticks = np.where(cov >= _ZERO32, cov, never)
         age = (self.tick - ticks).astype(np.float64) / self.ticks_per_second
         sums = np.bincount(key, weights=age.ravel(), minlength=nb * nb)
-        out = sums / np.maximum(counts, 1)
+        out = sums / counts
         if empty.size:
             out[empty] = age.ravel()[centre_cells]
         return out.reshape(nb, nb)
 
 
+def _coarse_box(rect, c: int, nc: int) -> tuple[int, int, int, int]:
+    """Coarse cells ``[i0, i1) x [j0, j1)`` whose centres lie in ``rect = [x0, x1, y0, y1]``:
+    cell j has centre (j + 0.5) c, inside [a, b] iff ceil(a/c - 0.5) <= j <= floor(b/c - 0.5)."""
+    x0, x1, y0, y1 = rect
+    return (
+        min(max(math.ceil(x0 / c - 0.5), 0), nc),
+        min(max(math.floor(x1 / c - 0.5) + 1, 0), nc),
+        min(max(math.ceil(y0 / c - 0.5), 0), nc),
+        min(max(math.floor(y1 / c - 0.5) + 1, 0), nc),
+    )
+
+
+def _raise_to(cov: np.ndarray, box: tuple[int, int, int, int], tick: int) -> None:
+    """``cov[box] = max(cov[box], tick)``."""
+    i0, i1, j0, j1 = box
+    if i0 < i1 and j0 < j1:
+        view = cov[i0:i1, j0:j1]
+        np.maximum(view, tick, out=view)
+
+
 @lru_cache(maxsize=32)
 def _block_layout(w: int, c: int, nc: int, block_px: int):
     """How coarse coverage cells fall into ``block_px`` blocks (constant per map): block count
-    per side, block of each coarse cell, coarse cells per block, blocks holding no coarse cell
+    per side, block of each coarse cell, coarse cells per block (at least 1: divisors), blocks holding no coarse cell
     centre, and for those the coarse cell under the block's centre."""
     nb = -(-w // block_px)
     bi = np.minimum(((np.arange(nc) + 0.5) * c // block_px).astype(np.int64), nb - 1)
     key = (bi[:, None] * nb + bi[None, :]).ravel()
     counts = np.bincount(key, minlength=nb * nb)
     empty = np.flatnonzero(counts == 0)
+    counts = np.maximum(counts, 1)  # divisors (empty blocks are filled apart)
     centre = (np.arange(nb) + 0.5) * block_px
     ci = np.minimum((centre // c).astype(np.int64), nc - 1)
     centre_cells = ci[empty // nb] * nc + ci[empty % nb]

@@ -7,6 +7,14 @@ Commands::
     fcplan run SCENARIO [--scheduler NAME] [--seed N] [--replan-period S] [--time-limit S] [--json]
     fcplan compare --schedulers A,B [--scenarios 1-24] [--seeds 0-4] [--jobs N] [--time-limit S]
                    [--replan-period S] [--json PATH] [--csv PATH] [--by-difficulty] [--quiet]
+    fcplan sweep CONFIG.toml [--results DIR] [--jobs N] [--dask ADDRESS|local] [--retry-failed]
+    fcplan report RESULTS [--out DIR] [--html] [--metric NAME]
+    fcplan replay PATH [--video out.mp4|out.gif] [--fps N] [--speed X] [--size PX] [--truth]
+    fcplan play [--scenario NAME] [--seed N] [--record PATH] [--speed X] [--fast]
+    fcplan import-legacy DIR [--out PATH]
+
+``fcplan run`` also takes ``--record PATH``. The commands after ``compare`` live in the modules of
+:data:`COMMAND_MODULES`; ``fcplan COMMAND --help`` lists every option.
 
 Bad input (an unknown scenario or scheduler, a malformed file, an out-of-range argument) prints one
 line naming the problem and exits with status 2; ``--debug`` shows the traceback instead.

@@ -65,6 +65,9 @@ class TaskKind(IntEnum):
     SEARCH = 1
 
 
+_FIRE_KIND = int(TaskKind.FIRE)  # a plain int compares with arrays faster than the enum member
+
+
 @dataclass(frozen=True, slots=True)
 class TaskGraphParams:
     """How the belief is turned into tasks.
@@ -166,18 +169,18 @@ class TaskGraph:
     @cached_property
     def task_index(self) -> dict[str, int]:
         """Task id -> row."""
-        return {t: i for i, t in enumerate(self.task_ids)}
+        return dict(zip(self.task_ids, range(len(self.task_ids)), strict=True))
 
     @cached_property
     def agent_index(self) -> dict[str, int]:
         """Agent id -> row."""
-        return {a: i for i, a in enumerate(self.agent_ids)}
+        return dict(zip(self.agent_ids, range(len(self.agent_ids)), strict=True))
 
     # ------------------------------------------------------------------ distances
     @cached_property
     def agent_task_distance(self) -> np.ndarray:
         """(A, K) straight-line px from each agent to each task."""
-        return _pairwise(self.agent_pos, self.task_pos)
+        return self._agent_distances()[0]
 
     @cached_property
     def task_distance(self) -> np.ndarray:
@@ -187,7 +190,18 @@ class TaskGraph:
     @cached_property
     def task_home_distance(self) -> np.ndarray:
         """(A, K) px from each task back to each agent's depot slot."""
-        return _pairwise(self.agent_home, self.task_pos)
+        return self._agent_distances()[1]
+
+    def _agent_distances(self) -> tuple[np.ndarray, np.ndarray]:
+        """Both (A, K) distance tables in one pass (their first use is usually together); each
+        one already cached is kept."""
+        n_a = len(self.agent_pos)
+        both = _pairwise(np.concatenate([self.agent_pos, self.agent_home]), self.task_pos)
+        d = self.__dict__
+        return (
+            d.setdefault("agent_task_distance", both[:n_a]),
+            d.setdefault("task_home_distance", both[n_a:]),
+        )
 
     @cached_property
     def agent_task_time(self) -> np.ndarray:
@@ -197,8 +211,7 @@ class TaskGraph:
     @cached_property
     def can_do(self) -> np.ndarray:
         """(A, K) bool: the agent's role can serve the task (fires: anyone; search: sensors)."""
-        fire = self.task_kind == TaskKind.FIRE
-        return fire[None, :] | (self.agent_can_sense[:, None] & ~fire[None, :])
+        return (self.task_kind == _FIRE_KIND)[None, :] | self.agent_can_sense[:, None]
 
     @cached_property
     def node_ids(self) -> tuple[str, ...]:
@@ -278,8 +291,13 @@ class TaskGraph:
 
 
 def _pairwise(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    d = a[:, None, :] - b[None, :, :]
-    return np.sqrt(np.einsum("ijk,ijk->ij", d, d))
+    """(len(a), len(b)) Euclidean distances between 2-D points: ``sqrt(dx * dx + dy * dy)``."""
+    dx = a[:, 0, None] - b[:, 0]
+    dy = a[:, 1, None] - b[:, 1]
+    dx *= dx
+    dy *= dy
+    dx += dy
+    return np.sqrt(dx, out=dx)
 
 
 def _rect_distance(points: np.ndarray, rects: np.ndarray) -> np.ndarray:
@@ -398,29 +416,27 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     xy = belief.known_xy()
     if len(xy):
         ntx = int(np.ceil(w / tw))
-        tx = (xy[:, 0] // tw).astype(np.int64)
-        ty = (xy[:, 1] // th).astype(np.int64)
-        key = tx * (int(np.ceil(w / th)) + 1) + ty
+        nty = int(np.ceil(w / th)) + 1
+        txy = (xy // np.array([tw, th])).astype(np.int64)
+        key = txy[:, 0] * nty + txy[:, 1]  # tile row-major (ty < nty)
         order = np.argsort(key, kind="stable")
         ks = key[order]
         first = np.empty(len(ks), dtype=bool)
         first[:1] = True
         np.not_equal(ks[1:], ks[:-1], out=first[1:])
         starts = first.nonzero()[0]
-        xs, ys = xy[order, 0].astype(np.float64), xy[order, 1].astype(np.float64)
-        seen = belief.last_seen[xy[order, 0], xy[order, 1]]
-        x0 = np.minimum.reduceat(xs, starts)
-        x1 = np.maximum.reduceat(xs, starts)
-        y0 = np.minimum.reduceat(ys, starts)
-        y1 = np.maximum.reduceat(ys, starts)
+        fxy = xy[order].astype(np.float64)
+        seen = belief.last_seen.ravel()[belief.known[order]]  # known = flat x * W + y
+        lo = np.minimum.reduceat(fxy, starts, axis=0)
+        hi = np.maximum.reduceat(fxy, starts, axis=0)
         last = np.maximum.reduceat(seen, starts)
         counts = np.empty_like(starts)  # tile sizes: gaps between starts
         np.subtract(starts[1:], starts[:-1], out=counts[:-1])
         counts[-1] = len(ks) - starts[-1]
-        fire_pos = _columns((x0 + x1) / 2.0, (y0 + y1) / 2.0)
+        fire_pos = (lo + hi) / 2.0
         fire_stale = (tick - last) / tps
-        tile_x, tile_y = tx[order][starts], ty[order][starts]
-        cluster = _clusters(tile_x, tile_y, ntx, int(np.ceil(w / th)) + 1)
+        tile_x, tile_y = np.divmod(ks[starts], nty)
+        cluster = _clusters(tile_x, tile_y, ntx, nty)
     else:
         fire_pos = np.zeros((0, 2))
         fire_stale = np.zeros(0)
@@ -474,6 +490,22 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     task_kind = np.full(k_total, int(TaskKind.SEARCH), dtype=np.int8)
     task_kind[:n_fire] = int(TaskKind.FIRE)
     minus_s = np.full(n_search, -1, dtype=np.int64)
+    if n_fire:
+        task_pos = np.concatenate([fire_pos, search_pos]).reshape(k_total, 2)
+        task_value = np.concatenate([counts * (1.0 + threat), search_value])
+        task_cells = _cat_int(counts, np.zeros(n_search, dtype=np.int64))
+        task_staleness = np.concatenate([fire_stale, search_age])
+        task_threat = np.concatenate([threat, np.zeros(n_search)])
+        task_cluster = _cat_int(cluster, minus_s)
+        task_block = _cat_int(fire_block, minus_s)
+    else:  # search blocks only: the same arrays without the empty concatenations
+        task_pos = search_pos.copy()
+        task_value = search_value
+        task_cells = np.zeros(n_search, dtype=np.int64)
+        task_staleness = search_age.copy()
+        task_threat = np.zeros(n_search)
+        task_cluster = minus_s
+        task_block = minus_s.copy()
 
     range_px = team.range_px()
     return _task_graph(
@@ -498,13 +530,13 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         agent_can_act=team.can_act.copy(),
         task_ids=fire_ids + search_ids,
         task_kind=task_kind,
-        task_pos=np.concatenate([fire_pos, search_pos]).reshape(k_total, 2),
-        task_value=np.concatenate([counts * (1.0 + threat), search_value]),
-        task_cells=_cat_int(counts, np.zeros(n_search, dtype=np.int64)),
-        task_staleness=np.concatenate([fire_stale, search_age]),
-        task_threat=np.concatenate([threat, np.zeros(n_search)]),
-        task_cluster=_cat_int(cluster, minus_s),
-        task_block=_cat_int(fire_block, minus_s),
+        task_pos=task_pos,
+        task_value=task_value,
+        task_cells=task_cells,
+        task_staleness=task_staleness,
+        task_threat=task_threat,
+        task_cluster=task_cluster,
+        task_block=task_block,
         facility_kinds=consts.fac_kinds,
         facility_pos=fac_pos,
         facility_rect=fac_rect,
@@ -547,12 +579,29 @@ def _search_ids(nb: int, blk: int) -> tuple[str, ...]:
 
 
 _EIGHT = np.ones((3, 3), dtype=bool)  # 8-connectivity
+_SMALL_CLUSTER = 256  # up to this many tiles, label by pairwise adjacency (no scipy call)
 
 
 def _clusters(tx: np.ndarray, ty: np.ndarray, nx_: int, ny_: int) -> np.ndarray:
-    """Connected-fire labels of occupied tiles (8-connectivity)."""
-    if len(tx) == 1:
+    """Connected-fire labels of occupied tiles (8-connectivity), numbered like
+    ``scipy.ndimage.label`` (by first tile in raster order; the tiles come sorted that way)."""
+    n = len(tx)
+    if n == 1:
         return np.zeros(1, dtype=np.int64)
+    if n <= _SMALL_CLUSTER:
+        # min-label propagation with pointer jumping: each tile ends up pointing at the first
+        # (lowest-index) tile of its component, and components are numbered in that order
+        adj = np.abs(tx[:, None] - tx) <= 1
+        adj &= np.abs(ty[:, None] - ty) <= 1
+        idx = np.arange(n)
+        lab = np.where(adj, idx, n).min(axis=1)
+        while True:
+            nxt = np.where(adj, lab, n).min(axis=1)
+            nxt = nxt[nxt]
+            if np.array_equal(nxt, lab):
+                break
+            lab = nxt
+        return (np.cumsum(lab == idx) - 1)[lab]
     from scipy.ndimage import label
 
     grid = np.zeros((nx_ + 1, ny_ + 1), dtype=bool)

@@ -34,8 +34,11 @@ Arguments
 ``illegal_action`` ("noop" or "raise")
     What a masked-out action does (see :mod:`fcplan.env.task_actions`).
 ``validate`` (default True)
-    Check every step's plan with :func:`fcplan.plan.validate_plan` (the mask already guarantees
-    it; turn off for speed).
+    Check that every step's plan passes :func:`fcplan.plan.validate_plan`. The mask already
+    guarantees it, so the check is vectorised: each chosen (agent, task) pair must be legal by
+    :func:`~fcplan.env.task_candidates.legal_tasks` (validate_plan's arithmetic for one-task
+    routes); a pair that is not sends the plan through ``validate_plan``, which raises
+    :class:`fcplan.errors.PlanError` naming it. ``False`` skips the check.
 ``graph_params``
     :class:`fcplan.taskgraph.TaskGraphParams` for the task graph.
 ``render_mode``
@@ -53,8 +56,9 @@ Actions, no-op and conflicts
     :mod:`fcplan.env.task_actions`: a chosen slot sends the agent to that one task (replacing its
     route); the **no-op holds course** (the plan does not mention the agent: it keeps its route,
     keeps hovering, keeps going home). Two agents of the same role picking one task: the first to
-    arrive keeps it, the other gets the no-op. The actions become a ``Plan`` (validated), then
-    :func:`fcplan.plan.plan_commands`, applied on the step's first tick.
+    arrive keeps it, the other gets the no-op. The actions become commands (exactly
+    ``plan_commands`` of the one-task ``Plan`` they describe, checked as ``validate`` says),
+    applied on the step's first tick.
 
 Reward
     ``r = -sum_ticks rate(t) / tps + prune_bonus * pruned``, with ``rate`` the manual's penalty rate
@@ -104,7 +108,8 @@ from typing import Any
 import numpy as np
 
 from fcplan.belief import Belief
-from fcplan.env.task_actions import actions_plan, decode_actions
+from fcplan.env import EnvError
+from fcplan.env.task_actions import actions_commands, actions_plan, decode_actions
 from fcplan.env.task_candidates import (
     AGENT_FEATURES,
     FEATURE_BOUND,
@@ -115,7 +120,7 @@ from fcplan.env.task_candidates import (
     task_features,
 )
 from fcplan.metrics import compute_all
-from fcplan.plan import plan_commands, validate_plan
+from fcplan.plan import validate_plan
 from fcplan.taskgraph import TaskGraph, TaskGraphParams, build_task_graph
 from fcplan.world import World
 
@@ -159,8 +164,6 @@ class TaskEnv(_Base):
         render_mode: str | None = None,
     ) -> None:
         from gymnasium import spaces
-
-        from fcplan.env import EnvError
 
         self.scenario = _load(scenario)
         if not (isinstance(k, (int, np.integer)) and 1 <= k <= 1024):
@@ -250,24 +253,21 @@ class TaskEnv(_Base):
 
         Returns ``(observations, rewards, terminations, truncations, infos)``.
         """
-        from fcplan.env import EnvError
-
         if not self.agents:
             raise EnvError("step: the episode is over; call reset() first")
         graph, cand = self.graph, self.candidates
-        act = np.full(self.n_agents, self.k, dtype=np.int64)
-        for i, a in enumerate(self.possible_agents):
-            if a in actions and actions[a] is not None:
-                act[i] = int(actions[a])
+        noop = self.k
+        act = [noop if (x := actions.get(a)) is None else int(x) for a in self.possible_agents]
         rows, illegal, conflict = decode_actions(graph, cand, act, illegal=self.illegal_action)
-        plan = actions_plan(
-            graph, rows, watch_altitude=self.watch_altitude, search_altitude=self.search_altitude
-        )
-        if self.validate:
-            validate_plan(plan, graph)
-        commands = plan_commands(plan, graph)
-        sent = rows >= 0
-        self._goal[sent] = graph.task_pos[rows[sent]]
+        alts = dict(watch_altitude=self.watch_altitude, search_altitude=self.search_altitude)
+        sent = np.flatnonzero(rows >= 0)
+        if self.validate and not cand.legal[sent, rows[sent]].all():
+            # legal_tasks is validate_plan's arithmetic for one-task routes: only a bug gets
+            # here, and validate_plan names the offending agent and task
+            validate_plan(actions_plan(graph, rows, **alts), graph)
+        commands = actions_commands(graph, rows, **alts)
+        if sent.size:
+            self._goal[sent] = graph.task_pos[rows[sent]]
         self._rows = rows
         reward = self._advance(commands)
         self.steps += 1

@@ -51,8 +51,9 @@ import numpy as np
 from fcplan.env.task_candidates import Candidates
 from fcplan.plan import Plan
 from fcplan.taskgraph import TaskGraph, TaskKind
+from fcplan.team import Command
 
-__all__ = ["decode_actions", "actions_plan", "plan_to_actions", "MappingCounts"]
+__all__ = ["decode_actions", "actions_plan", "actions_commands", "plan_to_actions", "MappingCounts"]
 
 _FIRE = int(TaskKind.FIRE)
 
@@ -78,28 +79,34 @@ def decode_actions(
         Agents whose action was illegal / lost a conflict.
     """
     n_a, k = cand.rows.shape
-    ar = np.arange(n_a)
     a = np.asarray(actions, dtype=np.int64).reshape(n_a)
-    ok = (a >= 0) & (a < k)
-    slot = np.where(ok, a, 0)
-    ok &= cand.valid[ar, slot]
-    bad = ~ok & (a != k)
-    if illegal == "raise" and bad.any():
+    # a handful of agents: plain Python over the (A,) actions beats a dozen numpy calls
+    cand_rows, valid = cand.rows.tolist(), cand.valid.tolist()
+    out: list[int] = []
+    bad_l: list[bool] = []
+    for i, x in enumerate(a.tolist()):
+        r = cand_rows[i][x] if 0 <= x < k and valid[i][x] else -1
+        out.append(r)
+        bad_l.append(r < 0 and x != k)
+    bad = np.array(bad_l, dtype=bool)
+    if illegal == "raise" and True in bad_l:
         from fcplan.env import EnvError
 
-        i = int(np.flatnonzero(bad)[0])
+        i = bad_l.index(True)
         legal = np.flatnonzero(np.r_[cand.valid[i], True]).tolist()
         raise EnvError(
             f"agent {graph.agent_ids[i]}: action {int(a[i])} is illegal (legal now: {legal}; "
             f"{k} is the no-op)"
         )
-    rows = np.where(ok, cand.rows[ar, slot], -1)
+    rows = np.array(out, dtype=np.int64)
     conflict = np.zeros(n_a, dtype=bool)
-    chosen = np.flatnonzero(ok)
-    if chosen.size > 1:
-        role = graph.agent_role[chosen].astype(np.int64)
-        key = rows[chosen] * 8 + role
-        if np.unique(key).size < key.size:  # rare: resolve by arrival time
+    sent = [i for i, r in enumerate(out) if r >= 0]
+    if len(sent) > 1:
+        role = graph.agent_role.tolist()
+        keys = [out[i] * 8 + role[i] for i in sent]
+        if len(set(keys)) < len(keys):  # rare: resolve by arrival time
+            chosen = np.array(sent)
+            key = np.array(keys, dtype=np.int64)
             eta = cand.start_distance[chosen, rows[chosen]] / graph.agent_speed[chosen]
             order = np.lexsort((chosen, eta, key))
             ks = key[order]
@@ -131,6 +138,46 @@ def actions_plan(
             z = watch_altitude if fire[t] else search_altitude
             alts[ids[i]] = float(min(max(z, lo[i]), hi[i]))
     return Plan(routes=routes, altitudes=alts)
+
+
+def actions_commands(
+    graph: TaskGraph,
+    rows: np.ndarray,
+    *,
+    watch_altitude: float = 35.0,
+    search_altitude: float = 70.0,
+) -> dict[str, Command]:
+    """``plan_commands(actions_plan(graph, rows, ...), graph)`` built directly from the rows
+    (the environment's per-step path: no task-id lookups).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fcplan.plan import plan_commands
+    >>> from fcplan.taskgraph import synthetic_task_graph
+    >>> g = synthetic_task_graph(3, 10, np.random.default_rng(0))
+    >>> rows = np.array([4, -1, 2])
+    >>> actions_commands(g, rows) == plan_commands(actions_plan(g, rows), g)
+    True
+    """
+    sel = np.flatnonzero(rows >= 0)
+    if not sel.size:
+        return {}
+    t = rows[sel]
+    pos = graph.task_pos[t].tolist()
+    fire = (graph.task_kind[t] == _FIRE).tolist()
+    sense = graph.agent_can_sense[sel].tolist()
+    bounds = graph.agent_alt_range[sel].tolist()
+    ids = graph.agent_ids
+    out: dict[str, Command] = {}
+    for j, i in enumerate(sel.tolist()):
+        z = None
+        if sense[j]:
+            z = watch_altitude if fire[j] else search_altitude
+            z = float(min(max(z, bounds[j][0]), bounds[j][1]))
+        x, y = pos[j]
+        out[ids[i]] = Command(route=((x, y),), patrol=False, altitude=z)
+    return out
 
 
 class MappingCounts(dict):

@@ -108,6 +108,7 @@ FEATURE_BOUND = 10.0
 _FIRE, _SEARCH = int(TaskKind.FIRE), int(TaskKind.SEARCH)
 _RETURNING = int(Mode.RETURNING)
 _POS1 = np.arange(1, 1 << 16)  # 1-based positions (task graphs hold far fewer tasks)
+_ROWS = np.arange(256)[:, None]  # agent rows as a column, for fancy indexing
 
 
 @dataclass(frozen=True, eq=False)
@@ -149,12 +150,32 @@ class Candidates:
 
 def legal_tasks(graph: TaskGraph) -> np.ndarray:
     """(A, T) bool: one-task routes :func:`fcplan.plan.validate_plan` accepts (same arithmetic)."""
-    d = graph.agent_task_distance
     dh = graph.task_home_distance
-    ok = graph.can_do & (2.0 * dh <= graph.agent_full_range[:, None] + 1e-6)
+    ok = 2.0 * dh <= (graph.agent_full_range + 1e-6)[:, None]
+    ok &= graph.can_do
     forced = graph.agent_mode == _RETURNING
-    have = graph.agent_battery / DRAIN_PER_PX
-    return ok & (forced[:, None] | (d + dh <= have[:, None] + 1e-6))
+    if forced.all():
+        return ok
+    reach = graph.agent_task_distance + dh
+    reach = reach <= (graph.agent_battery / DRAIN_PER_PX + 1e-6)[:, None]
+    if forced.any():
+        reach |= forced[:, None]
+    ok &= reach
+    return ok
+
+
+def _candidates(rows, start_distance, priority, freshness, legal) -> Candidates:
+    """``Candidates(...)`` without the frozen dataclass's per-field ``object.__setattr__``."""
+    c = object.__new__(Candidates)
+    c.__dict__.update(
+        rows=rows,
+        valid=rows >= 0,
+        start_distance=start_distance,
+        priority=priority,
+        freshness=freshness,
+        legal=legal,
+    )
+    return c
 
 
 def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candidates:
@@ -165,21 +186,31 @@ def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candid
     d_start = graph.agent_task_distance
     if forced.any():
         d_start = np.where(forced[:, None], graph.task_home_distance, d_start)
-    is_fire = graph.task_kind == _FIRE
-    n_f = int(np.count_nonzero(is_fire))  # fire tasks come first in a task graph
+    kind = graph.task_kind
+    n_f = n_t - int(np.count_nonzero(kind)) if n_t else 0  # fires (kind 0) come first
     fresh = np.ones(n_t)
+    value = graph.task_value
     if n_f:
         stale = graph.task_staleness[:n_f]
         fresh[:n_f] = np.minimum(np.exp(-(stale - fresh_s) / max(fresh_s, 1e-9)), 1.0)
-    prio = (graph.task_value * fresh) / (1.0 + d_start / graph.agent_speed[:, None])
-    prio[~legal] = -np.inf
+        value = value * fresh  # (x * 1.0 == x: skipped when there is no fire)
+    prio = value / (1.0 + d_start / graph.agent_speed[:, None])
+    prio = np.where(legal, prio, -np.inf)
     rows = np.full((n_a, k), -1, dtype=np.int64)
     if n_t == 0 or n_a == 0:
-        return Candidates(rows, rows >= 0, d_start, prio, fresh, legal)
+        return _candidates(rows, d_start, prio, fresh, legal)
+    m = min(k, n_t)
+    neg = np.negative(prio)
+    order = np.argsort(neg, axis=1, kind="stable")  # illegal (-inf) last
+    n_legal = legal.sum(axis=1)
+    if n_f == 0:  # search blocks only: the best legal ones, in order
+        take = np.minimum(n_legal, k)
+        head = order[:, :m]
+        rows[:, :m] = np.where(_POS1[:m] <= take[:, None], head, -1)
+        return _candidates(rows, d_start, prio, fresh, legal)
     ai = np.arange(n_a)[:, None]
-    order = np.argsort(-prio, axis=1, kind="stable")  # illegal (-inf) last
     n_fire = legal[:, :n_f].sum(axis=1)
-    n_search = legal[:, n_f:].sum(axis=1)
+    n_search = n_legal - n_fire
     take_fire = np.minimum(n_fire, np.maximum(k - k // 2, k - n_search))[:, None]
     take_search = np.minimum(n_search[:, None], k - take_fire)
     # rank of each sorted task within its kind (1-based); illegal tasks rank beyond every take
@@ -187,11 +218,10 @@ def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candid
     fire_rank = np.cumsum(s_fire, axis=1)
     pos1 = _POS1[:n_t] if n_t <= _POS1.size else np.arange(1, n_t + 1)
     chosen = np.where(s_fire, fire_rank <= take_fire, pos1 - fire_rank <= take_search)
-    m = min(k, n_t)
     first = np.argsort(~chosen, axis=1, kind="stable")[:, :m]  # chosen slots, priority order
     valid = chosen[ai, first]
     rows[:, :m] = np.where(valid, order[ai, first], -1)
-    return Candidates(rows, rows >= 0, d_start, prio, fresh, legal)
+    return _candidates(rows, d_start, prio, fresh, legal)
 
 
 def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.ndarray:
@@ -203,18 +233,21 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     if graph.n_tasks == 0:
         return np.zeros((n_a, k, len(TASK_FEATURES)), dtype=np.float32)
     w = float(graph.world_size)
+    valid = cand.valid
     r = np.maximum(cand.rows, 0)
-    ai = np.arange(n_a)[:, None]
+    ai = _ROWS[:n_a] if n_a <= _ROWS.shape[0] else np.arange(n_a)[:, None]
     pos = graph.task_pos[r]  # (A, k, 2)
     dist = cand.start_distance[ai, r]
     # other capable agents: how many are closer, and how close is the nearest
     d_all = cand.start_distance[:, r]  # (A_other, A, k)
-    capable = graph.can_do[:, r] & _not_self(n_a)
+    capable = graph.can_do[:, r]
+    capable &= _not_self(n_a)
     n_cap = capable.sum(axis=0)
-    closer = (capable & (d_all < dist)).sum(axis=0)
-    d_all[~capable] = np.inf
-    nearest = d_all.min(axis=0)
-    prio = np.where(cand.valid, cand.priority[ai, r], 0.0)
+    closer = d_all < dist
+    closer &= capable
+    n_closer = closer.sum(axis=0)
+    nearest = np.where(capable, d_all, np.inf).min(axis=0)
+    prio = np.where(valid, cand.priority[ai, r], 0.0)
     best = prio.max(axis=1)
     # per-task columns, computed once over all tasks and gathered
     per_task = np.empty((graph.n_tasks, 7))
@@ -228,21 +261,31 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     per_task[:, 5] = per_task[:, 4]
     per_task[:, 4] = graph.task_staleness / 60.0
     per_task[:, 6] = cand.freshness
-    out = np.empty((n_a, k, len(TASK_FEATURES)), dtype=np.float32)
+    # float64 work table, cast once (clipping before or after the cast gives the same float32)
+    out = np.zeros((n_a, k, len(TASK_FEATURES)))
     out[..., 0] = 1.0
     out[..., 1:8] = per_task[r]
-    out[..., 8:10] = (pos - graph.agent_pos[:, None, :]) / w
-    out[..., 10] = dist / w
+    np.subtract(pos, graph.agent_pos[:, None, :], out=out[..., 8:10])
+    out[..., 10] = dist
+    out[..., 12] = graph.task_home_distance[ai, r]
+    np.minimum(nearest, w, out=out[..., 14])  # min(d / w, 1) == min(d, w) / w
+    out[..., 8:15] /= w
     out[..., 11] = dist / (10.0 * graph.agent_speed[:, None])
-    out[..., 12] = graph.task_home_distance[ai, r] / w
-    out[..., 13] = closer / np.maximum(n_cap, 1)
-    out[..., 14] = np.minimum(nearest / w, 1.0)
+    out[..., 13] = n_closer / np.maximum(n_cap, 1)
     out[..., 15] = prio / np.where(best > 0, best, np.inf)[:, None]
-    gd = np.hypot(pos[..., 0] - goal[:, None, 0], pos[..., 1] - goal[:, None, 1])
-    out[..., 16] = np.where(np.isnan(gd), 0.0, np.exp(-gd / 50.0))  # NaN: no goal yet
-    out[~cand.valid] = 0.0
-    np.clip(out, -FEATURE_BOUND, FEATURE_BOUND, out=out)
-    return out
+    gd = pos - goal[:, None, :]
+    gd = np.hypot(gd[..., 0], gd[..., 1])
+    out[..., 16] = np.where(np.isnan(gd), 0.0, np.exp(gd / -50.0))  # NaN: no goal yet
+    out[~valid] = 0.0
+    _clip(out)
+    return out.astype(np.float32)
+
+
+def _clip(out: np.ndarray) -> None:
+    """Clip to ``[-FEATURE_BOUND, FEATURE_BOUND]`` in place (two ufunc calls: cheaper than
+    ``np.clip``'s wrapper; the same values, NaN kept)."""
+    np.minimum(out, FEATURE_BOUND, out=out)
+    np.maximum(out, -FEATURE_BOUND, out=out)
 
 
 @lru_cache(maxsize=64)
@@ -255,27 +298,54 @@ def _not_self(n: int) -> np.ndarray:
 
 def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> np.ndarray:
     """(A, S) float32 own-state vectors (:data:`AGENT_FEATURES`)."""
+    # a handful of agents: plain Python floats (the same IEEE arithmetic as numpy's)
     w = float(graph.world_size)
-    out = np.empty((graph.n_agents, len(AGENT_FEATURES)), dtype=np.float64)
-    out[:, 0:2] = graph.agent_pos / w
-    out[:, 2] = graph.agent_z / 100.0
-    out[:, 3] = graph.agent_battery / np.maximum(graph.agent_full_range * DRAIN_PER_PX, 1e-9)
-    tank_cap = graph.agent_tank_capacity
-    out[:, 4] = np.where(tank_cap > 0, graph.agent_tank / np.maximum(tank_cap, 1), 0.0)
-    out[:, 5] = graph.agent_can_sense
-    out[:, 6] = graph.agent_can_act
-    out[:, 7:11] = _MODE_ONE_HOT[graph.agent_mode]
-    out[:, 11] = time_fraction
-    out[:, 12] = graph.agent_range / np.maximum(graph.agent_full_range, 1e-9)
-    out[:, 13:15] = graph.agent_home / w
-    out[:, 15] = np.log1p(graph.known_cells) / 10.0
+    n_a = graph.n_agents
+    known = float(np.log1p(graph.known_cells)) / 10.0
     if graph.n_tasks:
         fire = graph.task_kind[np.maximum(cand.rows, 0)] == _FIRE
-        out[:, 16] = (fire & cand.valid).sum(axis=1) / max(cand.k, 1)
+        fire &= cand.valid
+        share = (fire.sum(axis=1) / max(cand.k, 1)).tolist()
     else:
-        out[:, 16] = 0.0
-    np.clip(out, -FEATURE_BOUND, FEATURE_BOUND, out=out)
+        share = [0.0] * n_a
+    one_hot = _MODE_ROWS
+    rows = [
+        [
+            x / w,
+            y / w,
+            z / 100.0,
+            bat / max(full * DRAIN_PER_PX, 1e-9),
+            tank / max(cap, 1) if cap > 0 else 0.0,
+            sense,
+            act,
+            *one_hot[mode],
+            time_fraction,
+            rng / max(full, 1e-9),
+            hx / w,
+            hy / w,
+            known,
+            sh,
+        ]
+        for (x, y), z, bat, full, tank, cap, sense, act, mode, rng, (hx, hy), sh in zip(
+            graph.agent_pos.tolist(),
+            graph.agent_z.tolist(),
+            graph.agent_battery.tolist(),
+            graph.agent_full_range.tolist(),
+            graph.agent_tank.tolist(),
+            graph.agent_tank_capacity.tolist(),
+            graph.agent_can_sense.tolist(),
+            graph.agent_can_act.tolist(),
+            graph.agent_mode.tolist(),
+            graph.agent_range.tolist(),
+            graph.agent_home.tolist(),
+            share,
+            strict=True,
+        )
+    ]
+    out = np.array(rows, dtype=np.float64).reshape(n_a, len(AGENT_FEATURES))
+    _clip(out)
     return out.astype(np.float32)
 
 
 _MODE_ONE_HOT = np.eye(4)[[int(Mode.IDLE), int(Mode.ACTIVE), int(Mode.RETURNING), int(Mode.HOMING)]]
+_MODE_ROWS = {int(m): tuple(_MODE_ONE_HOT[int(m)].tolist()) for m in Mode}

@@ -118,3 +118,123 @@ def test_outside_top_k_maps_to_nearest_candidate_of_its_kind():
     assert g.task_kind[c.rows[i, slot]] == g.task_kind[t]
     d = np.hypot(*(g.task_pos[c.rows[i][c.valid[i]]] - g.task_pos[t]).T)
     assert d[slot] == d.min()
+
+
+# ---------------------------------------------------------------- fast paths (issue 4, speed)
+# The env's per-step code and the modules under it have vectorised / deferred fast paths; each
+# is checked here against the plain definition it replaces.
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n_agents=st.integers(2, 8), k=st.integers(1, 6))
+def test_actions_commands_equal_plan_commands(seed, n_agents, k):
+    """actions_commands gives exactly plan_commands(actions_plan(...)): same agents, order,
+    routes and altitudes, for any rows and altitude settings."""
+    from fcplan.env.task_actions import actions_commands
+    from fcplan.plan import plan_commands
+
+    rng = np.random.default_rng(seed)
+    g = synthetic_task_graph(n_agents, 25, rng)
+    rows = np.where(rng.random(n_agents) < 0.3, -1, rng.integers(0, g.n_tasks, n_agents))
+    za, zs = rng.uniform(0.0, 200.0, 2)
+    fast = actions_commands(g, rows, watch_altitude=za, search_altitude=zs)
+    slow = plan_commands(actions_plan(g, rows, watch_altitude=za, search_altitude=zs), g)
+    assert list(fast.items()) == list(slow.items())
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n_agents=st.integers(2, 6), n_tasks=st.integers(1, 30))
+def test_validate_plan_fast_path_matches_checks(seed, n_agents, n_tasks):
+    """validate_plan's vectorised pass accepts exactly the plans its one-by-one checks accept,
+    and a rejected plan raises the same error message."""
+    from fcplan.plan import _check_plan, _plan_ok
+
+    rng = np.random.default_rng(seed)
+    g = synthetic_task_graph(n_agents, n_tasks, rng, battery=float(rng.uniform(60.0, 600.0)))
+    object.__setattr__(g, "agent_mode", rng.integers(0, 4, n_agents).astype(np.int8))
+    ids = list(g.agent_ids) + ["X9"]
+    tids = list(g.task_ids) + ["fire:nowhere"]
+    for _ in range(10):
+        agents = rng.choice(ids, size=int(rng.integers(0, 4)), replace=False).tolist()
+        routes = {a: tuple(rng.choice(tids, size=int(rng.integers(0, 4))).tolist()) for a in agents}
+        alts = {a: float(rng.uniform(0.0, 120.0)) for a in agents if rng.random() < 0.5}
+        home = frozenset(a for a in ids[:-1] if rng.random() < 0.1)
+        plan = Plan(routes=routes, altitudes=alts, home=home)
+        try:
+            _check_plan(plan, g)
+            slow = None
+        except PlanError as e:
+            slow = str(e)
+        assert _plan_ok(plan, g) == (slow is None)
+        try:
+            validate_plan(plan, g)
+            fast = None
+        except PlanError as e:
+            fast = str(e)
+        assert fast == slow
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), nx=st.integers(2, 30), ny=st.integers(2, 30))
+def test_fire_clusters_match_scipy_label(seed, nx, ny):
+    """The task graph's small-fire cluster labelling equals scipy.ndimage.label (8-connected,
+    numbered by first tile in raster order)."""
+    from scipy.ndimage import label
+
+    from fcplan.taskgraph import _EIGHT, _clusters
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, min(nx * ny, 200) + 1))
+    flat = np.sort(rng.choice(nx * ny, size=n, replace=False))
+    tx, ty = np.divmod(flat, ny)
+    grid = np.zeros((nx + 1, ny + 1), dtype=bool)
+    grid[tx, ty] = True
+    labels, _ = label(grid, structure=_EIGHT)
+    assert np.array_equal(_clusters(tx, ty, nx, ny), labels[tx, ty].astype(np.int64) - 1)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), backwards=st.booleans())
+def test_deferred_coverage_equals_eager_writes(seed, backwards):
+    """Belief's deferred coverage writes give the same coverage and block ages as writing every
+    tick, including agents that hover (same field of view) and time going backwards."""
+    from types import SimpleNamespace
+
+    from fcplan import load_scenario
+    from fcplan.belief import Belief, _coarse_box
+
+    rng = np.random.default_rng(seed)
+    sc = load_scenario("practice")
+    belief = Belief(sc)
+    n_a = len(sc.agents)
+    w, c = sc.world_size, belief.coverage_px
+    eager = np.full_like(belief.coverage, -1)
+    fov = rng.uniform(0, w, (n_a, 4))
+    empty = np.zeros(0, dtype=np.int64)
+    tick = 0
+    for step in range(60):
+        moving = rng.random(n_a) < 0.4  # the others hover: the same rectangle as last tick
+        centre = rng.uniform(-50, w + 50, (n_a, 2))
+        half = rng.uniform(5, 80, (n_a, 2))
+        new = np.stack(
+            [
+                centre[:, 0] - half[:, 0],
+                centre[:, 0] + half[:, 0],
+                centre[:, 1] - half[:, 1],
+                centre[:, 1] + half[:, 1],
+            ],
+            axis=1,
+        )
+        fov = np.where(moving[:, None], new, fov)
+        tick = tick - 7 if backwards and step == 30 else tick + 1
+        belief.update(SimpleNamespace(tick=tick, sensed=empty, pruned=empty, fov=fov))
+        for k in belief._sensing_rows:
+            i0, i1, j0, j1 = _coarse_box(fov[k].tolist(), c, eager.shape[0])
+            eager[i0:i1, j0:j1] = tick
+        if step % 7 == 0:
+            assert np.array_equal(belief.coverage, eager)
+    assert np.array_equal(belief.coverage, eager)
+    ref = Belief(sc)
+    ref._coverage[...] = eager
+    ref.tick = belief.tick
+    assert np.array_equal(belief.coverage_age_s(100), ref.coverage_age_s(100))

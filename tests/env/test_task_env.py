@@ -236,3 +236,29 @@ def test_render_rgb_array():
     g = gym_env(24, k=4, render_mode="rgb_array")
     g.reset(seed=0)
     assert g.render().shape == first.shape
+
+
+def test_validate_catches_a_plan_the_mask_should_have_prevented(monkeypatch):
+    """With validate=True a chosen task that is not legal for its agent (a decoding bug) raises
+    validate_plan's PlanError naming the agent; validate=False skips the check."""
+    import fcplan.env.task as task_mod
+    from fcplan.errors import PlanError
+
+    env = TaskEnv(1, k=4)
+    env.reset(seed=0)
+    i = int(np.flatnonzero(~env.graph.agent_can_sense)[0])
+    search = int(np.flatnonzero(env.graph.task_kind == 1)[0])  # no camera: never legal
+    agent = env.possible_agents[i]
+
+    def broken(graph, cand, act, illegal="noop"):
+        rows = np.full(graph.n_agents, -1, dtype=np.int64)
+        rows[i] = search
+        no = np.zeros(graph.n_agents, dtype=bool)
+        return rows, no, no.copy()
+
+    monkeypatch.setattr(task_mod, "decode_actions", broken)
+    with pytest.raises(PlanError, match=f"agent {agent}: cannot serve search task"):
+        env.step({})
+    loose = TaskEnv(1, k=4, validate=False)
+    loose.reset(seed=0)
+    loose.step({})
