@@ -166,9 +166,15 @@ class Fire:
         self.terrain = rng.random((w + 1, w + 1), dtype=np.float32)
         #: (W, W) uint8 cell state: UNBURNT, BURNING or PRUNED.
         self.state = np.zeros((w, w), dtype=np.uint8)
-        self.visits = np.zeros((w, w), dtype=np.uint32)
+        self._visits = np.zeros((w, w), dtype=np.uint32)
         self._state_flat = self.state.reshape(-1)
-        self._visits_flat = self.visits.reshape(-1)
+        self._visits_flat = self._visits.reshape(-1)
+        # visits of ticks where every front moves are queued here (a row copy per tick) and
+        # added to the grid in one np.add.at when full or when someone reads ``visits``
+        self._visit_rows = np.zeros((_VISIT_ROWS, n), dtype=np.int64)
+        self._n_visit_rows = 0
+        self._z = np.empty((2, n))  # per-tick buffers: the draws, and the moves of all fronts
+        self._move = np.empty((2, n))
         #: (n,) int64 flat index of each front's current cell (valid while alive).
         self.cell = np.where(
             self.alive,
@@ -188,6 +194,10 @@ class Fire:
         self.n_burning = 0
         self.n_pruned = 0
         self.n_ignited = 0
+        #: ``[x0, x1, y0, y1]`` (inclusive, Python ints) box around every cell that burns: a
+        #: superset of the burning cells (cells pruned since may still lie inside), empty
+        #: (``x0 > x1``) when nothing burns. Lets callers skip areas without a numpy call.
+        self.burn_box = [w, -1, w, -1]
 
     # ------------------------------------------------------------------ queries
     @property
@@ -207,6 +217,18 @@ class Fire:
     @y.setter
     def y(self, value) -> None:
         self._xy[1] = value
+
+    @property
+    def visits(self) -> np.ndarray:
+        """(W, W) uint32 front-ticks spent in each cell (up to date; writable)."""
+        if self._n_visit_rows:
+            self._flush_visits()
+        return self._visits
+
+    def _flush_visits(self) -> None:
+        k = self._n_visit_rows
+        np.add.at(self._visits_flat, self._visit_rows[:k].reshape(-1), _ONE)
+        self._n_visit_rows = 0
 
     @property
     def live(self) -> np.ndarray:
@@ -267,14 +289,45 @@ class Fire:
         if n == 0:
             return fresh
         if n <= _SMALL:  # a few cells (every tick of a normal fire): Python ints are cheaper
-            w, nblk, blocks = self.world_size, self._nblk, self._block_flat
-            cells = sorted(set(fresh.tolist())) if n > 1 else fresh.tolist()
-            for c in cells:
-                blocks[(c // w // BLOCK) * nblk + (c % w) // BLOCK] += 1
-            fresh = np.array(cells, dtype=np.int64)
-        else:
-            fresh = _unique(fresh)
-            np.add.at(self._block_flat, self._block_of(fresh), _ONE32)
+            return self._ignite_cells(fresh.tolist())
+        fresh = _unique(fresh)
+        np.add.at(self._block_flat, self._block_of(fresh), _ONE32)
+        w = self.world_size
+        ys = fresh % w
+        return self._burn(
+            fresh, int(fresh[0]) // w, int(fresh[-1]) // w, int(ys.min()), int(ys.max())
+        )
+
+    def _ignite_cells(self, cells: list) -> np.ndarray:
+        """:meth:`_ignite` of a short list of unburnt flat cells (Python ints, repeats allowed)."""
+        if not cells:
+            return _EMPTY
+        w, nblk, blocks = self.world_size, self._nblk, self._block_flat
+        if len(cells) > 1:
+            cells = sorted(set(cells))
+        y0, y1 = w, -1
+        for c in cells:
+            cx, cy = divmod(c, w)
+            blocks[(cx // BLOCK) * nblk + cy // BLOCK] += 1
+            if cy < y0:
+                y0 = cy
+            if cy > y1:
+                y1 = cy
+        # (cells are sorted: x grows along the list)
+        return self._burn(np.array(cells, dtype=np.int64), cells[0] // w, cells[-1] // w, y0, y1)
+
+    def _burn(self, fresh: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndarray:
+        """Set the (unique, unburnt) cells ``fresh`` burning, spanning ``[x0, x1] x [y0, y1]``
+        (blocks already counted); return ``fresh``."""
+        box = self.burn_box
+        if x0 < box[0]:
+            box[0] = x0
+        if x1 > box[1]:
+            box[1] = x1
+        if y0 < box[2]:
+            box[2] = y0
+        if y1 > box[3]:
+            box[3] = y1
         self._state_flat[fresh] = BURNING
         self.n_burning += int(fresh.size)
         self.n_ignited += int(fresh.size)
@@ -296,7 +349,7 @@ class Fire:
                 self._moving = None
                 new = self._ignite(self.cell[self.alive & waking[self.region]])
             self._set_next_wake()
-        z = self.rng.standard_normal((2, self.n_fronts))
+        z = self.rng.standard_normal(out=self._z)  # (the same draws as size=(2, n))
         if self._moving is None:
             self._refresh_moving()
         idx = self._moving
@@ -304,7 +357,11 @@ class Fire:
             return new
         all_moving = self._all_moving
         if all_moving:  # common case: no gathers, update the positions in place
-            np.add.at(self._visits_flat, self.cell, _ONE)
+            k = self._n_visit_rows
+            self._visit_rows[k] = self.cell
+            self._n_visit_rows = k + 1
+            if k + 1 == _VISIT_ROWS:
+                self._flush_visits()
             xy, zs = self._xy, z
         else:
             np.add.at(self._visits_flat, self.cell[idx], _ONE)
@@ -316,7 +373,7 @@ class Fire:
         cell_xy = np.rint(xy).astype(np.int64)
         fuel = self.terrain[cell_xy[0], cell_xy[1]]
         c = fuel * self._m_fuel_dt * _ratio(ut[0])
-        move = np.empty_like(xy)
+        move = self._move if all_moving else np.empty_like(xy)
         np.sin(ut[1], out=move[0])
         np.cos(ut[1], out=move[1])
         move *= c
@@ -337,14 +394,27 @@ class Fire:
         self.cell[idx] = flat
         # A front that stepped into a pruned cell freezes there (and does not burn it).
         st = self._state_flat[flat]
-        into_pruned = st == _PRUNED8
-        if np.count_nonzero(into_pruned):
-            self.frozen[
-                self._moving[into_pruned] if isinstance(idx, slice) else idx[into_pruned]
-            ] = True
-            self._moving = None
-        fresh = self._ignite(flat, st)
+        if flat.size <= _SMALL:  # a few fronts: the checks below on Python ints
+            st_list = st.tolist()
+            if PRUNED in st_list:
+                self._freeze(st, idx)
+            fresh = self._ignite_cells(
+                [c for c, v in zip(flat.tolist(), st_list, strict=True) if v == UNBURNT]
+            )
+        else:
+            if np.count_nonzero(st == _PRUNED8):
+                self._freeze(st, idx)
+            fresh = self._ignite(flat, st)
         return fresh if new.size == 0 else np.concatenate([new, fresh])
+
+    def _freeze(self, st: np.ndarray, idx) -> None:
+        """Freeze the moving fronts (rows ``idx``, or all moving ones) whose new cell, of state
+        ``st``, is pruned."""
+        into_pruned = st == _PRUNED8
+        self.frozen[self._moving[into_pruned] if isinstance(idx, slice) else idx[into_pruned]] = (
+            True
+        )
+        self._moving = None
 
     def _set_next_wake(self) -> None:
         """Tick at which the next inactive region activates (never: a huge number)."""
@@ -375,6 +445,8 @@ class Fire:
         np.subtract.at(self._block_flat, self._block_of(hit), _ONE32)
         self.n_burning -= int(hit.size)
         self.n_pruned += int(hit.size)
+        if self.n_burning == 0:
+            self.burn_box = [self.world_size, -1, self.world_size, -1]
         self.frozen |= self.alive & (self._state_flat[self.cell] == PRUNED)
         self._moving = None
         return hit
@@ -435,3 +507,4 @@ _ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
 _SD = np.array([[WIND_SPEED_SD], [WIND_DIR_SD_RAD]])  # (2, 1) draw scales: wind speed, direction
 _UNBURNT8, _BURNING8, _PRUNED8 = np.uint8(UNBURNT), np.uint8(BURNING), np.uint8(PRUNED)
 _SMALL = 32  # up to this many fresh cells, _ignite works on Python ints
+_VISIT_ROWS = 256  # ticks of front visits queued before they are added to the grid

@@ -2,7 +2,9 @@
 
 Agents are held as arrays (one row per agent, scenario order: perception, action, hybrid) so a tick
 moves the whole team with a few numpy operations. Only agents that *arrive* somewhere (a goal, the
-depot) are handled one by one, which happens a few times per second at most.
+depot) are handled one by one, which happens a few times per second at most. Teams of up to
+:data:`SMALL_TEAM` agents are moved by a loop on Python floats instead (numpy's per-call cost
+dominates there); it performs the same IEEE operations and gives bit-identical states (tested).
 
 Rules (ARCHITECTURE.md "Agents", FIRECOMMANDER.md section 4, rescaled to ``ticks_per_second``):
 
@@ -56,6 +58,8 @@ DRAIN_PER_HOVER_TICK = 0.05  # at 10 ticks/s
 ACTION_ALTITUDE = 30.0
 CLIMB_PER_TICK = 5.0  # m per tick at 10 ticks/s
 ACTION_IDLE_LIMIT_S = 3.0
+#: teams up to this many agents move on Python floats (:meth:`Team.move`)
+SMALL_TEAM = 16
 
 
 class Mode(IntEnum):
@@ -182,6 +186,12 @@ class Team:
         self._speed_margin = 2.0 * DRAIN_PER_PX * self.speed  # (speed is fixed per team)
         self._climb = CLIMB_PER_TICK * self.tick_scale
         self._is_action = self.role == _ROLE_ACTION
+        # the small-team path of move() reads these constants as Python numbers
+        self._small = 0 < n <= SMALL_TEAM
+        self._home_list = [tuple(h) for h in self.home.tolist()]
+        self._speed_list = self.speed.tolist()
+        self._speed_margin_list = self._speed_margin.tolist()
+        self._can_sense_list = self.can_sense.tolist()
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -228,6 +238,19 @@ class Team:
         # [x, x, y, y] + z [-tan_x, tan_x, -tan_y, tan_y]: z (-t) is exactly -(t z), and
         # x + (-h) is exactly x - h, so this equals [x - hx, x + hx, y - hy, y + hy]
         return self.pos.repeat(2, axis=1) + self.z[:, None] * _FOV_SCALE
+
+    def fov_rects_and_list(self) -> tuple[np.ndarray, list]:
+        """:meth:`fov_rects` and the same rectangles as nested Python lists."""
+        if not self._small:
+            rects = self.fov_rects()
+            return rects, rects.tolist()
+        # the same operations as fov_rects on Python floats: x + z (-t) per bound
+        ax, bx, ay, by = _FOV_SCALE_LIST
+        rects = [
+            [x + z * ax, x + z * bx, y + z * ay, y + z * by]
+            for (x, y), z in zip(self.pos.tolist(), self.z.tolist(), strict=True)
+        ]
+        return np.array(rects, dtype=np.float64), rects
 
     def sensing_confidence(self) -> np.ndarray:
         """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""
@@ -292,7 +315,18 @@ class Team:
 
     # ------------------------------------------------------------------ dynamics
     def move(self) -> np.ndarray:
-        """Move every agent one tick; return the rows that arrived at a route goal this tick."""
+        """Move every agent one tick; return the rows that arrived at a route goal this tick.
+
+        Teams of up to :data:`SMALL_TEAM` agents take :meth:`_move_small` (the same IEEE
+        operations on Python floats: a few numpy calls cost more than the whole loop there),
+        larger ones :meth:`_move_vector`; both give bit-identical states.
+        """
+        if self._small:
+            return self._move_small()
+        return self._move_vector()
+
+    def _move_vector(self) -> np.ndarray:
+        """:meth:`move` with numpy on the whole team."""
         # (np.count_nonzero is the cheapest "any" on these tiny arrays)
         mode = self.mode
         active = mode == _ACTIVE8
@@ -326,6 +360,121 @@ class Team:
             arrived_goal = _NO_ROWS
             self._rules(active)
         return arrived_goal
+
+    def _move_small(self) -> np.ndarray:
+        """:meth:`_move_vector` agent by agent on Python floats (same operations, same order, so
+        the same rounding; ``hypot`` is numpy's, or ``|d|`` when one component is zero, which
+        C's Annex F makes exact)."""
+        mode = self.mode.tolist()
+        pos = self.pos.tolist()
+        battery = self.battery.tolist()
+        hover_s = self.hover_s.tolist()
+        active = [m == _ACTIVE for m in mode]
+        any_active = True in active
+        # flying: going home (RETURNING, HOMING) or ACTIVE with a goal
+        flying = [
+            m >= _RETURNING or (m == _ACTIVE and h)
+            for m, h in zip(mode, self.has_goal.tolist(), strict=True)
+        ]
+        arrive = None
+        flat = None  # new positions, flat [x0, y0, x1, y1, ...]
+        if True in flying or any(x == 0.0 or y == 0.0 for x, y in pos):
+            goal = self.goal.tolist()
+            home = self._home_list
+            legs, deferred = [], []  # (target, dx, dy, dist) per agent; rows needing hypot
+            any_hover = False
+            for i, (x, y) in enumerate(pos):
+                t = home[i] if mode[i] >= _RETURNING else goal[i]
+                dx, dy = t[0] - x, t[1] - y
+                if dy == 0.0:  # hypot(x, +-0) is |x| exactly (C99 Annex F)
+                    d = abs(dx)
+                elif dx == 0.0:
+                    d = abs(dy)
+                else:
+                    d = 0.0
+                    deferred.append(i)
+                legs.append((t, dx, dy, d))
+                if active[i] and not flying[i]:
+                    any_hover = True
+            if deferred:
+                h = np.hypot([legs[i][1] for i in deferred], [legs[i][2] for i in deferred])
+                for i, d in zip(deferred, h.tolist(), strict=True):
+                    legs[i] = (*legs[i][:3], d)
+            distance = self.distance.tolist()
+            hd, dt, flat, arrive = self._hover_drain, self.dt_s, [], []
+            for i, ((x, y), (t, dx, dy, d), f, sp) in enumerate(
+                zip(pos, legs, flying, self._speed_list, strict=True)
+            ):
+                arr = f and d <= sp
+                arrive.append(arr)
+                step = d if arr else sp * f
+                if arr:
+                    flat += t
+                else:
+                    den = max(d, _TINY_F)  # (a NaN distance stays NaN, as np.maximum)
+                    flat += (x + dx / den * step, y + dy / den * step)
+                distance[i] += step
+                if any_hover:
+                    hov = active[i] and not f
+                    battery[i] -= DRAIN_PER_PX * step + hd * hov
+                    hover_s[i] = hover_s[i] + dt if hov else 0.0
+                else:
+                    battery[i] -= DRAIN_PER_PX * step
+            if not any_hover:
+                hover_s = None
+            self.pos = np.array(flat, dtype=np.float64).reshape(self.n, 2)
+            self.distance[:] = distance
+            self.battery[:] = battery
+        elif any_active:
+            hd = self._hover_drain
+            battery = [b - hd * a for b, a in zip(battery, active, strict=True)]
+            hover_s = [h + self.dt_s if a else 0.0 for h, a in zip(hover_s, active, strict=True)]
+            self.battery[:] = battery
+        else:
+            hover_s = None
+        self.hover_s = np.zeros(self.n) if hover_s is None else np.array(hover_s, np.float64)
+        # altitude
+        z, zt = self.z.tolist(), self.z_target.tolist()
+        if z != zt:  # (NaN targets compare unequal, as in the vector path)
+            climb, lo = self._climb, -self._climb
+            self.z[:] = [
+                zi + min(max(t - zi, lo), climb) * s
+                for zi, t, s in zip(z, zt, self._can_sense_list, strict=True)
+            ]
+        if arrive is not None and True in arrive:
+            arrive_a = np.array(arrive)
+            going_home = np.array(mode) >= _RETURNING
+            for i in (arrive_a & going_home).nonzero()[0].tolist():
+                self._dock(i)
+            arrived_goal = (arrive_a & np.array(active)).nonzero()[0]
+            for i in arrived_goal.tolist():
+                self._next_goal(i)
+            self._rules()  # docking changed modes
+            return arrived_goal
+        if any_active:
+            if flat is None:
+                xs, ys = [p[0] for p in pos], [p[1] for p in pos]
+            else:
+                xs, ys = flat[0::2], flat[1::2]
+            if not self._rules_idle(xs, ys, battery, hover_s, active):
+                self._rules(np.array(active))
+        return _NO_ROWS
+
+    def _rules_idle(
+        self, xs: list, ys: list, battery: list, hover_s: list | None, active: list
+    ) -> bool:
+        """True if :meth:`_rules` certainly does nothing: no hover clock at the 3-second limit,
+        and every active agent's battery is above an upper bound of its reserve (the reserve
+        uses ``hypot(d) <= |dx| + |dy|``; the bound's margin covers every rounding)."""
+        if hover_s is not None and max(hover_s) >= _IDLE_LIMIT_F:
+            return False
+        hm = self._hover_margin
+        for x, y, b, a, (hx, hy), sm in zip(
+            xs, ys, battery, active, self._home_list, self._speed_margin_list, strict=True
+        ):
+            if a and not b > (DRAIN_PER_PX * (abs(hx - x) + abs(hy - y)) + sm + hm) * _BOUND:
+                return False
+        return True
 
     def _fly(self, flying: np.ndarray, going_home: np.ndarray, active: np.ndarray) -> np.ndarray:
         """One step toward each flying agent's target; return the (N,) bool rows that arrived."""
@@ -430,6 +579,10 @@ class Team:
 _NO_ROWS = np.zeros(0, dtype=np.int64)
 _ACTIVE8, _RETURNING8 = np.int8(_ACTIVE), np.int8(_RETURNING)
 _IDLE_LIMIT = np.float64(ACTION_IDLE_LIMIT_S - 1e-9)
+_IDLE_LIMIT_F = float(_IDLE_LIMIT)
+_TINY_F = 5e-324
+_BOUND = 1.0 + 1e-9  # relative margin of _rules_idle's reserve bound
 _ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
 _TINY = np.float64(5e-324)  # smallest positive double
 _FOV_SCALE = np.array([-FOV_TAN_X, FOV_TAN_X, -FOV_TAN_Y, FOV_TAN_Y])
+_FOV_SCALE_LIST = _FOV_SCALE.tolist()

@@ -143,6 +143,7 @@ class World:
         self.team = Team(scenario)
         self._tps = scenario.ticks_per_second
         self._sensing_rows = np.flatnonzero(self.team.can_sense).tolist()
+        self._can_act = self.team.can_act.tolist()
         self.sensed = np.zeros((w, w), dtype=bool)
         self._sensed_flat = self.sensed.reshape(-1)
         facilities = scenario.scored_facilities
@@ -180,6 +181,7 @@ class World:
             "mode": np.zeros((rows, n), np.int8),
             "dumps": np.zeros((rows, n), np.int16),
         }
+        self._record_views()
 
     # ------------------------------------------------------------------ queries
     @property
@@ -251,24 +253,26 @@ class World:
         ignited = fire.step()
         if ignited.size:
             self._count_facilities(ignited, +1)
-        fov = team.fov_rects()
-        sensed, newly = self._sense(fov)
-        pruned, dumped = self._prune(fov)
+        fov, rects = team.fov_rects_and_list()
+        sensed, newly = self._sense(rects)
+        pruned, dumped = self._prune(rects)
         self._record()
-        return StepInfo(
-            tick=self.tick,
-            time_s=self.tick / self._tps,
-            ignited=ignited,
-            sensed=sensed,
-            newly_sensed=newly,
-            pruned=pruned,
-            fov=fov,
-            dumped=tuple(dumped),
-            arrived=tuple(arrived.tolist()),
+        return StepInfo(  # (positional: cheaper than keywords on this per-tick path)
+            self.tick,  # tick
+            self.tick / self._tps,  # time_s
+            ignited,
+            sensed,
+            newly,  # newly_sensed
+            pruned,
+            fov,
+            tuple(dumped),
+            tuple(arrived.tolist()),  # arrived
         )
 
     def _count_facilities(self, flat: np.ndarray, sign: int) -> np.ndarray:
         lab = self._labels_flat[flat]
+        if lab.size <= 32 and max(lab.tolist(), default=-1) < 0:  # (usual: no facility there)
+            return _EMPTY16
         inside = lab >= _ZERO16
         if not np.count_nonzero(inside):  # (the usual case: no facility there)
             return _EMPTY16
@@ -277,16 +281,21 @@ class World:
         self.facility_burning += sign * counts
         return counts
 
-    def _sense(self, fov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _sense(self, rects: list) -> tuple[np.ndarray, np.ndarray]:
         fire = self.fire
         if fire.n_burning == 0:  # nothing to sense (and no random draws, as in the loop below)
             return _EMPTY, _EMPTY
         team, w = self.team, self.world_size
         state, blocks = fire.state, fire.block_burning
-        rects = fov.tolist()
+        bx0, bx1, by0, by1 = fire.burn_box
         parts = []
         for i in self._sensing_rows:
-            sl = _cell_range(rects[i], w)
+            r = rects[i]
+            # no burning cell in view (every cell of the range is outside the fire's box): the
+            # scan below would find none and draw nothing
+            if r[1] < bx0 or r[0] > bx1 or r[3] < by0 or r[2] > by1:
+                continue
+            sl = _cell_range(r, w)
             if sl is None:
                 continue
             box = _burning_box(blocks, *sl)
@@ -309,18 +318,30 @@ class World:
             self.n_sensed_ever += int(newly.size)
         return sensed, newly
 
-    def _prune(self, fov: np.ndarray) -> tuple[np.ndarray, list[int]]:
+    def _prune(self, rects: list) -> tuple[np.ndarray, list[int]]:
         team, w = self.team, self.world_size
-        if not np.count_nonzero(team.armed):
+        armed = team.armed.tolist()
+        if True not in armed:
             return _EMPTY, []
-        armed = np.flatnonzero(team.armed & team.can_act & (team.tank > 0))
-        if armed.size == 0:
+        fire = self.fire
+        if fire.n_burning == 0:  # no dump can find a burning cell
+            return _EMPTY, []
+        bx0, bx1, by0, by1 = fire.burn_box
+        # armed, able to act, tank not empty, and a burning cell may be in view (outside the
+        # fire's box the scan below finds nothing: no draw, no dump)
+        rows = [
+            i
+            for i, (a, act, t, r) in enumerate(
+                zip(armed, self._can_act, team.tank.tolist(), rects, strict=True)
+            )
+            if a and act and t > 0 and not (r[1] < bx0 or r[0] > bx1 or r[3] < by0 or r[2] > by1)
+        ]
+        if not rows:
             return _EMPTY, []
         reference_gate = self.scenario.action_gate == "reference"
-        state, sensed, blocks = self.fire.state, self.sensed, self.fire.block_burning
-        rects = fov.tolist()
+        state, sensed, blocks = fire.state, self.sensed, fire.block_burning
         parts, dumped = [], []
-        for i in armed.tolist():
+        for i in rows:
             sl = _cell_range(rects[i], w)
             if sl is None:
                 continue
@@ -354,25 +375,48 @@ class World:
             return _EMPTY, dumped
         return (parts[0] if len(parts) == 1 else np.concatenate(parts)), dumped
 
+    def _record_views(self) -> None:
+        """Cache the trace arrays (and the xy and z parts of ``xyz``) for :meth:`_record`."""
+        r = self._rows
+        self._row_views = (
+            len(r["active"]),
+            r["active"],
+            r["pruned"],
+            r["sensed_active"],
+            r["sensed_ever"],
+            r["facility_burning"],
+            r["facility_pruned"],
+            r["xyz"][:, :, :2],
+            r["xyz"][:, :, 2],
+            r["battery"],
+            r["tank"],
+            r["mode"],
+            r["dumps"],
+        )
+
     def _record(self) -> None:
         k = self.tick - 1
-        rows = self._rows
-        if k >= len(rows["active"]):
+        if k >= self._row_views[0]:
+            rows = self._rows
             for name, arr in rows.items():
                 rows[name] = np.concatenate([arr, np.zeros_like(arr)])
-        team = self.team
-        rows["active"][k] = self.fire.n_burning
-        rows["pruned"][k] = self.fire.n_pruned
-        rows["sensed_active"][k] = self.n_sensed_active
-        rows["sensed_ever"][k] = self.n_sensed_ever
-        rows["facility_burning"][k] = self.facility_burning
-        rows["facility_pruned"][k] = self.facility_pruned
-        rows["xyz"][k, :, :2] = team.pos
-        rows["xyz"][k, :, 2] = team.z
-        rows["battery"][k] = team.battery
-        rows["tank"][k] = team.tank
-        rows["mode"][k] = team.mode
-        rows["dumps"][k] = team.dumps
+            self._record_views()
+        _, active, pruned, s_active, s_ever, f_burning, f_pruned, xy, z, bat, tank, mode, dumps = (
+            self._row_views
+        )
+        team, fire = self.team, self.fire
+        active[k] = fire.n_burning
+        pruned[k] = fire.n_pruned
+        s_active[k] = self.n_sensed_active
+        s_ever[k] = self.n_sensed_ever
+        f_burning[k] = self.facility_burning
+        f_pruned[k] = self.facility_pruned
+        xy[k] = team.pos
+        z[k] = team.z
+        bat[k] = team.battery
+        tank[k] = team.tank
+        mode[k] = team.mode
+        dumps[k] = team.dumps
 
 
 def _spawn(seed, n: int) -> list[np.random.Generator]:

@@ -109,10 +109,10 @@ from fcplan.env import EnvError
 from fcplan.env.motion_grid import (
     AGENTS,
     FACILITY,
-    KNOWN,
+    KNOWN_N,
     LAKE,
     LAST_SEEN,
-    PRUNED,
+    PRUNED_N,
     CoarseMaps,
 )
 from fcplan.team import CLIMB_PER_TICK, DRAIN_PER_PX
@@ -151,6 +151,8 @@ _N_FOV = 7
 _N_STATE = 8
 # team modes (fcplan.team.Mode)
 _IDLE, _ACTIVE = 0, 1
+#: mode one-hot features (idle, active, returning, homing) per team mode
+_ONE_HOT = tuple(tuple(float(m == k) for k in range(4)) for m in range(4))
 #: a move sets a goal this many steps away, so the agent never arrives (see MotionEnv.step)
 _GOAL_REACH = 1.5
 
@@ -354,8 +356,8 @@ class MotionEnv(_parallel_base()):
                 inv_span.tolist(),
                 self._inv_cap.tolist(),
                 self._inv_tank.tolist(),
-                team.can_sense.tolist(),
-                team.can_act.tolist(),
+                team.can_sense.astype(np.float64).tolist(),
+                team.can_act.astype(np.float64).tolist(),
                 (team.speed / w).tolist(),
                 self._drain_per_cap.tolist(),
                 team.speed.tolist(),
@@ -384,6 +386,8 @@ class MotionEnv(_parallel_base()):
         self._tick_rate = float(self.scenario.ticks_per_second)
         self._n_ticks = self.scenario.n_ticks
         self._penalties = world.facility_penalties
+        self._fb_last = None
+        self._fb_penalty = 0.0
         self._pw = self.scenario.scoring.propagation_weight
         self.agents = list(self.possible_agents)
         self._last_info = None
@@ -415,7 +419,8 @@ class MotionEnv(_parallel_base()):
                 if pos is None:
                     pos = team.pos.tolist()
                 x, y = pos[i]
-                goal[i] = (x + dx, y + dy)
+                goal[i, 0] = x + dx
+                goal[i, 1] = y + dy
                 has_goal[i] = True
                 mode[i] = _ACTIVE
                 continue
@@ -435,7 +440,11 @@ class MotionEnv(_parallel_base()):
         self._maps.update(info, world)
         self._last_info = info
         # reward
-        r = -(self._pw * world.fire.n_burning + float(self._penalties @ world.facility_burning))
+        fb = world.facility_burning.tolist()
+        if fb != self._fb_last:  # (facility counts change rarely: reuse the penalty sum)
+            self._fb_last = fb
+            self._fb_penalty = float(self._penalties @ world.facility_burning)
+        r = -(self._pw * world.fire.n_burning + self._fb_penalty)
         r /= self._tick_rate
         if self._shaping:
             r += self.sense_bonus * info.newly_sensed.size + self.prune_bonus * info.pruned.size
@@ -467,13 +476,15 @@ class MotionEnv(_parallel_base()):
         if self._n > _PY_AGENTS:
             vec, mask = self._agent_vectors(), self._masks()
             self._free_list = self._free.tolist()
+            self._mask_lists = mask.tolist()
             cell = (team.pos // self.cell_px).astype(np.int64)  # agents never leave the map
             return vec, mask, cell[:, 0].tolist(), cell[:, 1].tolist()
         cpx = self.cell_px
         pos, z, zt = team.pos.tolist(), team.z.tolist(), team.z_target.tolist()
         bat, tank, mode = team.battery.tolist(), team.tank.tolist(), team.mode.tolist()
         tf = self._world.tick / self._n_ticks
-        vecs, rows, free_all, cxs, cys = [], [], [], [], []
+        vecs: list = []
+        rows, free_all, cxs, cys = [], [], [], []
         for st, (x, y), zi, zti, bi, ti, m in zip(
             self._py, pos, z, zt, bat, tank, mode, strict=True
         ):
@@ -482,24 +493,19 @@ class MotionEnv(_parallel_base()):
             zn = (zi - lo) * inv_span
             free = m <= _ACTIVE
             home = math.sqrt((hx - x) ** 2 + (hy - y) ** 2) * drain
-            vecs.append(
-                (
-                    x * inv_w,
-                    y * inv_w,
-                    zn,
-                    bi * inv_cap,
-                    ti * inv_tank,
-                    home if home < 1.0 else 1.0,
-                    m == 0,
-                    m == 1,
-                    m == 2,
-                    m == 3,
-                    sense,
-                    act,
-                    tf,
-                    (max(1.0 - 0.6 * zn, 0.4) if sense else 0.0),
-                    spw,
-                )
+            vecs += (
+                x * inv_w,
+                y * inv_w,
+                zn,
+                bi * inv_cap,
+                ti * inv_tank,
+                home if home < 1.0 else 1.0,
+                *_ONE_HOT[m],
+                sense,
+                act,
+                tf,
+                (max(1.0 - 0.6 * zn, 0.4) if sense else 0.0),
+                spw,
             )
             # the action table's order: stay, west, east, north, south, then role actions
             moves = (
@@ -519,7 +525,9 @@ class MotionEnv(_parallel_base()):
             cxs.append(int(x // cpx))
             cys.append(int(y // cpx))
         self._free_list = free_all
-        return np.array(vecs, dtype=np.float32), np.array(rows, dtype=np.int8), cxs, cys
+        self._mask_lists = rows
+        vec = np.array(vecs, dtype=np.float32).reshape(self._n, _N_AGENT_FEATURES)
+        return vec, np.array(rows, dtype=np.int8), cxs, cys
 
     def _masks(self) -> np.ndarray:
         """(n, 8) int8 legal actions, from a (n, 8) table of conditions picked per action."""
@@ -568,15 +576,13 @@ class MotionEnv(_parallel_base()):
         vec, mask, cx, cy = self._agent_arrays()
         k = self._n_actions_list
         rows = [mask[i, : k[i]] for i in range(self._n)]
-        self._mask_lists = mask.tolist()
         maps.place_agents(cx, cy)
-        g = maps.windows[:_N_FOV, cx, cy]  # (7, n, V, V), a fresh array
-        g[LAST_SEEN] += maps.stamp(self._world.tick)  # staleness (clipped below)
-        g[KNOWN : PRUNED + 1] *= self._inv_c
-        g[AGENTS, :, self._r, self._r] -= 1.0  # others only
-        head = g[: AGENTS + 1]  # counts and age: clip to 1 (the rest is <= 1 already)
-        np.minimum(head, 1.0, out=head)
-        fov = g.transpose(1, 0, 2, 3)
+        fov = maps.crops(cx, cy, _N_FOV)  # (n, 7, V, V), a fresh array
+        # known and pruned come scaled and clipped; staleness and agents are clipped here
+        fov[:, LAST_SEEN] += maps.stamp(self._world.tick)
+        fov[:, AGENTS, self._r, self._r] -= 1.0  # others only
+        tail = fov[:, LAST_SEEN : AGENTS + 1]
+        np.minimum(tail, 1.0, out=tail)
         return {
             a: {"fov": fov[i], "agent": vec[i], "action_mask": rows[i]}
             for i, a in enumerate(self.possible_agents)
@@ -590,8 +596,8 @@ class MotionEnv(_parallel_base()):
         s = np.zeros((_N_STATE, nc, nc), dtype=np.float32)
         inv_c = 1.0 / self.cell_px
         np.minimum(maps.burning_layer() * inv_c, 1.0, out=s[0])
-        np.minimum(inner[KNOWN] * inv_c, 1.0, out=s[1])
-        np.minimum(inner[PRUNED] * inv_c, 1.0, out=s[2])
+        np.minimum(inner[KNOWN_N] * inv_c, 1.0, out=s[1])
+        np.minimum(inner[PRUNED_N] * inv_c, 1.0, out=s[2])
         np.minimum(inner[LAST_SEEN] + maps.stamp(self._world.tick), 1.0, out=s[3])
         cx, cy = maps.cells(team.pos)
         np.add.at(s[4], (cx[team.can_sense], cy[team.can_sense]), 1.0)

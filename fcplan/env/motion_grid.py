@@ -10,8 +10,9 @@ Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px
 ``r = view // 2`` cells of padding):
 
 ===  ==============  =====================================================================
- 0   ``known``       known burning px in the cell (sensed, not yet pruned)
- 1   ``pruned``      pruned px in the cell
+ 0   ``known``       known burning px in the cell (sensed, not yet pruned) / ``cell_px``,
+                     clipped to 1 (the count itself is layer 8, ``known_n``)
+ 1   ``pruned``      pruned px in the cell / ``cell_px``, clipped to 1 (count: layer 9)
  2   ``seen``        minus the tick the cell last overlapped a sensing agent's field of view,
                      times ``seen_scale`` (``+inf``: never, and outside the map), so that
                      ``min(1, seen + tick * seen_scale)`` is the cell's staleness
@@ -22,7 +23,12 @@ Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px
                      weighted by its penalty / 5
  7   ``burning``     true burning px in the cell (global state only; read it through
                      :meth:`CoarseMaps.burning_layer`)
+ 8   ``known_n``     known burning px in the cell
+ 9   ``pruned_n``    pruned px in the cell
 ===  ==============  =====================================================================
+
+Layers 0-1 are kept scaled and clipped (updated with their counts, a few cells per tick), so an
+observation crop needs no arithmetic on them.
 
 Examples
 --------
@@ -31,12 +37,12 @@ Examples
 >>> world = World().reset(load_scenario("practice"), seed=0)
 >>> maps = CoarseMaps(world.scenario, cell_px=20, view=5)
 >>> maps.grid.shape
-(8, 64, 64)
+(10, 64, 64)
 >>> info = world.step()
 >>> maps.update(info, world)
 >>> win = maps.gather(np.array([[0.0, 0.0]]))  # (L, N, view, view) around (0, 0)
 >>> win.shape, float(win[OUTSIDE, 0, 0, 0]), float(win[OUTSIDE, 0, 2, 2])
-((8, 1, 5, 5), 1.0, 0.0)
+((10, 1, 5, 5), 1.0, 0.0)
 """
 
 from __future__ import annotations
@@ -56,10 +62,14 @@ __all__ = [
     "LAKE",
     "FACILITY",
     "BURNING",
+    "KNOWN_N",
+    "PRUNED_N",
 ]
 
-KNOWN, PRUNED, LAST_SEEN, AGENTS, OUTSIDE, LAKE, FACILITY, BURNING = range(8)
-N_LAYERS = 8
+KNOWN, PRUNED, LAST_SEEN, AGENTS, OUTSIDE, LAKE, FACILITY, BURNING, KNOWN_N, PRUNED_N = range(10)
+N_LAYERS = 10
+#: the count layer behind each scaled layer
+_COUNT_OF = {KNOWN: KNOWN_N, PRUNED: PRUNED_N}
 #: changes of up to this many cells are applied one by one (cheaper than np.add.at)
 _SMALL = 16
 #: maps up to this many px use a cached px -> coarse-cell lookup table (4 bytes per px)
@@ -101,6 +111,7 @@ class CoarseMaps:
         c = int(cell_px)
         self.world_size, self.cell_px, self.view = w, c, int(view)
         self.seen_scale = float(seen_scale)
+        self._inv_c = 1.0 / c  # a Python float: the fastest scalar for numpy
         self.radius = r = self.view // 2
         self.nc = nc = -(-w // c)
         self.grid = np.zeros((N_LAYERS, nc + 2 * r, nc + 2 * r), dtype=np.float32)
@@ -160,16 +171,26 @@ class CoarseMaps:
         return (flat // w // c + r) * self._h + (flat % w // c + r)
 
     def _add(self, layer: int, flat: np.ndarray, sign: float) -> None:
+        """Add ``sign`` per px of ``flat`` to ``layer`` (a scaled layer: to its count, then
+        rescale the cells touched)."""
         n = flat.size
         if n == 0:
             return
         idx = self.padded_index(flat)
+        scaled = self.flat[layer] if layer in _COUNT_OF else None
+        if scaled is not None:
+            layer = _COUNT_OF[layer]
+        grid = self.flat[layer]
         if n > _SMALL:
-            np.add.at(self.flat[layer], idx, sign)
+            np.add.at(grid, idx, sign)
+            if scaled is not None:  # (float32 count * Python float, as a float32 array op)
+                scaled[idx] = np.minimum(grid[idx] * self._inv_c, 1.0)
             return
-        grid = self.flat[layer]  # a few cells: scalar updates beat np.add.at's setup
+        # a few cells: scalar updates beat np.add.at's setup
         for j in idx.tolist():
             grid[j] += sign
+            if scaled is not None:
+                scaled[j] = min(grid[j] * self._inv_c, 1.0)
 
     def update(self, info, world) -> None:
         """Fold one tick (:class:`fcplan.world.StepInfo`) of ``world`` into the maps."""
@@ -218,10 +239,12 @@ class CoarseMaps:
         layer, replacing the previous placement (a loop over agents: a handful of scalar
         writes beat numpy's fancy indexing here)."""
         layer = self.flat[AGENTS]
-        for c in self._agent_cells:
-            layer[c] = 0.0
         h, off = self._h, self.radius * (self._h + 1)
         cells = [x * h + y + off for x, y in zip(cx, cy, strict=True)]
+        if cells == self._agent_cells:  # nobody changed cell
+            return
+        for c in self._agent_cells:
+            layer[c] = 0.0
         for c in cells:
             layer[c] += 1.0
         self._agent_cells = cells
@@ -231,6 +254,17 @@ class CoarseMaps:
         idx = (pos // self.cell_px).astype(np.int64)
         np.clip(idx, 0, self.nc - 1, out=idx)
         return idx[:, 0], idx[:, 1]
+
+    def crops(self, cx: list, cy: list, layers: int) -> np.ndarray:
+        """(N, layers, view, view) crops of the first ``layers`` layers centred on coarse cells
+        ``(cx[i], cy[i])`` (lists of int inside the map; a fresh C-contiguous array, filled by
+        one slice copy per agent)."""
+        v = self.view
+        out = np.empty((len(cx), layers, v, v), dtype=np.float32)
+        g = self.grid[:layers]
+        for i, (x, y) in enumerate(zip(cx, cy, strict=True)):
+            out[i] = g[:, x : x + v, y : y + v]
+        return out
 
     def gather(self, pos: np.ndarray) -> np.ndarray:
         """(L, N, view, view) crops centred on the coarse cells of ``pos`` (a fresh array)."""

@@ -1,0 +1,111 @@
+"""Tests for the speed paths of fcplan.team and fcplan.fire: the small-team Python path of
+``Team.move`` gives bit-identical states to the numpy path, the fire's ``burn_box`` always holds
+every burning cell, and queued front visits add up to the same grid."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fcplan.fire import BURNING
+from fcplan.scenario import load_scenario
+from fcplan.team import SMALL_TEAM, Command, Team
+from fcplan.world import World
+
+_STATE = ("pos", "z", "z_target", "battery", "tank", "mode", "goal", "has_goal", "armed",
+          "hover_s", "distance", "dumps", "sorties", "goal_index", "patrol")  # fmt: skip
+
+
+def _bits(a) -> bytes:
+    """Exact bytes of an array (so -0.0 and 0.0 differ)."""
+    a = np.asarray(a)
+    return a.dtype.str.encode() + str(a.shape).encode() + np.ascontiguousarray(a).tobytes()
+
+
+_coord = st.one_of(
+    st.sampled_from([0.0, 1.0, 60.0, 599.5, 1199.0]),
+    st.floats(-50.0, 1250.0, allow_nan=False, allow_infinity=False),
+)
+_command = st.one_of(
+    st.builds(
+        Command,
+        route=st.lists(st.tuples(_coord, _coord), min_size=0, max_size=3).map(tuple),
+        patrol=st.booleans(),
+        altitude=st.one_of(st.none(), st.floats(0.0, 150.0)),
+    ),
+    st.builds(Command, home=st.just(True)),
+    st.builds(Command, altitude=st.floats(0.0, 150.0)),
+)
+# per tick: maybe a command for one agent row, maybe a dump by one row, maybe a battery cut
+_tick = st.tuples(
+    st.one_of(st.none(), st.tuples(st.integers(0, 15), _command)),
+    st.one_of(st.none(), st.integers(0, 15)),
+    st.one_of(st.none(), st.tuples(st.integers(0, 15), st.floats(0.0, 1.0))),
+)
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return load_scenario(1)
+
+
+@settings(max_examples=200, deadline=None)
+@given(ticks=st.lists(_tick, min_size=1, max_size=60), moves=st.integers(0, 40))
+def test_small_team_path_is_bit_identical_to_the_vector_path(scenario, ticks, moves):
+    """Team.move on Python floats (teams <= SMALL_TEAM) and on numpy leave every state array
+    bit for bit equal, through routes (diagonal, axis-aligned, on the map edge), patrols, altitude
+    changes, going home, dumps, docking and forced returns on a low battery."""
+    small, vector = Team(scenario), Team(scenario)
+    assert small._small and small.n <= SMALL_TEAM
+    vector._small = False
+    for cmd, dump, cut in ticks:
+        for team in (small, vector):
+            if cmd is not None:
+                i = cmd[0] % team.n
+                team.apply({i: cmd[1]})
+            if dump is not None and team.tank[dump % team.n] > 0:
+                team.record_dump(dump % team.n)
+            if cut is not None:
+                i = cut[0] % team.n
+                team.battery[i] = team.battery_capacity[i] * cut[1]
+        for _ in range(1 + moves // 10):
+            a, b = small.move(), vector.move()
+            assert a.tolist() == b.tolist()
+            for name in _STATE:
+                assert _bits(getattr(small, name)) == _bits(getattr(vector, name)), name
+            assert small.routes[0].tolist() == vector.routes[0].tolist()
+            ra, la = small.fov_rects_and_list()
+            assert _bits(ra) == _bits(vector.fov_rects())
+            assert la == ra.tolist()
+
+
+@settings(max_examples=4, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), prune_every=st.integers(3, 40))
+def test_burn_box_holds_every_burning_cell_and_visits_add_up(scenario, seed, prune_every):
+    """The fire's burn_box contains every burning cell after every tick (with pruning), and the
+    queued visit rows give the same grid as adding every tick's visits at once (reading
+    ``visits`` every tick flushes the queue every tick)."""
+    worlds = [World().reset(scenario, seed=seed) for _ in range(2)]
+    rng = np.random.default_rng(seed)
+    for t in range(500):
+        picks = None
+        for k, world in enumerate(worlds):
+            fire = world.fire
+            world.step()
+            if k == 0:
+                fire.visits  # noqa: B018 - flushes the queue
+            if t % prune_every == 0 and fire.n_burning:
+                if picks is None:
+                    cells = np.flatnonzero(fire.state.reshape(-1) == BURNING)
+                    picks = rng.choice(cells, size=min(3, cells.size), replace=False)
+                fire.prune(picks)
+            xs, ys = np.nonzero(fire.state == BURNING)
+            if xs.size:
+                x0, x1, y0, y1 = fire.burn_box
+                assert x0 <= xs.min() and xs.max() <= x1 and y0 <= ys.min() and ys.max() <= y1
+    a, b = (w.fire for w in worlds)
+    assert a.visits.sum() > 0
+    np.testing.assert_array_equal(a.visits, b.visits)
+    np.testing.assert_array_equal(a.state, b.state)
