@@ -76,12 +76,12 @@ def run(args: argparse.Namespace) -> int:
         suffix = os.path.splitext(args.video)[1].lower()
         if suffix not in (".mp4", ".gif"):
             raise CliError(f"--video {args.video}: the file must end in .mp4 or .gif")
-    elif not has_display():
+    rec = load_recording(args.path)  # a bad file is the first thing to report
+    if not args.video and not has_display():
         raise CliError(
             "no display to open a replay window; write a video instead: "
             f"fcplan replay {args.path} --video out.mp4"
         )
-    rec = load_recording(args.path)
     if args.video:
         from fcplan.video import write_video
 
