@@ -135,6 +135,7 @@ class Fire:
         w = int(world_size)
         self.world_size = w
         self._w_float = np.float64(w)
+        self._stride = np.array([w, 1], dtype=np.int64)  # (x, y) -> flat x w + y
         self.ticks_per_second = int(ticks_per_second)
         self.dt = REFERENCE_TPS / self.ticks_per_second
         self.rng = rng
@@ -339,7 +340,6 @@ class Fire:
         Regions whose delay has passed activate first (their ignition cells burn); then every
         live, unfrozen front takes one FARSITE step.
         """
-        w = self.world_size
         self.tick += 1
         new = _EMPTY
         if self.tick >= self._next_wake:
@@ -389,8 +389,7 @@ class Fire:
             self.alive[idx[~inside]] = False
             self._moving = None
             idx, xy = idx[inside], xy[:, inside]
-        cell_xy = xy.astype(np.int64)
-        flat = cell_xy[0] * w + cell_xy[1]
+        flat = self._stride @ xy.astype(np.int64)  # x w + y, exact on int64 (one call)
         self.cell[idx] = flat
         # A front that stepped into a pruned cell freezes there (and does not burn it).
         st = self._state_flat[flat]

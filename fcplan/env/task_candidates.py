@@ -144,21 +144,28 @@ class Candidates:
 
     def action_mask(self) -> np.ndarray:
         """(A, k + 1) int8: legal candidate slots, then the always-legal no-op."""
-        a = self.rows.shape[0]
-        return np.concatenate([self.valid, np.ones((a, 1), dtype=bool)], axis=1).astype(np.int8)
+        a, k = self.rows.shape
+        out = np.ones((a, k + 1), dtype=np.int8)
+        out[:, :k] = self.valid
+        return out
 
 
 def legal_tasks(graph: TaskGraph) -> np.ndarray:
     """(A, T) bool: one-task routes :func:`fcplan.plan.validate_plan` accepts (same arithmetic)."""
+    forced = graph.agent_mode == _RETURNING
+    return _legal(graph, forced, forced.tolist())
+
+
+def _legal(graph: TaskGraph, forced: np.ndarray, forced_l: list) -> np.ndarray:
+    """:func:`legal_tasks` given the forced-return flags (array and list)."""
     dh = graph.task_home_distance
     ok = 2.0 * dh <= (graph.agent_full_range + 1e-6)[:, None]
     ok &= graph.can_do
-    forced = graph.agent_mode == _RETURNING
-    if forced.all():
+    if all(forced_l):
         return ok
     reach = graph.agent_task_distance + dh
     reach = reach <= (graph.agent_battery / DRAIN_PER_PX + 1e-6)[:, None]
-    if forced.any():
+    if True in forced_l:
         reach |= forced[:, None]
     ok &= reach
     return ok
@@ -181,10 +188,11 @@ def _candidates(rows, start_distance, priority, freshness, legal) -> Candidates:
 def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candidates:
     """The ``k`` most relevant legal tasks of every agent (see the module docstring)."""
     n_a, n_t = graph.n_agents, graph.n_tasks
-    legal = legal_tasks(graph)
     forced = graph.agent_mode == _RETURNING
+    forced_l = forced.tolist()  # a handful of agents: Python any/all beat numpy's reductions
+    legal = _legal(graph, forced, forced_l)
     d_start = graph.agent_task_distance
-    if forced.any():
+    if True in forced_l:
         d_start = np.where(forced[:, None], graph.task_home_distance, d_start)
     kind = graph.task_kind
     n_f = n_t - int(np.count_nonzero(kind)) if n_t else 0  # fires (kind 0) come first
