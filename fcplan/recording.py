@@ -428,33 +428,10 @@ class Recording:
     # ------------------------------------------------------------------ scores
     def trace(self):
         """The per-tick :class:`fcplan.trace.Trace`, rebuilt from the arrays and the scenario."""
-        from fcplan.trace import AgentTrace, Trace
+        from fcplan.trace import Trace
 
-        a, sc = self.arrays, self.scenario
-        agents = AgentTrace(
-            ids=tuple(x.id for x in sc.agents),
-            xyz=a["agent_xyz"],
-            battery=a["agent_battery"],
-            tank=a["agent_tank"],
-            mode=a["agent_mode"],
-            dumps=a["agent_dumps"],
-        )
-        return Trace(
-            ticks_per_second=sc.ticks_per_second,
-            active=a["active"],
-            pruned=a["pruned"],
-            sensed_active=a["sensed_active"],
-            sensed_ever=a["sensed_ever"],
-            facility_burning=a["facility_burning"],
-            facility_pruned=a["facility_pruned"],
-            facility_kinds=tuple(f.kind for f in sc.scored_facilities),
-            facility_penalties=np.array([f.penalty for f in sc.scored_facilities], np.float64),
-            region_delays_s=np.array([r.delay_s for r in sc.regions], np.float64),
-            fire_mode=sc.fire_mode,
-            propagation_weight=sc.scoring.propagation_weight,
-            temporal_exponent=sc.scoring.temporal_exponent,
-            agents=agents,
-        )
+        ids = (x.id for x in self.scenario.agents)
+        return Trace.from_rows(self.scenario, self.arrays, ids, agent_prefix="agent_")
 
     def metrics(self) -> dict:
         """Both metric definitions (:func:`fcplan.metrics.compute_all`) from the recording alone."""

@@ -83,6 +83,43 @@ class Trace:
             raise ValueError("Trace.facility_kinds length disagrees with facility arrays")
 
     @classmethod
+    def from_rows(cls, scenario, rows, agent_ids, *, agent_prefix: str = "") -> Trace:
+        """Build a trace from per-tick row arrays and the scenario's constants.
+
+        ``rows`` maps ``active``, ``pruned``, ``sensed_active``, ``sensed_ever``,
+        ``facility_burning``, ``facility_pruned`` and, after ``agent_prefix``, ``xyz``,
+        ``battery``, ``tank``, ``mode`` and ``dumps`` to arrays with one row per tick (the world's
+        trace rows, or a recording's arrays with ``agent_prefix="agent_"``). The arrays are used
+        as given, not copied.
+        """
+        p = agent_prefix
+        agents = AgentTrace(
+            ids=tuple(agent_ids),
+            xyz=rows[p + "xyz"],
+            battery=rows[p + "battery"],
+            tank=rows[p + "tank"],
+            mode=rows[p + "mode"],
+            dumps=rows[p + "dumps"],
+        )
+        facilities = scenario.scored_facilities
+        return cls(
+            ticks_per_second=scenario.ticks_per_second,
+            active=rows["active"],
+            pruned=rows["pruned"],
+            sensed_active=rows["sensed_active"],
+            sensed_ever=rows["sensed_ever"],
+            facility_burning=rows["facility_burning"],
+            facility_pruned=rows["facility_pruned"],
+            facility_kinds=tuple(f.kind for f in facilities),
+            facility_penalties=np.array([f.penalty for f in facilities], np.float64),
+            region_delays_s=np.array([r.delay_s for r in scenario.regions], np.float64),
+            fire_mode=scenario.fire_mode,
+            propagation_weight=scenario.scoring.propagation_weight,
+            temporal_exponent=scenario.scoring.temporal_exponent,
+            agents=agents,
+        )
+
+    @classmethod
     def from_counts(
         cls,
         *,

@@ -41,7 +41,7 @@ import numpy as np
 
 from fcplan.fire import _BURNING8, BLOCK, Fire, _unique
 from fcplan.team import Command, Team
-from fcplan.trace import AgentTrace, Trace
+from fcplan.trace import Trace
 
 __all__ = ["World", "StepInfo"]
 
@@ -196,33 +196,8 @@ class World:
 
     def trace(self) -> Trace:
         """The per-tick record so far (copies), ready for :func:`fcplan.metrics.compute_metrics`."""
-        t = self.tick
-        r = {k: v[:t].copy() for k, v in self._rows.items()}
-        sc = self.scenario
-        agents = AgentTrace(
-            ids=self.team.ids,
-            xyz=r["xyz"],
-            battery=r["battery"],
-            tank=r["tank"],
-            mode=r["mode"],
-            dumps=r["dumps"],
-        )
-        return Trace(
-            ticks_per_second=sc.ticks_per_second,
-            active=r["active"],
-            pruned=r["pruned"],
-            sensed_active=r["sensed_active"],
-            sensed_ever=r["sensed_ever"],
-            facility_burning=r["facility_burning"],
-            facility_pruned=r["facility_pruned"],
-            facility_kinds=tuple(f.kind for f in sc.scored_facilities),
-            facility_penalties=self.facility_penalties.copy(),
-            region_delays_s=np.array([r_.delay_s for r_ in sc.regions], np.float64),
-            fire_mode=sc.fire_mode,
-            propagation_weight=sc.scoring.propagation_weight,
-            temporal_exponent=sc.scoring.temporal_exponent,
-            agents=agents,
-        )
+        rows = {k: v[: self.tick].copy() for k, v in self._rows.items()}
+        return Trace.from_rows(self.scenario, rows, self.team.ids)
 
     def ignite(self, xy) -> np.ndarray:
         """Set cells burning by hand (spot fires, tests); return the flat indices that ignited.

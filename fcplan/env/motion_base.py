@@ -78,7 +78,7 @@ from __future__ import annotations
 import numpy as np
 
 from fcplan.env import EnvError
-from fcplan.env.motion_presets import PresetEnv, rf1_structure_penalty
+from fcplan.env.motion_presets import MOVES, PresetEnv, rf1_structure_penalty
 
 __all__ = ["BaseEnv", "STATIONARY_FIRE"]
 
@@ -91,7 +91,6 @@ _PALETTE = np.array(
 
 #: The reference's fixed firespots (flat indices; ``x = i // W``, ``y = i % W``).
 STATIONARY_FIRE = (39, 5, 22, 81, 69)
-_MOVES = np.array([[-1, 0], [1, 0], [0, -1], [0, 1]], dtype=np.int64)
 
 
 class BaseEnv(PresetEnv):
@@ -200,7 +199,7 @@ class BaseEnv(PresetEnv):
         acts = self._actions(actions)
         w, v = self.world_size, self.vision
         moving = acts < 4
-        self._pos[moving] = np.clip(self._pos[moving] + _MOVES[acts[moving]], 0, w - 1)
+        self._pos[moving] = np.clip(self._pos[moving] + MOVES[acts[moving]], 0, w - 1)
         # sensing: every fire cell in each perception agent's scope
         contrib = np.zeros(self.n, dtype=np.int64)
         burning = self.fire & ~self.pruned

@@ -80,7 +80,7 @@ from __future__ import annotations
 import numpy as np
 
 from fcplan.env import EnvError
-from fcplan.env.motion_presets import PresetEnv, rf1_structure_penalty
+from fcplan.env.motion_presets import MOVES, PresetEnv, rf1_structure_penalty
 
 __all__ = ["CmplxEnv", "WIND_DIRECTIONS"]
 
@@ -93,7 +93,6 @@ _PALETTE = np.array(
 
 #: Wind directions (degrees) the reference draws from.
 WIND_DIRECTIONS = (0, 45, 90, 135, 180)
-_DIRS = np.array([[-1, 0], [1, 0], [0, -1], [0, 1]], dtype=np.int64)
 _N_FOV = 6
 
 
@@ -210,7 +209,7 @@ class CmplxEnv(PresetEnv):
         w = self.world_size
         # 1. move
         moving = acts < 4
-        step = _DIRS[np.minimum(acts, 3)] * self._speed[:, None]
+        step = MOVES[np.minimum(acts, 3)] * self._speed[:, None]
         self._pos = np.where(moving[:, None], np.clip(self._pos + step, 0, w - 1), self._pos)
         dz = np.where(self.is_perception & (acts == 4), self.vert_vel, 0)
         dz = np.where(self.is_perception & (acts == 5), -self.vert_vel, dz)

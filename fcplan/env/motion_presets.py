@@ -31,6 +31,9 @@ from fcplan.env import EnvError
 
 __all__ = ["make_preset", "rf1_structure_penalty", "PresetEnv"]
 
+#: The reference presets' moves, by action 0-3: x-1, x+1, y-1, y+1 (spec section 6).
+MOVES = np.array([[-1, 0], [1, 0], [0, -1], [0, 1]], dtype=np.int64)
+
 
 def make_preset(name: str, **kwargs: Any):
     """Make the preset ``"base"``, ``"cmplx1"`` or ``"cmplx2"`` with its keyword arguments.
