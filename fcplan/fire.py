@@ -24,6 +24,9 @@ What fcplan keeps and fixes (ARCHITECTURE.md "Fire"):
   by its fuel coefficient.
 * Random numbers: two normals are drawn for *every* front every tick, live or not, so the fire's
   random stream never depends on what the agents do (common random numbers across schedulers).
+  They are drawn up to 64 ticks ahead, together with everything of the step that does not depend
+  on the positions (wind speed, C/R, sin and cos of the direction), in a few calls over the whole
+  block; element by element the arithmetic is the per-tick one, so the trajectories are the same.
 * Intensity is not used by any rule. It is kept as a grid of front visits (``visits``); the
   Gaussian heat field of the manual is computed on demand by :meth:`Fire.intensity`.
 
@@ -170,12 +173,19 @@ class Fire:
         self._visits = np.zeros((w, w), dtype=np.uint32)
         self._state_flat = self.state.reshape(-1)
         self._visits_flat = self._visits.reshape(-1)
-        # visits of ticks where every front moves are queued here (a row copy per tick) and
+        # the cells of the moving fronts are queued here tick after tick (one copy per tick) and
         # added to the grid in one np.add.at when full or when someone reads ``visits``
-        self._visit_rows = np.zeros((_VISIT_ROWS, n), dtype=np.int64)
-        self._n_visit_rows = 0
-        self._z = np.empty((2, n))  # per-tick buffers: the draws, and the moves of all fronts
-        self._move = np.empty((2, n))
+        self._visit_queue = np.zeros(_VISIT_ROWS * max(n, 1), dtype=np.int64)
+        self._n_visits = 0
+        self._move = np.empty((2, n))  # per-tick buffer: the moves of all fronts
+        # The position-free part of the FARSITE step (draws, wind, C/R, sin and cos of Theta) for
+        # the next ``_pre_len`` ticks of every front, filled in one go by _refill.
+        self._pre_len = max(1, min(_PRE_TICKS, _PRE_VALUES // max(n, 1)))
+        self._pre_t = self._pre_len  # next row to use (all used: refill first)
+        self._pre_z = np.empty((self._pre_len, 2, n))
+        self._pre_sc = np.empty((self._pre_len, 2, n))
+        self._pre_u = self._pre_z[:, 0]  # (wind speeds overwrite the draws: a view)
+        self._pre_ratio = np.empty((self._pre_len, n)) if n <= _INTERP_MAX else None
         #: (n,) int64 flat index of each front's current cell (valid while alive).
         self.cell = np.where(
             self.alive,
@@ -222,14 +232,13 @@ class Fire:
     @property
     def visits(self) -> np.ndarray:
         """(W, W) uint32 front-ticks spent in each cell (up to date; writable)."""
-        if self._n_visit_rows:
+        if self._n_visits:
             self._flush_visits()
         return self._visits
 
     def _flush_visits(self) -> None:
-        k = self._n_visit_rows
-        np.add.at(self._visits_flat, self._visit_rows[:k].reshape(-1), _ONE)
-        self._n_visit_rows = 0
+        np.add.at(self._visits_flat, self._visit_queue[: self._n_visits], _ONE)
+        self._n_visits = 0
 
     @property
     def live(self) -> np.ndarray:
@@ -349,35 +358,40 @@ class Fire:
                 self._moving = None
                 new = self._ignite(self.cell[self.alive & waking[self.region]])
             self._set_next_wake()
-        z = self.rng.standard_normal(out=self._z)  # (the same draws as size=(2, n))
+        t = self._pre_t
+        if t == self._pre_len:
+            self._refill()
+            t = 0
+        self._pre_t = t + 1
         if self._moving is None:
             self._refresh_moving()
         idx = self._moving
         if idx.size == 0:
             return new
         all_moving = self._all_moving
+        ratio = self._pre_ratio
+        k = self._n_visits
+        if k + self.n_fronts > self._visit_queue.size:
+            self._flush_visits()
+            k = 0
         if all_moving:  # common case: no gathers, update the positions in place
-            k = self._n_visit_rows
-            self._visit_rows[k] = self.cell
-            self._n_visit_rows = k + 1
-            if k + 1 == _VISIT_ROWS:
-                self._flush_visits()
-            xy, zs = self._xy, z
+            self._visit_queue[k : k + self.n_fronts] = self.cell
+            self._n_visits = k + self.n_fronts
+            xy, sc = self._xy, self._pre_sc[t]
+            ratio = _ratio(self._pre_u[t]) if ratio is None else ratio[t]
         else:
-            np.add.at(self._visits_flat, self.cell[idx], _ONE)
+            np.take(self.cell, idx, out=self._visit_queue[k : k + idx.size])
+            self._n_visits = k + idx.size
             # gathers through flat indices (1-D takes are much cheaper than 2-D fancy indexing)
             idx2 = self._m_idx2
             xy = self._xy.reshape(-1)[idx2].reshape(2, -1)
-            zs = z.reshape(-1)[idx2].reshape(2, -1)
-        ut = self._m_wind_theta + _SD * zs  # rows: U = U_avg + 2 N, Theta = theta_avg + 2 N
+            sc = self._pre_sc[t].reshape(-1)[idx2].reshape(2, -1)
+            ratio = _ratio(self._pre_u[t][idx]) if ratio is None else ratio[t][idx]
         cell_xy = np.rint(xy).astype(np.int64)
         fuel = self.terrain[cell_xy[0], cell_xy[1]]
-        c = fuel * self._m_fuel_dt * _ratio(ut[0])
-        move = self._move if all_moving else np.empty_like(xy)
-        np.sin(ut[1], out=move[0])
-        np.cos(ut[1], out=move[1])
-        move *= c
-        xy += move  # x += C sin(Theta), y += C cos(Theta)
+        c = fuel * self._m_fuel_dt * ratio
+        # x += C sin(Theta), y += C cos(Theta)
+        xy += np.multiply(sc, c, out=self._move if all_moving else None)
         if not all_moving:
             self._xy.reshape(-1)[idx2] = xy.reshape(-1)
         ge, lt = xy >= _ZERO, xy < self._w_float
@@ -415,6 +429,26 @@ class Fire:
         )
         self._moving = None
 
+    def _refill(self) -> None:
+        """Draw the next ``_pre_len`` ticks of every front (two normals each, in the order
+        per-tick draws of shape ``(2, n)`` would take them) and compute what does not depend on
+        the positions: ``U = U_avg + 2 N``, C/R of ``U``, ``sin`` and ``cos`` of
+        ``Theta = theta_avg + 2 N``. Element by element these are the per-tick operations, so
+        the fronts move exactly as if everything were computed tick by tick."""
+        z = self.rng.standard_normal(out=self._pre_z)
+        theta = z[:, 1]
+        theta *= WIND_DIR_SD_RAD
+        theta += self._theta
+        np.sin(theta, out=self._pre_sc[:, 0])
+        np.cos(theta, out=self._pre_sc[:, 1])
+        u = self._pre_u  # the speed draws, overwritten
+        u *= WIND_SPEED_SD
+        u += self._wind
+        if self._pre_ratio is not None:
+            self._pre_ratio[:] = _interp(u.reshape(-1), _U_GRID, _RATIO_TABLE, None, None).reshape(
+                u.shape
+            )
+
     def _set_next_wake(self) -> None:
         """Tick at which the next inactive region activates (never: a huge number)."""
         waiting = self.delay_ticks[~self.region_active]
@@ -425,7 +459,6 @@ class Fire:
         idx = np.flatnonzero(self.alive & self.region_active[self.region] & ~self.frozen)
         self._moving = idx
         self._all_moving = idx.size == self.n_fronts
-        self._m_wind_theta = np.stack([self._wind[idx], self._theta[idx]])
         self._m_idx2 = np.concatenate([idx, idx + self.n_fronts])  # rows 0 and 1 of (2, n)
         self._m_fuel_dt = self._fuel[idx] * self.dt
 
@@ -491,7 +524,7 @@ _UNI_SLOPE = np.diff(_UNI_TABLE, append=_UNI_TABLE[-1])
 
 def _ratio(u: np.ndarray) -> np.ndarray:
     """Tabulated :func:`spread_rate_ratio` for the per-tick hot path."""
-    if u.size <= 256:
+    if u.size <= _INTERP_MAX:
         return _interp(u, _U_GRID, _RATIO_TABLE, None, None)
     pos = (u - _U_LO) * (1.0 / _U_STEP)
     np.clip(pos, 0.0, _U_N - 1.0, out=pos)
@@ -503,7 +536,9 @@ _ONE = np.uint32(1)
 _ONE32 = np.int32(1)
 _NEVER = 2**62
 _ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
-_SD = np.array([[WIND_SPEED_SD], [WIND_DIR_SD_RAD]])  # (2, 1) draw scales: wind speed, direction
 _UNBURNT8, _BURNING8, _PRUNED8 = np.uint8(UNBURNT), np.uint8(BURNING), np.uint8(PRUNED)
 _SMALL = 32  # up to this many fresh cells, _ignite works on Python ints
+_PRE_TICKS = 64  # ticks of draws and position-free terms computed ahead in one go ...
+_PRE_VALUES = 4096  # ... fewer for large fires: at most about this many fronts x ticks
+_INTERP_MAX = 256  # C/R by np.interp up to this many moving fronts (see _ratio)
 _VISIT_ROWS = 256  # ticks of front visits queued before they are added to the grid
