@@ -168,6 +168,12 @@ class Fire:
         self._set_next_wake()
         # One terrain field for the map, padded by one cell so rounded positions never overflow.
         self.terrain = rng.random((w + 1, w + 1), dtype=np.float32)
+        self._terrain_flat = self.terrain.reshape(-1)
+        self._t_stride = np.array([w + 1, 1], dtype=np.int64)  # rounded (x, y) -> terrain index
+        # A front moves less than C = fuel dt R/2 px per axis in a tick (terrain < 1, C/R < 1/2:
+        # LB(U) >= 0.77 keeps HB > 1). Fronts stand in burning cells, inside ``burn_box``, so
+        # while the box keeps this far from the edges no front can leave the map.
+        self._edge_margin = 0.5 * float(per[:, 0].max(initial=0.0)) * self.dt + 1.0
         #: (W, W) uint8 cell state: UNBURNT, BURNING or PRUNED.
         self.state = np.zeros((w, w), dtype=np.uint8)
         self._visits = np.zeros((w, w), dtype=np.uint32)
@@ -387,15 +393,19 @@ class Fire:
             xy = self._xy.reshape(-1)[idx2].reshape(2, -1)
             sc = self._pre_sc[t].reshape(-1)[idx2].reshape(2, -1)
             ratio = _ratio(self._pre_u[t][idx]) if ratio is None else ratio[t][idx]
-        cell_xy = np.rint(xy).astype(np.int64)
-        fuel = self.terrain[cell_xy[0], cell_xy[1]]
+        fuel = self._terrain_flat[self._t_stride @ np.rint(xy).astype(np.int64)]
         c = fuel * self._m_fuel_dt * ratio
         # x += C sin(Theta), y += C cos(Theta)
         xy += np.multiply(sc, c, out=self._move if all_moving else None)
         if not all_moving:
             self._xy.reshape(-1)[idx2] = xy.reshape(-1)
-        ge, lt = xy >= _ZERO, xy < self._w_float
-        if np.count_nonzero(ge) == xy.size and np.count_nonzero(lt) == xy.size:  # all inside
+        (x0, x1, y0, y1), m, w = self.burn_box, self._edge_margin, self.world_size
+        if m <= x0 <= x1 and x1 + m < w and m <= y0 and y1 + m < w:
+            inside_all = True  # (see _edge_margin: no front can have left)
+        else:
+            ge, lt = xy >= _ZERO, xy < self._w_float
+            inside_all = np.count_nonzero(ge) == xy.size and np.count_nonzero(lt) == xy.size
+        if inside_all:
             if all_moving:
                 idx = slice(None)
         else:
