@@ -192,6 +192,7 @@ class Team:
         self._speed_list = self.speed.tolist()
         self._speed_margin_list = self._speed_margin.tolist()
         self._can_sense_list = self.can_sense.tolist()
+        self._is_action_list = self._is_action.tolist()
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -364,74 +365,91 @@ class Team:
     def _move_small(self) -> np.ndarray:
         """:meth:`_move_vector` agent by agent on Python floats (same operations, same order, so
         the same rounding; ``hypot`` is numpy's, or ``|d|`` when one component is zero, which
-        C's Annex F makes exact)."""
+        C's Annex F makes exact). An agent that does not fly moves by ``(d / |d|) 0.0``, which is
+        the zero of ``d``'s sign: its position is ``x + 0.0 dx`` and no ``hypot`` is needed."""
         mode = self.mode.tolist()
         pos = self.pos.tolist()
         battery = self.battery.tolist()
-        hover_s = self.hover_s.tolist()
         active = [m == _ACTIVE for m in mode]
-        any_active = True in active
         # flying: going home (RETURNING, HOMING) or ACTIVE with a goal
         flying = [
-            m >= _RETURNING or (m == _ACTIVE and h)
-            for m, h in zip(mode, self.has_goal.tolist(), strict=True)
+            m >= _RETURNING or (a and h)
+            for m, a, h in zip(mode, active, self.has_goal.tolist(), strict=True)
         ]
+        any_active = True in active
         arrive = None
         flat = None  # new positions, flat [x0, y0, x1, y1, ...]
+        hover_s = None  # None: every hover clock is 0
         if True in flying or any(x == 0.0 or y == 0.0 for x, y in pos):
-            goal = self.goal.tolist()
-            home = self._home_list
-            legs, deferred = [], []  # (target, dx, dy, dist) per agent; rows needing hypot
-            any_hover = False
-            for i, (x, y) in enumerate(pos):
-                t = home[i] if mode[i] >= _RETURNING else goal[i]
-                dx, dy = t[0] - x, t[1] - y
-                if dy == 0.0:  # hypot(x, +-0) is |x| exactly (C99 Annex F)
-                    d = abs(dx)
-                elif dx == 0.0:
-                    d = abs(dy)
-                else:
-                    d = 0.0
-                    deferred.append(i)
-                legs.append((t, dx, dy, d))
-                if active[i] and not flying[i]:
-                    any_hover = True
-            if deferred:
-                h = np.hypot([legs[i][1] for i in deferred], [legs[i][2] for i in deferred])
-                for i, d in zip(deferred, h.tolist(), strict=True):
-                    legs[i] = (*legs[i][:3], d)
-            distance = self.distance.tolist()
+            goal, home, speed = self.goal.tolist(), self._home_list, self._speed_list
+            dist = self.distance.tolist()
+            # the flyers' distances to their targets: one hypot call for those that need it
+            legs = {}
+            hyp_i, hyp_x, hyp_y = [], [], []
+            for i, f in enumerate(flying):
+                if f:
+                    t = home[i] if mode[i] >= _RETURNING else goal[i]
+                    x, y = pos[i]
+                    dx, dy = t[0] - x, t[1] - y
+                    if dy == 0.0:  # hypot(x, +-0) is |x| exactly (C99 Annex F)
+                        legs[i] = (t, dx, dy, abs(dx))
+                    elif dx == 0.0:
+                        legs[i] = (t, dx, dy, abs(dy))
+                    else:
+                        legs[i] = (t, dx, dy, 0.0)
+                        hyp_i.append(i)
+                        hyp_x.append(dx)
+                        hyp_y.append(dy)
+            if hyp_i:
+                for i, d in zip(hyp_i, np.hypot(hyp_x, hyp_y).tolist(), strict=True):
+                    t, dx, dy, _ = legs[i]
+                    legs[i] = (t, dx, dy, d)
             hd, dt, flat, arrive = self._hover_drain, self.dt_s, [], []
-            for i, ((x, y), (t, dx, dy, d), f, sp) in enumerate(
-                zip(pos, legs, flying, self._speed_list, strict=True)
-            ):
-                arr = f and d <= sp
-                arrive.append(arr)
-                step = d if arr else sp * f
-                if arr:
-                    flat += t
-                else:
-                    den = max(d, _TINY_F)  # (a NaN distance stays NaN, as np.maximum)
-                    flat += (x + dx / den * step, y + dy / den * step)
-                distance[i] += step
-                if any_hover:
-                    hov = active[i] and not f
-                    battery[i] -= DRAIN_PER_PX * step + hd * hov
-                    hover_s[i] = hover_s[i] + dt if hov else 0.0
-                else:
+            any_hover = any_active and True in [
+                a and not f for a, f in zip(active, flying, strict=True)
+            ]
+            if any_hover:
+                hover_s = self.hover_s.tolist()
+            for i, (x, y) in enumerate(pos):
+                if flying[i]:
+                    t, dx, dy, d = legs[i]
+                    sp = speed[i]
+                    if d <= sp:
+                        arrive.append(True)
+                        flat += t
+                        step = d
+                    else:
+                        arrive.append(False)
+                        den = max(d, _TINY_F)  # (a NaN distance stays NaN, as np.maximum)
+                        flat += (x + dx / den * sp, y + dy / den * sp)
+                        step = sp
+                    dist[i] += step
                     battery[i] -= DRAIN_PER_PX * step
-            if not any_hover:
-                hover_s = None
+                    if any_hover:
+                        hover_s[i] = 0.0
+                else:
+                    arrive.append(False)
+                    t = home[i] if mode[i] >= _RETURNING else goal[i]
+                    flat += (x + 0.0 * (t[0] - x), y + 0.0 * (t[1] - y))
+                    dist[i] += 0.0
+                    if active[i]:  # hovering
+                        battery[i] -= 0.0 + hd
+                        hover_s[i] = hover_s[i] + dt
+                    else:
+                        battery[i] -= 0.0
+                        if any_hover:
+                            hover_s[i] = 0.0
             self.pos = np.array(flat, dtype=np.float64).reshape(self.n, 2)
-            self.distance[:] = distance
+            self.distance[:] = dist
             self.battery[:] = battery
         elif any_active:
             hd = self._hover_drain
             battery = [b - hd * a for b, a in zip(battery, active, strict=True)]
-            hover_s = [h + self.dt_s if a else 0.0 for h, a in zip(hover_s, active, strict=True)]
+            hover_s = [
+                h + self.dt_s if a else 0.0
+                for h, a in zip(self.hover_s.tolist(), active, strict=True)
+            ]
             self.battery[:] = battery
-        else:
-            hover_s = None
         self.hover_s = np.zeros(self.n) if hover_s is None else np.array(hover_s, np.float64)
         # altitude
         z, zt = self.z.tolist(), self.z_target.tolist()
@@ -456,25 +474,42 @@ class Team:
                 xs, ys = [p[0] for p in pos], [p[1] for p in pos]
             else:
                 xs, ys = flat[0::2], flat[1::2]
-            if not self._rules_idle(xs, ys, battery, hover_s, active):
-                self._rules(np.array(active))
+            self._rules_lists(mode, xs, ys, battery, hover_s)
         return _NO_ROWS
 
-    def _rules_idle(
-        self, xs: list, ys: list, battery: list, hover_s: list | None, active: list
-    ) -> bool:
-        """True if :meth:`_rules` certainly does nothing: no hover clock at the 3-second limit,
-        and every active agent's battery is above an upper bound of its reserve (the reserve
-        uses ``hypot(d) <= |dx| + |dy|``; the bound's margin covers every rounding)."""
-        if hover_s is not None and max(hover_s) >= _IDLE_LIMIT_F:
-            return False
-        hm = self._hover_margin
-        for x, y, b, a, (hx, hy), sm in zip(
-            xs, ys, battery, active, self._home_list, self._speed_margin_list, strict=True
-        ):
-            if a and not b > (DRAIN_PER_PX * (abs(hx - x) + abs(hy - y)) + sm + hm) * _BOUND:
-                return False
-        return True
+    def _rules_lists(
+        self, mode: list, xs: list, ys: list, battery: list, hover_s: list | None
+    ) -> None:
+        """:meth:`_rules` of a small team on Python numbers (the current modes, positions,
+        batteries and hover clocks as lists; ``hover_s`` None when every clock is 0).
+
+        An agent whose battery is above an upper bound of its reserve (``hypot(d) <= |dx| +
+        |dy|``, with a margin covering every rounding) is certainly not low; only the others
+        need the exact reserve, with numpy's ``hypot`` and the vector rule's operations."""
+        hm, home, margins = self._hover_margin, self._home_list, self._speed_margin_list
+        near = []
+        for i, m in enumerate(mode):
+            if m == _ACTIVE:
+                hx, hy = home[i]
+                x, y = xs[i], ys[i]
+                if (
+                    not battery[i]
+                    > (DRAIN_PER_PX * (abs(hx - x) + abs(hy - y)) + margins[i] + hm) * _BOUND
+                ):
+                    near.append(i)
+        if near:
+            dx = [home[i][0] - xs[i] for i in near]
+            dy = [home[i][1] - ys[i] for i in near]
+            for i, h in zip(near, np.hypot(dx, dy).tolist(), strict=True):
+                if battery[i] <= DRAIN_PER_PX * h + margins[i] + hm:
+                    self.mode[i] = _RETURNING
+                    mode[i] = _RETURNING
+        if hover_s is None or not max(hover_s) >= _IDLE_LIMIT_F:  # (the usual case)
+            return
+        for i, (m, h, act) in enumerate(zip(mode, hover_s, self._is_action_list, strict=True)):
+            if m == _ACTIVE and act and h >= _IDLE_LIMIT_F:
+                self.mode[i] = _HOMING
+                self.has_goal[i] = False
 
     def _fly(self, flying: np.ndarray, going_home: np.ndarray, active: np.ndarray) -> np.ndarray:
         """One step toward each flying agent's target; return the (N,) bool rows that arrived."""
@@ -542,6 +577,16 @@ class Team:
     def _rules(self, active: np.ndarray | None = None) -> None:
         """Battery reserve, and the 3-second rule for action agents (``active``: the rows in
         ACTIVE mode, if the caller has them)."""
+        if self._small:
+            pos = self.pos.tolist()
+            self._rules_lists(
+                self.mode.tolist(),
+                [p[0] for p in pos],
+                [p[1] for p in pos],
+                self.battery.tolist(),
+                self.hover_s.tolist(),
+            )
+            return
         if active is None:
             active = self.mode == _ACTIVE8
         if not np.count_nonzero(active):
@@ -581,7 +626,7 @@ _ACTIVE8, _RETURNING8 = np.int8(_ACTIVE), np.int8(_RETURNING)
 _IDLE_LIMIT = np.float64(ACTION_IDLE_LIMIT_S - 1e-9)
 _IDLE_LIMIT_F = float(_IDLE_LIMIT)
 _TINY_F = 5e-324
-_BOUND = 1.0 + 1e-9  # relative margin of _rules_idle's reserve bound
+_BOUND = 1.0 + 1e-9  # relative margin of _rules_lists's reserve bound
 _ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
 _TINY = np.float64(5e-324)  # smallest positive double
 _FOV_SCALE = np.array([-FOV_TAN_X, FOV_TAN_X, -FOV_TAN_Y, FOV_TAN_Y])
