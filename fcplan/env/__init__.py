@@ -8,6 +8,7 @@ Two levels of control over the same simulator:
     of the agent's own state, a ``k x F`` task-feature table and an ``action_mask``.
 ``mode="motion"`` (:mod:`fcplan.env.motion`)
     One step is one tick: moves, altitude, dump, with local field-of-view observations.
+    :class:`PlanFollower` (:mod:`fcplan.env.motion_expert`) drives it with any scheduler's plans.
 
 Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with a centralised
 joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any
@@ -45,6 +46,7 @@ __all__ = [
     "load_demonstrations",
     "Demonstrations",
     "replay_actions",
+    "PlanFollower",
 ]
 
 #: Environment levels accepted by :func:`parallel_env`.
@@ -64,6 +66,7 @@ _LAZY = {
     "load_demonstrations": "fcplan.env.demonstrations",
     "Demonstrations": "fcplan.env.demonstrations",
     "replay_actions": "fcplan.env.demonstrations",
+    "PlanFollower": "fcplan.env.motion_expert",
 }
 
 

@@ -312,6 +312,13 @@ class MotionEnv(_parallel_base()):
         """The underlying :class:`fcplan.World` (after :meth:`reset`)."""
         return self._world
 
+    @property
+    def last_info(self):
+        """The :class:`fcplan.world.StepInfo` of the last tick (None right after :meth:`reset`):
+        what a scheduler-driven expert feeds its belief with
+        (:mod:`fcplan.env.motion_expert`)."""
+        return self._last_info
+
     # ------------------------------------------------------------------ episode
     def reset(self, seed: int | None = None, options: dict | None = None):
         """Start an episode; return ``(observations, infos)``."""

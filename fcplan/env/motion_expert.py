@@ -1,0 +1,205 @@
+"""Scheduler-driven expert for the motion-level environment: plans turned into per-tick moves.
+
+The motion level has no scheduler of its own: a scheduler plans tasks, not moves. A
+:class:`PlanFollower` bridges the two so that any registered scheduler can drive a
+:class:`fcplan.env.motion.MotionEnv`, as a baseline to compare a learned motion policy with or
+as the expert of imitation learning:
+
+* **Belief.** It keeps the team's :class:`fcplan.belief.Belief`, fed every tick with the env's
+  :attr:`~fcplan.env.motion.MotionEnv.last_info`, exactly as :func:`fcplan.run_episode` does.
+* **Replans.** Every ``replan_period`` simulated seconds (periodic replans only) it builds the
+  task graph and asks the scheduler for a plan through :func:`fcplan.scheduling.solve` (so a
+  failing solver falls back to greedy), with the world's ``controller_rng``. Agents the plan does
+  not mention keep their route; agents sent home stop (the simulator flies agents home by
+  itself when their battery or tank runs out).
+* **Moves.** Each tick an agent steps toward the next goal of its route along the axis with the
+  larger offset (the other axis if that move is masked), until both offsets are within half a
+  step. At a goal an action or hybrid agent dumps once on a fire task (as an arrival arms one
+  dump in the simulator), then takes the next goal. With no goal left, a perception or hybrid
+  agent climbs or descends toward the plan's altitude, otherwise it stays. Only legal actions
+  (by the observation's ``action_mask``) are chosen.
+
+The follower reads the live world (``env.world``) for positions and modes, as a centralised
+expert would; its actions depend only on the env's state, so episodes are deterministic for a
+given seed.
+
+Examples
+--------
+>>> from fcplan.env.motion import MotionEnv
+>>> from fcplan.env.motion_expert import PlanFollower
+>>> env = MotionEnv("practice")
+>>> expert = PlanFollower(env, "greedy")
+>>> obs, infos = env.reset(seed=0)
+>>> expert.reset()
+>>> for _ in range(30):
+...     obs, rewards, terms, truncs, infos = env.step(expert.actions(obs))
+>>> expert.replans
+3
+"""
+
+from __future__ import annotations
+
+from fcplan.belief import Belief
+from fcplan.env import EnvError
+from fcplan.env.motion import ACTION_NAMES, MotionEnv
+from fcplan.scheduling import Scheduler, make_scheduler, solve
+from fcplan.taskgraph import TaskGraphParams, TaskKind, build_task_graph
+from fcplan.team import Mode
+
+__all__ = ["PlanFollower"]
+
+_FIRE = int(TaskKind.FIRE)
+_RETURNING = int(Mode.RETURNING)
+
+
+class PlanFollower:
+    """Turn a scheduler's plans into motion-level actions (module docstring: the rules).
+
+    Parameters
+    ----------
+    env : fcplan.env.motion.MotionEnv
+        The environment to drive (a scenario env, not a preset).
+    scheduler : str or Scheduler
+        A registered scheduler name or spec (``"greedy"``, ``"milp:slots=2"``) or an instance.
+    replan_period : float
+        Simulated seconds between replans (> 0).
+    time_limit : float, optional
+        Passed to the scheduler on every replan (None: its default).
+    graph_params : fcplan.taskgraph.TaskGraphParams, optional
+        Task-graph settings (None: the defaults of :func:`fcplan.taskgraph.build_task_graph`).
+
+    Attributes
+    ----------
+    replans : int
+        Plans made since :meth:`reset`.
+    plan : fcplan.plan.Plan or None
+        The last plan.
+    """
+
+    def __init__(
+        self,
+        env,
+        scheduler: str | Scheduler,
+        *,
+        replan_period: float = 1.0,
+        time_limit: float | None = None,
+        graph_params: TaskGraphParams | None = None,
+    ) -> None:
+        if not isinstance(env, MotionEnv):
+            raise EnvError("PlanFollower: env must be a scenario MotionEnv (presets have no plans)")
+        if not replan_period > 0:
+            raise EnvError(f"replan_period: must be > 0 simulated seconds (got {replan_period!r})")
+        self.env = env
+        self.scheduler = make_scheduler(scheduler) if isinstance(scheduler, str) else scheduler
+        self.time_limit = time_limit
+        self.graph_params = graph_params
+        sc = env.scenario
+        self._period = max(int(round(replan_period * sc.ticks_per_second)), 1)
+        self._ids = list(env.possible_agents)
+        self._row = {a: i for i, a in enumerate(self._ids)}
+        letters = [
+            "H" if (a.role.can_sense and a.role.can_act) else ("P" if a.role.can_sense else "A")
+            for a in sc.agents
+        ]
+        # action index by name, per agent
+        self._act = [{name: k for k, name in enumerate(ACTION_NAMES[r])} for r in letters]
+        self.belief: Belief | None = None
+        self.plan = None
+        self.replans = 0
+
+    def reset(self) -> None:
+        """Forget routes and belief; call after ``env.reset()``."""
+        if self.env.world is None:
+            raise EnvError("PlanFollower.reset: reset the env first")
+        self.belief = Belief(self.env.scenario)
+        self._belief_tick = self.env.world.tick
+        self._next_replan = self.env.world.tick
+        n = len(self._ids)
+        self._routes: list[list[tuple[float, float, bool]]] = [[] for _ in range(n)]
+        self._alt: list[float | None] = [None] * n
+        self._patrol = [False] * n
+        self.plan = None
+        self.replans = 0
+
+    def actions(self, observations: dict) -> dict[str, int]:
+        """One legal action per live agent for the current tick."""
+        if self.belief is None:
+            self.reset()
+        env, world = self.env, self.env.world
+        info = env.last_info
+        if info is not None and info.tick > self._belief_tick:
+            self.belief.update(info)
+            self._belief_tick = info.tick
+        if world.tick >= self._next_replan:
+            self._replan()
+            self._next_replan = world.tick + self._period
+        team = world.team
+        pos, z_target = team.pos.tolist(), team.z_target.tolist()
+        mode, speed = team.mode.tolist(), team.speed.tolist()
+        climb = 5.0 * team.tick_scale
+        out = {}
+        for i, a in enumerate(self._ids):
+            if a not in observations:
+                continue
+            mask = observations[a]["action_mask"].tolist()
+            act = self._act[i]
+
+            def legal(name: str, act=act, mask=mask) -> bool:
+                k = act.get(name)
+                return k is not None and bool(mask[k])
+
+            choice = "stay"
+            route = self._routes[i]
+            if mode[i] < _RETURNING:  # (a forced return flies home by itself)
+                x, y = pos[i]
+                half = 0.5 * speed[i]
+                while route and abs(route[0][0] - x) <= half and abs(route[0][1] - y) <= half:
+                    if route[0][2] and legal("dump"):
+                        choice = "dump"
+                        route[0] = (route[0][0], route[0][1], False)  # one dump per goal
+                        break
+                    done = route.pop(0)
+                    if self._patrol[i]:  # a patrol loop goes round again
+                        route.append(done)
+                if choice == "stay" and route:
+                    dx, dy = route[0][0] - x, route[0][1] - y
+                    moves = [
+                        ("east" if dx > 0 else "west", abs(dx)),
+                        ("south" if dy > 0 else "north", abs(dy)),
+                    ]
+                    moves.sort(key=lambda m: -m[1])
+                    for name, off in moves:
+                        if off > half and legal(name):
+                            choice = name
+                            break
+            if choice == "stay" and self._alt[i] is not None:
+                if z_target[i] < self._alt[i] - 0.5 * climb and legal("climb"):
+                    choice = "climb"
+                elif z_target[i] > self._alt[i] + 0.5 * climb and legal("descend"):
+                    choice = "descend"
+            out[a] = act[choice]
+        return out
+
+    def _replan(self) -> None:
+        world = self.env.world
+        graph = build_task_graph(self.env.scenario, world.team, self.belief, self.graph_params)
+        plan = solve(self.scheduler, graph, time_limit=self.time_limit, rng=world.controller_rng)
+        self.plan = plan
+        self.replans += 1
+        tidx, pos, kind = graph.task_index, graph.task_pos, graph.task_kind
+        can_act = world.team.can_act.tolist()
+        for agent, z in plan.altitudes.items():
+            self._alt[self._row[agent]] = float(z)
+        for agent in plan.home:
+            self._routes[self._row[agent]] = []
+        for agent, route in plan.routes.items():
+            i = self._row[agent]
+            self._patrol[i] = agent in plan.patrol
+            self._routes[i] = [
+                (
+                    float(pos[tidx[t], 0]),
+                    float(pos[tidx[t], 1]),
+                    can_act[i] and int(kind[tidx[t]]) == _FIRE,
+                )
+                for t in route
+            ]
