@@ -138,6 +138,7 @@ class Fire:
         w = int(world_size)
         self.world_size = w
         self._w_float = np.float64(w)
+        self._w_bits = self._w_float.view(np.uint64)
         self._stride = np.array([w, 1], dtype=np.int64)  # (x, y) -> flat x w + y
         self.ticks_per_second = int(ticks_per_second)
         self.dt = REFERENCE_TPS / self.ticks_per_second
@@ -403,8 +404,12 @@ class Fire:
         if m <= x0 <= x1 and x1 + m < w and m <= y0 and y1 + m < w:
             inside_all = True  # (see _edge_margin: no front can have left)
         else:
-            ge, lt = xy >= _ZERO, xy < self._w_float
-            inside_all = np.count_nonzero(ge) == xy.size and np.count_nonzero(lt) == xy.size
+            # as unsigned integers the bits of non-negative doubles keep their order and every
+            # negative double (and NaN) is larger: all below W's bits means all in [+0, W)
+            inside_all = np.count_nonzero(xy.view(np.uint64) < self._w_bits) == xy.size
+            if not inside_all:
+                ge, lt = xy >= _ZERO, xy < self._w_float
+                inside_all = np.count_nonzero(ge & lt) == xy.size
         if inside_all:
             if all_moving:
                 idx = slice(None)
