@@ -240,18 +240,16 @@ class Team:
         # x + (-h) is exactly x - h, so this equals [x - hx, x + hx, y - hy, y + hy]
         return self.pos.repeat(2, axis=1) + self.z[:, None] * _FOV_SCALE
 
-    def fov_rects_and_list(self) -> tuple[np.ndarray, list]:
-        """:meth:`fov_rects` and the same rectangles as nested Python lists."""
+    def fov_rects_list(self) -> list[list[float]]:
+        """:meth:`fov_rects` as nested Python lists (the same values)."""
         if not self._small:
-            rects = self.fov_rects()
-            return rects, rects.tolist()
+            return self.fov_rects().tolist()
         # the same operations as fov_rects on Python floats: x + z (-t) per bound
         ax, bx, ay, by = _FOV_SCALE_LIST
-        rects = [
+        return [
             [x + z * ax, x + z * bx, y + z * ay, y + z * by]
             for (x, y), z in zip(self.pos.tolist(), self.z.tolist(), strict=True)
         ]
-        return np.array(rects, dtype=np.float64), rects
 
     def sensing_confidence(self) -> np.ndarray:
         """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""

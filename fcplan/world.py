@@ -60,9 +60,15 @@ class StepInfo:
     sensed: np.ndarray  # (k,) int64 cells sensed this tick (unique)
     newly_sensed: np.ndarray  # (k,) int64 cells sensed for the first time
     pruned: np.ndarray  # (k,) int64 cells put out this tick
-    fov: np.ndarray  # (N, 4) float64 [x0, x1, y0, y1] of every agent after moving
+    fov_rects: list  # (N,) lists [x0, x1, y0, y1] of floats: every agent's field of view
     dumped: tuple[int, ...]  # rows of agents that dumped
     arrived: tuple[int, ...]  # rows of agents that reached a route goal
+
+    @property
+    def fov(self) -> np.ndarray:
+        """(N, 4) float64 ``[x0, x1, y0, y1]`` inclusive field of view of every agent after
+        moving (built from :attr:`fov_rects` on each access)."""
+        return np.array(self.fov_rects, dtype=np.float64).reshape(-1, 4)
 
 
 def _cell_range(rect: list[float], w: int) -> tuple[int, int, int, int] | None:
@@ -228,7 +234,7 @@ class World:
         ignited = fire.step()
         if ignited.size:
             self._count_facilities(ignited, +1)
-        fov, rects = team.fov_rects_and_list()
+        rects = team.fov_rects_list()
         sensed, newly = self._sense(rects)
         pruned, dumped = self._prune(rects)
         self._record()
@@ -239,7 +245,7 @@ class World:
             sensed,
             newly,  # newly_sensed
             pruned,
-            fov,
+            rects,  # fov_rects
             tuple(dumped),
             tuple(arrived.tolist()),  # arrived
         )

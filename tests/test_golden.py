@@ -117,10 +117,12 @@ class Digests:
 
 
 def digest_info(d: Digests, info) -> None:
-    """Every field of one tick's StepInfo."""
+    """Every field of one tick's StepInfo (the fields of view as the ``fov`` array, the name
+    and form they had when the golden file was written)."""
     for f in dataclasses.fields(info):
-        v = getattr(info, f.name)
-        d.add(f"step.{f.name}", np.asarray(v, dtype=np.int64) if isinstance(v, tuple) else v)
+        name = "fov" if f.name == "fov_rects" else f.name
+        v = info.fov if name == "fov" else getattr(info, f.name)
+        d.add(f"step.{name}", np.asarray(v, dtype=np.int64) if isinstance(v, tuple) else v)
 
 
 def digest_belief(d: Digests, b: Belief) -> None:
