@@ -107,7 +107,6 @@ import numpy as np
 
 from fcplan.env import EnvError
 from fcplan.env.motion_grid import (
-    AGENTS,
     FACILITY,
     KNOWN_N,
     LAKE,
@@ -153,6 +152,8 @@ _N_STATE = 8
 _IDLE, _ACTIVE = 0, 1
 #: mode one-hot features (idle, active, returning, homing) per team mode
 _ONE_HOT = tuple(tuple(float(m == k) for k in range(4)) for m in range(4))
+#: stay, west, east, north, south of an agent flown home (only stay is legal)
+_HOMING_MOVES = (True, False, False, False, False)
 #: a move sets a goal this many steps away, so the agent never arrives (see MotionEnv.step)
 _GOAL_REACH = 1.5
 
@@ -382,6 +383,8 @@ class MotionEnv(_parallel_base()):
             for i, sp in enumerate(team.speed.tolist())
         ]
         self._n_actions_list = self._n_actions.tolist()
+        #: action mask tuples -> int8 arrays (copied into each observation)
+        self._mask_cache: dict[tuple, np.ndarray] = {}
         self._maps.reset()
         self._tick_rate = float(self.scenario.ticks_per_second)
         self._n_ticks = self.scenario.n_ticks
@@ -466,25 +469,30 @@ class MotionEnv(_parallel_base()):
         return obs, rewards, terms, truncs, infos
 
     # ------------------------------------------------------------------ observations
-    def _agent_arrays(self) -> tuple[np.ndarray, np.ndarray, list, list]:
-        """``(vectors (n, 15) float32, masks (n, 8) int8, coarse x, coarse y)``, and the agents
-        that take orders in ``self._free_list``: a plain Python loop over the agents for small
-        teams (a few numpy calls cost more than the whole loop there), numpy beyond
-        :data:`_PY_AGENTS` agents; both give identical results."""
+    def _agent_arrays(self) -> tuple[np.ndarray, list, list, list]:
+        """``(vectors (n, 15) float32, masks, coarse x, coarse y)``: ``masks[i]`` is agent
+        ``i``'s fresh ``(n_actions,)`` int8 action mask. Also keeps the masks as tuples of bools
+        in ``self._mask_lists`` and the agents that take orders in ``self._free_list`` (read by
+        :meth:`step`). A plain Python loop over the agents for small teams (a few numpy calls
+        cost more than the whole loop there), numpy beyond :data:`_PY_AGENTS` agents; both give
+        identical results."""
         team = self._team
         inv_w = self._inv_w
         if self._n > _PY_AGENTS:
             vec, mask = self._agent_vectors(), self._masks()
             self._free_list = self._free.tolist()
-            self._mask_lists = mask.tolist()
+            k = self._n_actions_list
+            self._mask_lists = [tuple(row[: k[i]]) for i, row in enumerate(mask.tolist())]
+            masks = [mask[i, : k[i]] for i in range(self._n)]
             cell = (team.pos // self.cell_px).astype(np.int64)  # agents never leave the map
-            return vec, mask, cell[:, 0].tolist(), cell[:, 1].tolist()
+            return vec, masks, cell[:, 0].tolist(), cell[:, 1].tolist()
         cpx = self.cell_px
         pos, z, zt = team.pos.tolist(), team.z.tolist(), team.z_target.tolist()
         bat, tank, mode = team.battery.tolist(), team.tank.tolist(), team.mode.tolist()
         tf = self._world.tick / self._n_ticks
+        cache = self._mask_cache
         vecs: list = []
-        rows, free_all, cxs, cys = [], [], [], []
+        rows, masks, free_all, cxs, cys = [], [], [], [], []
         for st, (x, y), zi, zti, bi, ti, m in zip(
             self._py, pos, z, zt, bat, tank, mode, strict=True
         ):
@@ -508,26 +516,26 @@ class MotionEnv(_parallel_base()):
                 spw,
             )
             # the action table's order: stay, west, east, north, south, then role actions
-            moves = (
-                True,
-                free and x >= sp,
-                free and x <= hi_lim,
-                free and y >= sp,
-                free and y <= hi_lim,
-            )
+            moves = (True, x >= sp, x <= hi_lim, y >= sp, y <= hi_lim) if free else _HOMING_MOVES
             if letter == "P":
-                rows.append((*moves, zti < z_hi, zti > z_lo, False))
+                row = (*moves, zti < z_hi, zti > z_lo)
             elif letter == "A":
-                rows.append((*moves, free and ti > 0, False, False))
+                row = (*moves, free and ti > 0)
             else:
-                rows.append((*moves, zti < z_hi, zti > z_lo, free and ti > 0))
+                row = (*moves, zti < z_hi, zti > z_lo, free and ti > 0)
+            rows.append(row)
+            # (the tuple says its agent's role by its length: one cached array per tuple)
+            arr = cache.get(row)
+            if arr is None:
+                arr = cache[row] = np.array(row, dtype=np.int8)
+            masks.append(arr.copy())
             free_all.append(free)
             cxs.append(int(x // cpx))
             cys.append(int(y // cpx))
         self._free_list = free_all
         self._mask_lists = rows
         vec = np.array(vecs, dtype=np.float32).reshape(self._n, _N_AGENT_FEATURES)
-        return vec, np.array(rows, dtype=np.int8), cxs, cys
+        return vec, masks, cxs, cys
 
     def _masks(self) -> np.ndarray:
         """(n, 8) int8 legal actions, from a (n, 8) table of conditions picked per action."""
@@ -572,19 +580,13 @@ class MotionEnv(_parallel_base()):
         return v
 
     def _observe(self) -> dict:
-        maps = self._maps
-        vec, mask, cx, cy = self._agent_arrays()
-        k = self._n_actions_list
-        rows = [mask[i, : k[i]] for i in range(self._n)]
-        maps.place_agents(cx, cy)
-        fov = maps.crops(cx, cy, _N_FOV)  # (n, 7, V, V), a fresh array
-        # known and pruned come scaled and clipped; staleness and agents are clipped here
-        fov[:, LAST_SEEN] += maps.stamp(self._world.tick)
-        fov[:, AGENTS, self._r, self._r] -= 1.0  # others only
-        tail = fov[:, LAST_SEEN : AGENTS + 1]
-        np.minimum(tail, 1.0, out=tail)
+        vec, masks, cx, cy = self._agent_arrays()
+        # (N, 7, V, V), a fresh array: known and pruned come scaled and clipped, the agents
+        # layer as "another agent is there", staleness clipped
+        fov = self._maps.observe(cx, cy, self._world.tick, _N_FOV)
+        # (indexing the arrays: iterating over them costs more)
         return {
-            a: {"fov": fov[i], "agent": vec[i], "action_mask": rows[i]}
+            a: {"fov": fov[i], "agent": vec[i], "action_mask": masks[i]}
             for i, a in enumerate(self.possible_agents)
         }
 

@@ -16,7 +16,7 @@ Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px
  2   ``seen``        minus the tick the cell last overlapped a sensing agent's field of view,
                      times ``seen_scale`` (``+inf``: never, and outside the map), so that
                      ``min(1, seen + tick * seen_scale)`` is the cell's staleness
- 3   ``agents``      agents in the cell (all of them; see :meth:`CoarseMaps.place_agents`)
+ 3   ``agents``      1 where at least one agent is (see :meth:`CoarseMaps.place_agents`)
  4   ``outside``     share of the cell outside the map (1 in the padding)
  5   ``lake``        share of the cell covered by a lake
  6   ``facility``    share of the cell inside a scored facility (incl. the depot),
@@ -27,8 +27,9 @@ Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px
  9   ``pruned_n``    pruned px in the cell
 ===  ==============  =====================================================================
 
-Layers 0-1 are kept scaled and clipped (updated with their counts, a few cells per tick), so an
-observation crop needs no arithmetic on them.
+Layers 0-1 are kept scaled and clipped (updated with their counts, a few cells per tick), and
+layer 3 as 0/1, so an observation crop (:meth:`CoarseMaps.observe`) needs arithmetic only on the
+``seen`` layer (plus one write per agent: whether another agent shares its cell).
 
 Examples
 --------
@@ -117,6 +118,7 @@ class CoarseMaps:
         self.grid = np.zeros((N_LAYERS, nc + 2 * r, nc + 2 * r), dtype=np.float32)
         #: (L, nc, nc) view of the map part of :attr:`grid`
         self.inner = self.grid[:, r : r + nc, r : r + nc]
+        self._seen = self.inner[LAST_SEEN]
         self._static = self._static_layers(scenario)
         #: (L, H-view+1, H-view+1, view, view) windows; a crop is ``windows[:, cx, cy]``
         self.windows = sliding_window_view(self.grid, (self.view, self.view), axis=(1, 2))
@@ -125,10 +127,10 @@ class CoarseMaps:
         #: per layer, a flat view of the padded grid
         self.flat = [self.grid[k].reshape(-1) for k in range(N_LAYERS)]
         self._lut = _lookup(w, c, r, h) if w * w <= _LUT_MAX_PX else None
-        self._agent_cells: list[int] = []
-        self._pending: list[tuple[np.ndarray, float]] = []
+        self._win_cache: dict[int, np.ndarray] = {}
         #: per agent, whether its field of view counts as camera coverage
         self._sensing = [a.role.can_sense for a in scenario.agents]
+        self._sensing_rows = [j for j, f in enumerate(self._sensing) if f]
         self.reset()
 
     def _static_layers(self, scenario) -> np.ndarray:
@@ -161,6 +163,8 @@ class CoarseMaps:
         g[LAST_SEEN] = np.inf
         self.inner[OUTSIDE : FACILITY + 1] = self._static
         self._agent_cells: list[int] = []
+        #: per agent placed by :meth:`place_agents`: 1.0 if another agent shares its cell
+        self.shared: list[float] = []
         self._pending: list[tuple[np.ndarray, float]] = []
 
     def padded_index(self, flat: np.ndarray) -> np.ndarray:
@@ -203,7 +207,7 @@ class CoarseMaps:
             self._add(PRUNED, pruned, 1.0)
             seen = pruned[world.sensed.reshape(-1)[pruned]]
             self._add(KNOWN, seen, -1.0)
-        self.cover(info.fov.tolist(), info.tick, self._sensing)
+        self._cover(info.fov.tolist(), self._sensing_rows, -float(self.stamp(info.tick)))
         if len(self._pending) > 512:
             self.burning_layer()
 
@@ -218,35 +222,42 @@ class CoarseMaps:
     def cover(self, rects: list, tick: int, which: list | None = None) -> None:
         """Mark the coarse cells overlapping each ``[x0, x1, y0, y1]`` rectangle as seen now
         (only the rectangles whose flag in ``which`` is true, if given)."""
+        rows = range(len(rects)) if which is None else [j for j, f in enumerate(which) if f]
+        self._cover(rects, rows, -float(np.float32(tick * self.seen_scale)))
+
+    def _cover(self, rects: list, rows, value: float) -> None:
+        """:meth:`cover` of the rectangles ``rects[j]`` for ``j`` in ``rows`` with ``value``."""
         c = self.cell_px
-        seen = self.inner[LAST_SEEN]  # slicing stops at the map's far edges by itself
-        value = -float(self.stamp(tick))
-        for j, (x0, x1, y0, y1) in enumerate(rects):
-            if which is not None and not which[j]:
-                continue
+        seen = self._seen  # slicing stops at the map's far edges by itself
+        for j in rows:
+            x0, x1, y0, y1 = rects[j]
             if x1 < 0 or y1 < 0:
                 continue
-            seen[
-                max(int(x0 // c), 0) : int(x1 // c) + 1, max(int(y0 // c), 0) : int(y1 // c) + 1
-            ] = value
+            i0, i1 = int(x0 // c), int(x1 // c) + 1
+            j0, j1 = int(y0 // c), int(y1 // c) + 1
+            seen[i0 if i0 > 0 else 0 : i1, j0 if j0 > 0 else 0 : j1] = value
 
     def stamp(self, tick: int) -> np.float32:
         """``tick * seen_scale`` as float32 (add it to the ``seen`` layer to get staleness)."""
         return np.float32(tick * self.seen_scale)
 
     def place_agents(self, cx: list, cy: list) -> None:
-        """Put the agents of coarse cells ``(cx[i], cy[i])`` (lists of int) on the ``agents``
-        layer, replacing the previous placement (a loop over agents: a handful of scalar
-        writes beat numpy's fancy indexing here)."""
-        layer = self.flat[AGENTS]
+        """Mark the coarse cells ``(cx[i], cy[i])`` (lists of int inside the map) on the ``agents``
+        layer (1 where at least one agent is), replacing the previous placement, and note per
+        agent in :attr:`shared` whether another agent is in its cell (a loop over agents: a
+        handful of scalar writes beat numpy's fancy indexing here)."""
         h, off = self._h, self.radius * (self._h + 1)
         cells = [x * h + y + off for x, y in zip(cx, cy, strict=True)]
         if cells == self._agent_cells:  # nobody changed cell
             return
+        layer = self.flat[AGENTS]
         for c in self._agent_cells:
             layer[c] = 0.0
+        count: dict[int, int] = {}
         for c in cells:
-            layer[c] += 1.0
+            layer[c] = 1.0
+            count[c] = count.get(c, 0) + 1
+        self.shared = [1.0 if count[c] > 1 else 0.0 for c in cells]
         self._agent_cells = cells
 
     def cells(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -258,12 +269,40 @@ class CoarseMaps:
     def crops(self, cx: list, cy: list, layers: int) -> np.ndarray:
         """(N, layers, view, view) crops of the first ``layers`` layers centred on coarse cells
         ``(cx[i], cy[i])`` (lists of int inside the map; a fresh C-contiguous array, filled by
-        one slice copy per agent)."""
+        one window copy per agent)."""
         v = self.view
         out = np.empty((len(cx), layers, v, v), dtype=np.float32)
-        g = self.grid[:layers]
+        win = self._windows(layers)
         for i, (x, y) in enumerate(zip(cx, cy, strict=True)):
-            out[i] = g[:, x : x + v, y : y + v]
+            out[i] = win[:, x, y]
+        return out
+
+    def _windows(self, layers: int) -> np.ndarray:
+        """:attr:`windows` of the first ``layers`` layers (cached)."""
+        win = self._win_cache.get(layers)
+        if win is None:
+            win = self._win_cache[layers] = self.windows[:layers]
+        return win
+
+    def observe(self, cx: list, cy: list, tick: int, layers: int) -> np.ndarray:
+        """The agents' observation crops at ``tick``: (N, layers, view, view) float32 with
+        ``layers >= 4``, a fresh C-contiguous array.
+
+        Places the agents of coarse cells ``(cx[i], cy[i])`` (:meth:`place_agents`), crops the
+        first ``layers`` layers around each, turns ``seen`` into staleness
+        ``min(1, seen + tick * seen_scale)`` and sets each crop's centre on ``agents`` to whether
+        *another* agent shares the cell.
+        """
+        self.place_agents(cx, cy)
+        v, r = self.view, self.radius
+        out = np.empty((len(cx), layers, v, v), dtype=np.float32)
+        win = self._windows(layers)
+        for i, (x, y) in enumerate(zip(cx, cy, strict=True)):
+            out[i] = win[:, x, y]
+        out[:, AGENTS, r, r] = self.shared
+        seen = out[:, LAST_SEEN]
+        np.add(seen, np.float32(tick * self.seen_scale), out=seen)
+        np.minimum(seen, 1.0, out=seen)
         return out
 
     def gather(self, pos: np.ndarray) -> np.ndarray:

@@ -342,7 +342,10 @@ def test_small_team_python_path_equals_numpy_path(monkeypatch):
             monkeypatch.setattr(motion, "_PY_AGENTS", 0)
             vec_np, mask_np, cx_np, cy_np = env._agent_arrays()
             monkeypatch.setattr(motion, "_PY_AGENTS", 16)
-            np.testing.assert_array_equal(mask, mask_np)
+            assert len(mask) == len(mask_np) == len(env.possible_agents)
+            for m, m_np in zip(mask, mask_np, strict=True):
+                assert m.dtype == m_np.dtype == np.int8
+                np.testing.assert_array_equal(m, m_np)
             np.testing.assert_array_equal(vec, vec_np)
             assert (cx, cy) == (cx_np, cy_np)
 
