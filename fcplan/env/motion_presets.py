@@ -29,7 +29,7 @@ import numpy as np
 
 from fcplan.env import EnvError
 
-__all__ = ["make_preset", "rf1_structure_penalty", "PresetEnv"]
+__all__ = ["make_preset", "rf1_structure_penalty", "rf1_penalty_small", "PresetEnv"]
 
 #: The reference presets' moves, by action 0-3: x-1, x+1, y-1, y+1 (spec section 6).
 MOVES = np.array([[-1, 0], [1, 0], [0, -1], [0, 1]], dtype=np.int64)
@@ -77,6 +77,36 @@ def rf1_structure_penalty(pos: np.ndarray, is_perception: np.ndarray, comm_range
     other_role = is_perception[:, None] != is_perception[None, :]
     unpaired = ~(near & other_role).any(axis=1)
     return float(lonely.sum() + 3 * unpaired.sum())
+
+
+def rf1_penalty_small(pos: list, is_perception: list, comm_range: float) -> float:
+    """:func:`rf1_structure_penalty` for a small team, on Python lists (the same value; a
+    double loop over the agents beats numpy's setup for a handful of them).
+
+    Parameters
+    ----------
+    pos : list of [x, y]
+    is_perception : list of bool
+    comm_range : float
+
+    Returns
+    -------
+    float
+        The penalty magnitude (RF1 subtracts it).
+    """
+    lonely = unpaired = 0
+    for i, (xi, yi) in enumerate(pos):
+        near = paired = False
+        role = is_perception[i]
+        for j, (xj, yj) in enumerate(pos):
+            if j != i and max(abs(xj - xi), abs(yj - yi)) <= comm_range:
+                near = True
+                if is_perception[j] != role:
+                    paired = True
+                    break
+        lonely += not near
+        unpaired += not paired
+    return float(lonely + 3 * unpaired)
 
 
 def _parallel_base():

@@ -13,7 +13,7 @@ from fcplan.env import EnvError
 from fcplan.env.motion import parallel_env
 from fcplan.env.motion_base import STATIONARY_FIRE, BaseEnv
 from fcplan.env.motion_cmplx import CmplxEnv
-from fcplan.env.motion_presets import rf1_structure_penalty
+from fcplan.env.motion_presets import rf1_penalty_small, rf1_structure_penalty
 from fcplan.fire import BURNING, PRUNED
 
 pettingzoo_test = pytest.importorskip("pettingzoo.test")
@@ -271,3 +271,20 @@ def test_cmplx_invariants(seed, variant):
         pruned, sensed = now, env.sensed.copy()
         for a in obs:
             assert obs[a] in env.observation_space(a)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(1, 8),
+    st.integers(0, 2**32 - 1),
+    st.sampled_from([0.0, 1.0, 2.5, 5.0, 30.0]),
+)
+def test_rf1_penalty_small_equals_numpy(n, seed, comm_range):
+    """The Python-list RF1 structure penalty used by small teams equals the numpy one for any
+    positions, roles and range (ties at the range included)."""
+    rng = np.random.default_rng(seed)
+    pos = rng.integers(0, 8, size=(n, 2))
+    is_p = rng.random(n) < 0.5
+    want = rf1_structure_penalty(pos, is_p, comm_range)
+    got = rf1_penalty_small(pos.tolist(), is_p.tolist(), comm_range)
+    assert got == want and type(got) is float
