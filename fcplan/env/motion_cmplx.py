@@ -234,7 +234,7 @@ class CmplxEnv(PresetEnv):
             raise EnvError("step: the episode is over; call reset()")
         from fcplan.fire import BURNING
 
-        acts = self._actions(actions).tolist()
+        acts = self._actions(actions)
         w = self.world_size
         # 1. move (a loop over a few agents on Python ints: cheaper than numpy here)
         pos, zs = self._pos.tolist(), self._z.tolist()

@@ -143,7 +143,9 @@ class PresetEnv(_parallel_base()):
         from gymnasium import spaces
 
         self._n_actions = n_actions
-        pairs = list(zip(self.possible_agents, n_actions.tolist(), strict=True))
+        self._n_actions_list = n_actions.tolist()
+        self._default_list: list[int] | None = None  # (from self._default_action, on first use)
+        pairs = list(zip(self.possible_agents, self._n_actions_list, strict=True))
         self._action_spaces = {a: spaces.Discrete(k) for a, k in pairs}
         self._obs_spaces = {
             a: spaces.Dict(
@@ -198,14 +200,18 @@ class PresetEnv(_parallel_base()):
             self._reseed = np.random.default_rng()
         return np.random.SeedSequence(int(self._reseed.integers(2**63)))
 
-    def _actions(self, actions: dict) -> np.ndarray:
-        acts = np.zeros(self.n, dtype=np.int64)
-        for i, a in enumerate(self.possible_agents):
-            v = actions.get(a, self._default_action[i])
-            k = self._n_actions[i]
+    def _actions(self, actions: dict) -> list[int]:
+        """Each agent's action from ``{agent: action}`` (missing agents take their default),
+        checked, as Python ints in agent order."""
+        defaults = self._default_list
+        if defaults is None:
+            defaults = self._default_list = np.asarray(self._default_action).tolist()
+        acts = []
+        for a, d, k in zip(self.possible_agents, defaults, self._n_actions_list, strict=True):
+            v = actions.get(a, d)
             if not (isinstance(v, (int, np.integer)) and 0 <= v < k):
                 raise EnvError(f"action of {a}: must be an integer in 0..{k - 1} (got {v!r})")
-            acts[i] = v
+            acts.append(int(v))
         return acts
 
     def render(self):
