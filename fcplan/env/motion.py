@@ -401,21 +401,22 @@ class MotionEnv(_parallel_base()):
         if not self.agents:
             raise EnvError("step: the episode is over; call reset()")
         team, world = self._team, self._world
-        lists, spec, n_act = self._mask_lists, self._spec, self._n_actions_list
-        free = self._free_list
         goal, has_goal, mode, armed = team.goal, team.has_goal, team.mode, team.armed
         pos = None
-        for i, a in enumerate(self.possible_agents):
+        # (each mask tuple holds exactly the agent's actions: its length bounds the action)
+        for i, (a, row, spec, free) in enumerate(
+            zip(self.possible_agents, self._mask_lists, self._spec, self._free_list, strict=True)
+        ):
             v = actions.get(a, 0)
             try:
-                if not 0 <= v < n_act[i]:
+                if v < 0:
                     raise IndexError
-                legal = lists[i][v]
+                legal = row[v]
             except (IndexError, TypeError):
                 raise EnvError(
-                    f"action of {a}: must be an integer in 0..{n_act[i] - 1} (got {v!r})"
+                    f"action of {a}: must be an integer in 0..{len(row) - 1} (got {v!r})"
                 ) from None
-            kind, dx, dy, dz = spec[i][v] if legal else _STAY_SPEC
+            kind, dx, dy, dz = spec[v] if legal else _STAY_SPEC
             if kind == _K_MOVE:
                 # a goal _GOAL_REACH steps away: the agent flies exactly one step and never
                 # "arrives" (an arrival would arm a dump)
@@ -427,7 +428,7 @@ class MotionEnv(_parallel_base()):
                 has_goal[i] = True
                 mode[i] = _ACTIVE
                 continue
-            if free[i]:  # hover where it is (or stay idle at its depot slot)
+            if free:  # hover where it is (or stay idle at its depot slot)
                 has_goal[i] = False
             if kind == _K_DUMP:
                 # armed for this tick; active (hovering), so an emptied tank sends it home
@@ -493,14 +494,15 @@ class MotionEnv(_parallel_base()):
         cache = self._mask_cache
         vecs: list = []
         rows, masks, free_all, cxs, cys = [], [], [], [], []
-        for st, (x, y), zi, zti, bi, ti, m in zip(
-            self._py, pos, z, zt, bat, tank, mode, strict=True
-        ):
+        for (
             (hx, hy, lo, inv_span, inv_cap, inv_tank, sense, act, spw, drain, sp, hi_lim, z_hi,
-             z_lo, letter) = st  # fmt: skip
+             z_lo, letter),
+            (x, y), zi, zti, bi, ti, m,
+        ) in zip(self._py, pos, z, zt, bat, tank, mode, strict=True):  # fmt: skip
             zn = (zi - lo) * inv_span
             free = m <= _ACTIVE
             home = math.sqrt((hx - x) ** 2 + (hy - y) ** 2) * drain
+            conf = 1.0 - 0.6 * zn
             vecs += (
                 x * inv_w,
                 y * inv_w,
@@ -512,7 +514,7 @@ class MotionEnv(_parallel_base()):
                 sense,
                 act,
                 tf,
-                (max(1.0 - 0.6 * zn, 0.4) if sense else 0.0),
+                ((conf if conf > 0.4 else 0.4) if sense else 0.0),
                 spw,
             )
             # the action table's order: stay, west, east, north, south, then role actions

@@ -75,6 +75,7 @@ _COUNT_OF = {KNOWN: KNOWN_N, PRUNED: PRUNED_N}
 _SMALL = 16
 #: maps up to this many px use a cached px -> coarse-cell lookup table (4 bytes per px)
 _LUT_MAX_PX = 2048 * 2048
+_ONE32 = np.float32(1.0)
 
 
 @lru_cache(maxsize=4)
@@ -128,6 +129,7 @@ class CoarseMaps:
         self.flat = [self.grid[k].reshape(-1) for k in range(N_LAYERS)]
         self._lut = _lookup(w, c, r, h) if w * w <= _LUT_MAX_PX else None
         self._win_cache: dict[int, np.ndarray] = {}
+        self._views: list[tuple] = []
         #: per agent, whether its field of view counts as camera coverage
         self._sensing = [a.role.can_sense for a in scenario.agents]
         self._sensing_rows = [j for j, f in enumerate(self._sensing) if f]
@@ -165,7 +167,9 @@ class CoarseMaps:
         self._agent_cells: list[int] = []
         #: per agent placed by :meth:`place_agents`: 1.0 if another agent shares its cell
         self.shared: list[float] = []
-        self._pending: list[tuple[np.ndarray, float]] = []
+        #: cells that started burning, and cells pruned, not yet on the burning layer
+        self._pending: list[np.ndarray] = []
+        self._pending_out: list[np.ndarray] = []
 
     def padded_index(self, flat: np.ndarray) -> np.ndarray:
         """Flat px indices ``x * W + y`` -> flat indices into one padded layer of :attr:`grid`."""
@@ -199,24 +203,29 @@ class CoarseMaps:
     def update(self, info, world) -> None:
         """Fold one tick (:class:`fcplan.world.StepInfo`) of ``world`` into the maps."""
         if info.ignited.size:  # the burning layer is folded in on demand (burning_layer)
-            self._pending.append((info.ignited, 1.0))
-        self._add(KNOWN, info.newly_sensed, 1.0)
+            self._pending.append(info.ignited)
+        if info.newly_sensed.size:
+            self._add(KNOWN, info.newly_sensed, 1.0)
         pruned = info.pruned
         if pruned.size:
-            self._pending.append((pruned, -1.0))
+            self._pending_out.append(pruned)
             self._add(PRUNED, pruned, 1.0)
             seen = pruned[world.sensed.reshape(-1)[pruned]]
             self._add(KNOWN, seen, -1.0)
         self._cover(info.fov.tolist(), self._sensing_rows, -float(self.stamp(info.tick)))
-        if len(self._pending) > 512:
+        if len(self._pending) + len(self._pending_out) > 512:
             self.burning_layer()
 
     def burning_layer(self) -> np.ndarray:
         """(nc, nc) true burning px per coarse cell (a view of :attr:`grid`, brought up to
-        date first: per tick the changes are only queued, as observations do not need them)."""
-        for flat, sign in self._pending:
-            self._add(BURNING, flat, sign)
-        self._pending.clear()
+        date first: per tick the changes are only queued, as observations do not need them;
+        the queued cells go in with one ``np.add.at`` per sign, exact as the counts are whole
+        numbers)."""
+        for queue, sign in ((self._pending, 1.0), (self._pending_out, -1.0)):
+            if queue:
+                flat = queue[0] if len(queue) == 1 else np.concatenate(queue)
+                self._add(BURNING, flat, sign)
+                queue.clear()
         return self.inner[BURNING]
 
     def cover(self, rects: list, tick: int, which: list | None = None) -> None:
@@ -296,13 +305,20 @@ class CoarseMaps:
         self.place_agents(cx, cy)
         v, r = self.view, self.radius
         out = np.empty((len(cx), layers, v, v), dtype=np.float32)
-        win = self._windows(layers)
+        # per agent, the window view of its cell (kept while it stays in the cell)
+        views = self._views
+        if len(views) != len(cx) or views[0][0] != layers:
+            views = self._views = [(layers, -1, -1, None)] * len(cx)
         for i, (x, y) in enumerate(zip(cx, cy, strict=True)):
-            out[i] = win[:, x, y]
+            _, vx, vy, w = views[i]
+            if vx != x or vy != y:
+                w = self._windows(layers)[:, x, y]
+                views[i] = (layers, x, y, w)
+            out[i] = w
         out[:, AGENTS, r, r] = self.shared
         seen = out[:, LAST_SEEN]
         np.add(seen, np.float32(tick * self.seen_scale), out=seen)
-        np.minimum(seen, 1.0, out=seen)
+        np.minimum(seen, _ONE32, out=seen)
         return out
 
     def gather(self, pos: np.ndarray) -> np.ndarray:
