@@ -110,7 +110,6 @@ from fcplan.env.motion_grid import (
     FACILITY,
     KNOWN_N,
     LAKE,
-    LAST_SEEN,
     PRUNED_N,
     CoarseMaps,
 )
@@ -602,7 +601,7 @@ class MotionEnv(_parallel_base()):
         np.minimum(maps.burning_layer() * inv_c, 1.0, out=s[0])
         np.minimum(inner[KNOWN_N] * inv_c, 1.0, out=s[1])
         np.minimum(inner[PRUNED_N] * inv_c, 1.0, out=s[2])
-        np.minimum(inner[LAST_SEEN] + maps.stamp(self._world.tick), 1.0, out=s[3])
+        s[3] = maps.staleness(self._world.tick)
         cx, cy = maps.cells(team.pos)
         np.add.at(s[4], (cx[team.can_sense], cy[team.can_sense]), 1.0)
         np.add.at(s[5], (cx[team.can_act], cy[team.can_act]), 1.0)

@@ -3,8 +3,8 @@
 The motion environment observes the 1-px world through **coarse cells** of ``cell_px`` px. The
 maps it crops from are kept per coarse cell and updated *incrementally* from each tick's
 :class:`fcplan.world.StepInfo` (cells ignited, sensed for the first time, pruned; fields of view),
-so a tick never scans the full grid. All agents' crops come from one fancy-indexed gather on a
-``sliding_window_view`` of a padded stack of maps.
+so a tick never scans the full grid. Each agent's crop is one copy of a window
+(``sliding_window_view``) of a padded stack of maps.
 
 Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px) + 2 r``,
 ``r = view // 2`` cells of padding):
@@ -13,9 +13,11 @@ Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px
  0   ``known``       known burning px in the cell (sensed, not yet pruned) / ``cell_px``,
                      clipped to 1 (the count itself is layer 8, ``known_n``)
  1   ``pruned``      pruned px in the cell / ``cell_px``, clipped to 1 (count: layer 9)
- 2   ``seen``        minus the tick the cell last overlapped a sensing agent's field of view,
-                     times ``seen_scale`` (``+inf``: never, and outside the map), so that
-                     ``min(1, seen + tick * seen_scale)`` is the cell's staleness
+ 2   ``stale``       staleness ``min(1, seen + tick * seen_scale)`` at the tick of the last
+                     :meth:`CoarseMaps.observe` (1 before the first; 1 in the padding), from
+                     :attr:`CoarseMaps.seen`: minus the tick the cell last overlapped a sensing
+                     agent's field of view, times ``seen_scale`` (``+inf``: never, and outside
+                     the map)
  3   ``agents``      1 where at least one agent is (see :meth:`CoarseMaps.place_agents`)
  4   ``outside``     share of the cell outside the map (1 in the padding)
  5   ``lake``        share of the cell covered by a lake
@@ -28,8 +30,9 @@ Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px
 ===  ==============  =====================================================================
 
 Layers 0-1 are kept scaled and clipped (updated with their counts, a few cells per tick), and
-layer 3 as 0/1, so an observation crop (:meth:`CoarseMaps.observe`) needs arithmetic only on the
-``seen`` layer (plus one write per agent: whether another agent shares its cell).
+layer 3 as 0/1; :meth:`CoarseMaps.observe` recomputes layer 2 over the whole padded layer (two
+operations on contiguous arrays, cheaper than the same on the crops), so an observation crop
+needs no arithmetic (only one write per agent: whether another agent shares its cell).
 
 Examples
 --------
@@ -119,7 +122,11 @@ class CoarseMaps:
         self.grid = np.zeros((N_LAYERS, nc + 2 * r, nc + 2 * r), dtype=np.float32)
         #: (L, nc, nc) view of the map part of :attr:`grid`
         self.inner = self.grid[:, r : r + nc, r : r + nc]
-        self._seen = self.inner[LAST_SEEN]
+        #: (H, H) float32: minus the tick each cell was last seen, times ``seen_scale``
+        self.seen = np.full(self.grid.shape[1:], np.inf, dtype=np.float32)
+        self._seen = self.seen[r : r + nc, r : r + nc]
+        self._seen_flat = self.seen.reshape(-1)
+        self._stale_flat = self.grid[LAST_SEEN].reshape(-1)  # (a view: the grid is contiguous)
         self._static = self._static_layers(scenario)
         #: (L, H-view+1, H-view+1, view, view) windows; a crop is ``windows[:, cx, cy]``
         self.windows = sliding_window_view(self.grid, (self.view, self.view), axis=(1, 2))
@@ -130,6 +137,7 @@ class CoarseMaps:
         self._lut = _lookup(w, c, r, h) if w * w <= _LUT_MAX_PX else None
         self._win_cache: dict[int, np.ndarray] = {}
         self._views: list[tuple] = []
+        self._view_list: list = []
         #: per agent, whether its field of view counts as camera coverage
         self._sensing = [a.role.can_sense for a in scenario.agents]
         self._sensing_rows = [j for j, f in enumerate(self._sensing) if f]
@@ -162,7 +170,8 @@ class CoarseMaps:
         g = self.grid
         g[:] = 0.0
         g[OUTSIDE] = 1.0
-        g[LAST_SEEN] = np.inf
+        g[LAST_SEEN] = 1.0
+        self.seen[:] = np.inf
         self.inner[OUTSIDE : FACILITY + 1] = self._static
         self._agent_cells: list[int] = []
         #: per agent placed by :meth:`place_agents`: 1.0 if another agent shares its cell
@@ -247,8 +256,12 @@ class CoarseMaps:
             seen[i0 if i0 > 0 else 0 : i1, j0 if j0 > 0 else 0 : j1] = value
 
     def stamp(self, tick: int) -> np.float32:
-        """``tick * seen_scale`` as float32 (add it to the ``seen`` layer to get staleness)."""
+        """``tick * seen_scale`` as float32 (add it to :attr:`seen` to get staleness)."""
         return np.float32(tick * self.seen_scale)
+
+    def staleness(self, tick: int) -> np.ndarray:
+        """(nc, nc) float32 staleness of the map's cells at ``tick`` (a fresh array)."""
+        return np.minimum(self._seen + self.stamp(tick), 1.0)
 
     def place_agents(self, cx: list, cy: list) -> None:
         """Mark the coarse cells ``(cx[i], cy[i])`` (lists of int inside the map) on the ``agents``
@@ -297,28 +310,27 @@ class CoarseMaps:
         """The agents' observation crops at ``tick``: (N, layers, view, view) float32 with
         ``layers >= 4``, a fresh C-contiguous array.
 
-        Places the agents of coarse cells ``(cx[i], cy[i])`` (:meth:`place_agents`), crops the
-        first ``layers`` layers around each, turns ``seen`` into staleness
-        ``min(1, seen + tick * seen_scale)`` and sets each crop's centre on ``agents`` to whether
-        *another* agent shares the cell.
+        Places the agents of coarse cells ``(cx[i], cy[i])`` (:meth:`place_agents`), brings the
+        ``stale`` layer to ``tick`` (``min(1, seen + tick * seen_scale)``), crops the first
+        ``layers`` layers around each agent and sets each crop's centre on ``agents`` to
+        whether *another* agent shares the cell.
         """
         self.place_agents(cx, cy)
-        v, r = self.view, self.radius
-        out = np.empty((len(cx), layers, v, v), dtype=np.float32)
+        stale = self._stale_flat
+        np.add(self._seen_flat, np.float32(tick * self.seen_scale), out=stale)
+        np.minimum(stale, _ONE32, out=stale)
         # per agent, the window view of its cell (kept while it stays in the cell)
-        views = self._views
-        if len(views) != len(cx) or views[0][0] != layers:
-            views = self._views = [(layers, -1, -1, None)] * len(cx)
+        views, wins = self._views, self._view_list
+        if len(views) != len(cx) or (views and views[0][0] != layers):
+            views = self._views = [(layers, -1, -1)] * len(cx)
+            wins = self._view_list = [None] * len(cx)
         for i, (x, y) in enumerate(zip(cx, cy, strict=True)):
-            _, vx, vy, w = views[i]
-            if vx != x or vy != y:
-                w = self._windows(layers)[:, x, y]
-                views[i] = (layers, x, y, w)
-            out[i] = w
+            if views[i][1] != x or views[i][2] != y:
+                views[i] = (layers, x, y)
+                wins[i] = self._windows(layers)[:, x, y]
+        out = np.array(wins)  # (one copy of all the windows)
+        r = self.radius
         out[:, AGENTS, r, r] = self.shared
-        seen = out[:, LAST_SEEN]
-        np.add(seen, np.float32(tick * self.seen_scale), out=seen)
-        np.minimum(seen, _ONE32, out=seen)
         return out
 
     def gather(self, pos: np.ndarray) -> np.ndarray:

@@ -288,3 +288,23 @@ def test_rf1_penalty_small_equals_numpy(n, seed, comm_range):
     want = rf1_structure_penalty(pos, is_p, comm_range)
     got = rf1_penalty_small(pos.tolist(), is_p.tolist(), comm_range)
     assert got == want and type(got) is float
+
+
+@pytest.mark.parametrize("variant", ["cmplx1", "cmplx2"])
+def test_cmplx_incremental_layers_equal_the_fire(variant):
+    """The cmplx env's padded known-fire and pruned layers, kept up to date from each step's
+    sensed and pruned cells, equal a direct computation from the fire state and the sensed
+    grid at every step (also with agents moved by hand between steps)."""
+    env = CmplxEnv(variant=variant, max_steps=120)
+    env.reset(seed=3)
+    rng = np.random.default_rng(3)
+    w, r = env.world_size, env.max_alt
+    for t in range(120):
+        if t % 30 == 10:  # put the team on a fire region: pruning happens
+            env._pos[:] = [int(v) for v in env.regions[t % len(env.regions)].center]
+        env.step({a: int(rng.integers(env.action_space(a).n)) for a in env.agents})
+        inner = env._grid[:, r : r + w, r : r + w]
+        known = (env.fire.state == BURNING) & env.sensed
+        np.testing.assert_array_equal(inner[2], known.astype(np.float32))
+        np.testing.assert_array_equal(inner[3], (env.fire.state == PRUNED).astype(np.float32))
+    assert env.fire.n_pruned > 0
