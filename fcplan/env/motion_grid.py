@@ -14,7 +14,8 @@ Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px
                      clipped to 1 (the count itself is layer 8, ``known_n``)
  1   ``pruned``      pruned px in the cell / ``cell_px``, clipped to 1 (count: layer 9)
  2   ``stale``       staleness ``min(1, seen + tick * seen_scale)`` at the tick of the last
-                     :meth:`CoarseMaps.observe` (1 before the first; 1 in the padding), from
+                     :meth:`CoarseMaps.observe` in the rows its crops spanned (1 before the
+                     first; 1 in the padding; :meth:`CoarseMaps.staleness` for the map), from
                      :attr:`CoarseMaps.seen`: minus the tick the cell last overlapped a sensing
                      agent's field of view, times ``seen_scale`` (``+inf``: never, and outside
                      the map)
@@ -30,9 +31,9 @@ Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px
 ===  ==============  =====================================================================
 
 Layers 0-1 are kept scaled and clipped (updated with their counts, a few cells per tick), and
-layer 3 as 0/1; :meth:`CoarseMaps.observe` recomputes layer 2 over the whole padded layer (two
-operations on contiguous arrays, cheaper than the same on the crops), so an observation crop
-needs no arithmetic (only one write per agent: whether another agent shares its cell).
+layer 3 as 0/1; :meth:`CoarseMaps.observe` recomputes layer 2 over the rows the crops span
+(two operations on one contiguous run, cheaper than the same on the strided crop channel), so
+the crops need no arithmetic (only one write per agent: whether another agent shares its cell).
 
 Examples
 --------
@@ -126,6 +127,8 @@ class CoarseMaps:
         self.seen = np.full(self.grid.shape[1:], np.inf, dtype=np.float32)
         self._seen = self.seen[r : r + nc, r : r + nc]
         self._seen_flat = self.seen.reshape(-1)
+        #: the agents layer, flat, from the first map cell: cell (cx, cy) is at cx * H + cy
+        self._agents_flat = self.grid[AGENTS].reshape(-1)[r * (nc + 2 * r + 1) :]
         self._stale_flat = self.grid[LAST_SEEN].reshape(-1)  # (a view: the grid is contiguous)
         self._static = self._static_layers(scenario)
         #: (L, H-view+1, H-view+1, view, view) windows; a crop is ``windows[:, cx, cy]``
@@ -136,8 +139,6 @@ class CoarseMaps:
         self.flat = [self.grid[k].reshape(-1) for k in range(N_LAYERS)]
         self._lut = _lookup(w, c, r, h) if w * w <= _LUT_MAX_PX else None
         self._win_cache: dict[int, np.ndarray] = {}
-        self._views: list[tuple] = []
-        self._view_list: list = []
         #: per agent, whether its field of view counts as camera coverage
         self._sensing = [a.role.can_sense for a in scenario.agents]
         self._sensing_rows = [j for j, f in enumerate(self._sensing) if f]
@@ -174,8 +175,9 @@ class CoarseMaps:
         self.seen[:] = np.inf
         self.inner[OUTSIDE : FACILITY + 1] = self._static
         self._agent_cells: list[int] = []
-        #: per agent placed by :meth:`place_agents`: 1.0 if another agent shares its cell
-        self.shared: list[float] = []
+        #: per agent placed by :meth:`place_agents`: 1.0 if another agent shares its cell (or
+        #: 0.0 alone: no agent shares one)
+        self.shared: list[float] | float = 0.0
         #: cells that started burning, and cells pruned, not yet on the burning layer
         self._pending: list[np.ndarray] = []
         self._pending_out: list[np.ndarray] = []
@@ -268,18 +270,22 @@ class CoarseMaps:
         layer (1 where at least one agent is), replacing the previous placement, and note per
         agent in :attr:`shared` whether another agent is in its cell (a loop over agents: a
         handful of scalar writes beat numpy's fancy indexing here)."""
-        h, off = self._h, self.radius * (self._h + 1)
-        cells = [x * h + y + off for x, y in zip(cx, cy, strict=True)]
+        h = self._h
+        cells = [x * h + y for x, y in zip(cx, cy, strict=True)]
         if cells == self._agent_cells:  # nobody changed cell
             return
-        layer = self.flat[AGENTS]
+        layer = self._agents_flat
         for c in self._agent_cells:
             layer[c] = 0.0
-        count: dict[int, int] = {}
         for c in cells:
             layer[c] = 1.0
-            count[c] = count.get(c, 0) + 1
-        self.shared = [1.0 if count[c] > 1 else 0.0 for c in cells]
+        if len(set(cells)) == len(cells):  # (the usual case: nobody shares a cell)
+            self.shared = 0.0
+        else:
+            count: dict[int, int] = {}
+            for c in cells:
+                count[c] = count.get(c, 0) + 1
+            self.shared = [1.0 if count[c] > 1 else 0.0 for c in cells]
         self._agent_cells = cells
 
     def cells(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -290,20 +296,17 @@ class CoarseMaps:
 
     def crops(self, cx: list, cy: list, layers: int) -> np.ndarray:
         """(N, layers, view, view) crops of the first ``layers`` layers centred on coarse cells
-        ``(cx[i], cy[i])`` (lists of int inside the map; a fresh C-contiguous array, filled by
-        one window copy per agent)."""
-        v = self.view
-        out = np.empty((len(cx), layers, v, v), dtype=np.float32)
-        win = self._windows(layers)
-        for i, (x, y) in enumerate(zip(cx, cy, strict=True)):
-            out[i] = win[:, x, y]
-        return out
+        ``(cx[i], cy[i])`` (lists of int inside the map; a fresh C-contiguous array, one
+        fancy-indexed gather of the windows)."""
+        return self._windows(layers)[cx, cy]
 
     def _windows(self, layers: int) -> np.ndarray:
-        """:attr:`windows` of the first ``layers`` layers (cached)."""
+        """:attr:`windows` of the first ``layers`` layers with the layer axis third, ``(H-view+1,
+        H-view+1, layers, view, view)`` (cached): ``_windows(k)[cx, cy]`` gathers the crops of
+        cells ``(cx[i], cy[i])`` as one fresh ``(N, k, view, view)`` array."""
         win = self._win_cache.get(layers)
         if win is None:
-            win = self._win_cache[layers] = self.windows[:layers]
+            win = self._win_cache[layers] = np.moveaxis(self.windows[:layers], 0, 2)
         return win
 
     def observe(self, cx: list, cy: list, tick: int, layers: int) -> np.ndarray:
@@ -311,24 +314,18 @@ class CoarseMaps:
         ``layers >= 4``, a fresh C-contiguous array.
 
         Places the agents of coarse cells ``(cx[i], cy[i])`` (:meth:`place_agents`), brings the
-        ``stale`` layer to ``tick`` (``min(1, seen + tick * seen_scale)``), crops the first
-        ``layers`` layers around each agent and sets each crop's centre on ``agents`` to
-        whether *another* agent shares the cell.
+        ``stale`` layer to ``tick`` (``min(1, seen + tick * seen_scale)``) in the rows the crops
+        span, crops the first ``layers`` layers around each agent and sets each crop's centre
+        on ``agents`` to whether *another* agent shares the cell.
         """
         self.place_agents(cx, cy)
-        stale = self._stale_flat
-        np.add(self._seen_flat, np.float32(tick * self.seen_scale), out=stale)
+        # the rows of the padded layers the crops span, as one contiguous run of cells
+        h = self._h
+        lo, hi = min(cx) * h, (max(cx) + self.view) * h
+        stale = self._stale_flat[lo:hi]
+        np.add(self._seen_flat[lo:hi], np.float32(tick * self.seen_scale), out=stale)
         np.minimum(stale, _ONE32, out=stale)
-        # per agent, the window view of its cell (kept while it stays in the cell)
-        views, wins = self._views, self._view_list
-        if len(views) != len(cx) or (views and views[0][0] != layers):
-            views = self._views = [(layers, -1, -1)] * len(cx)
-            wins = self._view_list = [None] * len(cx)
-        for i, (x, y) in enumerate(zip(cx, cy, strict=True)):
-            if views[i][1] != x or views[i][2] != y:
-                views[i] = (layers, x, y)
-                wins[i] = self._windows(layers)[:, x, y]
-        out = np.array(wins)  # (one copy of all the windows)
+        out = self._windows(layers)[cx, cy]  # (one gather of all the windows)
         r = self.radius
         out[:, AGENTS, r, r] = self.shared
         return out
