@@ -184,6 +184,11 @@ class CmplxEnv(PresetEnv):
         cx = np.arange(w, dtype=np.int64) + r
         #: flat map cell x * W + y -> flat index in a padded layer
         self._lut = (cx[:, None] * h + cx[None, :]).reshape(-1)
+        #: the windows with the channel axis third: ``[xs, ys]`` gathers (N, 6, side, side)
+        self._windows_t = np.moveaxis(self._windows, 0, 2)
+        xs = np.arange(w, dtype=np.int64)
+        #: flat map cell x * W + y -> x * side + y
+        self._side_lut = (xs[:, None] * side + xs[None, :]).reshape(-1)
 
     # ------------------------------------------------------------------ episode
     def reset(self, seed: int | None = None, options: dict | None = None):
@@ -380,17 +385,21 @@ class CmplxEnv(PresetEnv):
                 count[c] = count.get(c, 0) + 1
             self._shared = [1.0 if count[c] > 1 else 0.0 for c in cells]
             self._agent_cells = cells
-        fov = np.empty((n, _N_FOV, side, side), dtype=np.float32)
-        win = self._windows
+        xs, ys = [p[0] for p in pos], [p[1] for p in pos]
+        fov = self._windows_t[xs, ys]  # (one gather of the agents' windows, a fresh array)
+        flat = fov.reshape(-1)
+        area = side * side
         vec = []
         dz = max(self.max_alt - self.min_alt, 1)
         for i, ((x, y), z) in enumerate(zip(pos, zs, strict=True)):
-            fov[i] = win[:, x, y]  # (the window of the padded grid centred on the agent)
             bx0, bx1, by0, by1 = self._box_of((x, y), z)
             fov[i, _BOX, bx0 - x + r : bx1 - x + r, by0 - y + r : by1 - y + r] = 1.0
             got = self._this_step[i]
-            if got.size:
-                fov[i, _THIS_STEP, got // w - x + r, got % w - y + r] = 1.0
+            if got.size:  # (map cell -> its place in the crop, through the cell's x * side + y)
+                flat[
+                    self._side_lut[got]
+                    + ((i * _N_FOV + _THIS_STEP) * area - (x - r) * side - (y - r))
+                ] = 1.0
             vec += (x / (w - 1), y / (w - 1), (z - self.min_alt) / dz, float(self._is_p[i]))
         fov[:, _AGENTS, r, r] = self._shared
         agent = np.array(vec, dtype=np.float32).reshape(n, 4)

@@ -94,19 +94,19 @@ def rf1_penalty_small(pos: list, is_perception: list, comm_range: float) -> floa
     float
         The penalty magnitude (RF1 subtracts it).
     """
-    lonely = unpaired = 0
-    for i, (xi, yi) in enumerate(pos):
-        near = paired = False
-        role = is_perception[i]
-        for j, (xj, yj) in enumerate(pos):
-            if j != i and max(abs(xj - xi), abs(yj - yi)) <= comm_range:
-                near = True
-                if is_perception[j] != role:
-                    paired = True
-                    break
-        lonely += not near
-        unpaired += not paired
-    return float(lonely + 3 * unpaired)
+    n = len(pos)
+    near = [False] * n
+    paired = [False] * n
+    c = comm_range
+    for i in range(n):
+        xi, yi = pos[i]
+        for j in range(i + 1, n):  # (each pair once: the relation is symmetric)
+            dx, dy = pos[j][0] - xi, pos[j][1] - yi
+            if -c <= dx <= c and -c <= dy <= c:  # Chebyshev distance <= c
+                near[i] = near[j] = True
+                if is_perception[i] != is_perception[j]:
+                    paired[i] = paired[j] = True
+    return float((n - sum(near)) + 3 * (n - sum(paired)))
 
 
 def _parallel_base():
