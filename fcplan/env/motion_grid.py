@@ -321,7 +321,7 @@ class CoarseMaps:
         self.place_agents(cx, cy)
         # the rows of the padded layers the crops span, as one contiguous run of cells
         h = self._h
-        lo, hi = min(cx) * h, (max(cx) + self.view) * h
+        lo, hi = (min(cx) * h, (max(cx) + self.view) * h) if cx else (0, 0)
         stale = self._stale_flat[lo:hi]
         np.add(self._seen_flat[lo:hi], np.float32(tick * self.seen_scale), out=stale)
         np.minimum(stale, _ONE32, out=stale)
