@@ -272,7 +272,6 @@ class MotionEnv(_parallel_base()):
             [[a.role.can_sense, a.role.can_act] for a in sc.agents], dtype=np.float32
         ).reshape(n, 2)
         self._modes = np.arange(4)
-        self._r = self.view // 2
         self._inv_c = 1.0 / self.cell_px  # a Python float: the fastest scalar for numpy
         self._shaping = bool(self.sense_bonus or self.prune_bonus or self.dump_cost)
         self._action_spaces = {
