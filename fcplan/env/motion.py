@@ -153,6 +153,8 @@ _IDLE, _ACTIVE = 0, 1
 _ONE_HOT = tuple(tuple(float(m == k) for k in range(4)) for m in range(4))
 #: stay, west, east, north, south of an agent flown home (only stay is legal)
 _HOMING_MOVES = (True, False, False, False, False)
+#: the action mask tuple of each role when every action is legal
+_ALL_LEGAL = {r: (True,) * len(names) for r, names in ACTION_NAMES.items()}
 #: a move sets a goal this many steps away, so the agent never arrives (see MotionEnv.step)
 _GOAL_REACH = 1.5
 
@@ -516,13 +518,24 @@ class MotionEnv(_parallel_base()):
                 spw,
             )
             # the action table's order: stay, west, east, north, south, then role actions
-            moves = (True, x >= sp, x <= hi_lim, y >= sp, y <= hi_lim) if free else _HOMING_MOVES
-            if letter == "P":
-                row = (*moves, zti < z_hi, zti > z_lo)
-            elif letter == "A":
-                row = (*moves, free and ti > 0)
+            if (
+                free
+                and sp <= x <= hi_lim
+                and sp <= y <= hi_lim
+                and (letter == "A" or z_lo < zti < z_hi)
+                and (letter == "P" or ti > 0)
+            ):  # (the usual case: everything is legal)
+                row = _ALL_LEGAL[letter]
             else:
-                row = (*moves, zti < z_hi, zti > z_lo, free and ti > 0)
+                moves = (
+                    (True, x >= sp, x <= hi_lim, y >= sp, y <= hi_lim) if free else _HOMING_MOVES
+                )
+                if letter == "P":
+                    row = (*moves, zti < z_hi, zti > z_lo)
+                elif letter == "A":
+                    row = (*moves, free and ti > 0)
+                else:
+                    row = (*moves, zti < z_hi, zti > z_lo, free and ti > 0)
             rows.append(row)
             # (the tuple says its agent's role by its length: one cached array per tuple)
             arr = cache.get(row)
