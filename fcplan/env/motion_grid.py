@@ -3,8 +3,8 @@
 The motion environment observes the 1-px world through **coarse cells** of ``cell_px`` px. The
 maps it crops from are kept per coarse cell and updated *incrementally* from each tick's
 :class:`fcplan.world.StepInfo` (cells ignited, sensed for the first time, pruned; fields of view),
-so a tick never scans the full grid. Each agent's crop is one copy of a window
-(``sliding_window_view``) of a padded stack of maps.
+so a tick never scans the full grid. All agents' crops come from one fancy-indexed gather on a
+``sliding_window_view`` of a padded stack of maps.
 
 Layers of :attr:`CoarseMaps.grid` (``(L, H, H)`` float32, ``H = ceil(W / cell_px) + 2 r``,
 ``r = view // 2`` cells of padding):
