@@ -107,11 +107,9 @@ import numpy as np
 
 from fcplan.env import EnvError
 from fcplan.env.motion_grid import (
-    AGENTS,
     FACILITY,
     KNOWN_N,
     LAKE,
-    LAST_SEEN,
     PRUNED_N,
     CoarseMaps,
 )
@@ -153,6 +151,10 @@ _N_STATE = 8
 _IDLE, _ACTIVE = 0, 1
 #: mode one-hot features (idle, active, returning, homing) per team mode
 _ONE_HOT = tuple(tuple(float(m == k) for k in range(4)) for m in range(4))
+#: stay, west, east, north, south of an agent flown home (only stay is legal)
+_HOMING_MOVES = (True, False, False, False, False)
+#: the action mask tuple of each role when every action is legal
+_ALL_LEGAL = {r: (True,) * len(names) for r, names in ACTION_NAMES.items()}
 #: a move sets a goal this many steps away, so the agent never arrives (see MotionEnv.step)
 _GOAL_REACH = 1.5
 
@@ -272,7 +274,6 @@ class MotionEnv(_parallel_base()):
             [[a.role.can_sense, a.role.can_act] for a in sc.agents], dtype=np.float32
         ).reshape(n, 2)
         self._modes = np.arange(4)
-        self._r = self.view // 2
         self._inv_c = 1.0 / self.cell_px  # a Python float: the fastest scalar for numpy
         self._shaping = bool(self.sense_bonus or self.prune_bonus or self.dump_cost)
         self._action_spaces = {
@@ -389,6 +390,8 @@ class MotionEnv(_parallel_base()):
             for i, sp in enumerate(team.speed.tolist())
         ]
         self._n_actions_list = self._n_actions.tolist()
+        #: action mask tuples -> int8 arrays (copied into each observation)
+        self._mask_cache: dict[tuple, np.ndarray] = {}
         self._maps.reset()
         self._tick_rate = float(self.scenario.ticks_per_second)
         self._n_ticks = self.scenario.n_ticks
@@ -405,21 +408,22 @@ class MotionEnv(_parallel_base()):
         if not self.agents:
             raise EnvError("step: the episode is over; call reset()")
         team, world = self._team, self._world
-        lists, spec, n_act = self._mask_lists, self._spec, self._n_actions_list
-        free = self._free_list
         goal, has_goal, mode, armed = team.goal, team.has_goal, team.mode, team.armed
         pos = None
-        for i, a in enumerate(self.possible_agents):
+        # (each mask tuple holds exactly the agent's actions: its length bounds the action)
+        for i, (a, row, spec, free) in enumerate(
+            zip(self.possible_agents, self._mask_lists, self._spec, self._free_list, strict=True)
+        ):
             v = actions.get(a, 0)
             try:
-                if not 0 <= v < n_act[i]:
+                if v < 0:
                     raise IndexError
-                legal = lists[i][v]
+                legal = row[v]
             except (IndexError, TypeError):
                 raise EnvError(
-                    f"action of {a}: must be an integer in 0..{n_act[i] - 1} (got {v!r})"
+                    f"action of {a}: must be an integer in 0..{len(row) - 1} (got {v!r})"
                 ) from None
-            kind, dx, dy, dz = spec[i][v] if legal else _STAY_SPEC
+            kind, dx, dy, dz = spec[v] if legal else _STAY_SPEC
             if kind == _K_MOVE:
                 # a goal _GOAL_REACH steps away: the agent flies exactly one step and never
                 # "arrives" (an arrival would arm a dump)
@@ -431,7 +435,7 @@ class MotionEnv(_parallel_base()):
                 has_goal[i] = True
                 mode[i] = _ACTIVE
                 continue
-            if free[i]:  # hover where it is (or stay idle at its depot slot)
+            if free:  # hover where it is (or stay idle at its depot slot)
                 has_goal[i] = False
             if kind == _K_DUMP:
                 # armed for this tick; active (hovering), so an emptied tank sends it home
@@ -473,33 +477,39 @@ class MotionEnv(_parallel_base()):
         return obs, rewards, terms, truncs, infos
 
     # ------------------------------------------------------------------ observations
-    def _agent_arrays(self) -> tuple[np.ndarray, np.ndarray, list, list]:
-        """``(vectors (n, 15) float32, masks (n, 8) int8, coarse x, coarse y)``, and the agents
-        that take orders in ``self._free_list``: a plain Python loop over the agents for small
-        teams (a few numpy calls cost more than the whole loop there), numpy beyond
-        :data:`_PY_AGENTS` agents; both give identical results."""
+    def _agent_arrays(self) -> tuple[np.ndarray, list, list, list]:
+        """``(vectors (n, 15) float32, masks, coarse x, coarse y)``: ``masks[i]`` is agent
+        ``i``'s fresh ``(n_actions,)`` int8 action mask. Also keeps the masks as tuples of bools
+        in ``self._mask_lists`` and the agents that take orders in ``self._free_list`` (read by
+        :meth:`step`). A plain Python loop over the agents for small teams (a few numpy calls
+        cost more than the whole loop there), numpy beyond :data:`_PY_AGENTS` agents; both give
+        identical results."""
         team = self._team
         inv_w = self._inv_w
         if self._n > _PY_AGENTS:
             vec, mask = self._agent_vectors(), self._masks()
             self._free_list = self._free.tolist()
-            self._mask_lists = mask.tolist()
+            k = self._n_actions_list
+            self._mask_lists = [tuple(row[: k[i]]) for i, row in enumerate(mask.tolist())]
+            masks = [mask[i, : k[i]] for i in range(self._n)]
             cell = (team.pos // self.cell_px).astype(np.int64)  # agents never leave the map
-            return vec, mask, cell[:, 0].tolist(), cell[:, 1].tolist()
+            return vec, masks, cell[:, 0].tolist(), cell[:, 1].tolist()
         cpx = self.cell_px
         pos, z, zt = team.pos.tolist(), team.z.tolist(), team.z_target.tolist()
         bat, tank, mode = team.battery.tolist(), team.tank.tolist(), team.mode.tolist()
         tf = self._world.tick / self._n_ticks
+        cache = self._mask_cache
         vecs: list = []
-        rows, free_all, cxs, cys = [], [], [], []
-        for st, (x, y), zi, zti, bi, ti, m in zip(
-            self._py, pos, z, zt, bat, tank, mode, strict=True
-        ):
+        rows, masks, free_all, cxs, cys = [], [], [], [], []
+        for (
             (hx, hy, lo, inv_span, inv_cap, inv_tank, sense, act, spw, drain, sp, hi_lim, z_hi,
-             z_lo, letter) = st  # fmt: skip
+             z_lo, letter),
+            (x, y), zi, zti, bi, ti, m,
+        ) in zip(self._py, pos, z, zt, bat, tank, mode, strict=True):  # fmt: skip
             zn = (zi - lo) * inv_span
             free = m <= _ACTIVE
             home = math.sqrt((hx - x) ** 2 + (hy - y) ** 2) * drain
+            conf = 1.0 - 0.6 * zn
             vecs += (
                 x * inv_w,
                 y * inv_w,
@@ -511,30 +521,41 @@ class MotionEnv(_parallel_base()):
                 sense,
                 act,
                 tf,
-                (max(1.0 - 0.6 * zn, 0.4) if sense else 0.0),
+                ((conf if conf > 0.4 else 0.4) if sense else 0.0),
                 spw,
             )
             # the action table's order: stay, west, east, north, south, then role actions
-            moves = (
-                True,
-                free and x >= sp,
-                free and x <= hi_lim,
-                free and y >= sp,
-                free and y <= hi_lim,
-            )
-            if letter == "P":
-                rows.append((*moves, zti < z_hi, zti > z_lo, False))
-            elif letter == "A":
-                rows.append((*moves, free and ti > 0, False, False))
+            if (
+                free
+                and sp <= x <= hi_lim
+                and sp <= y <= hi_lim
+                and (letter == "A" or z_lo < zti < z_hi)
+                and (letter == "P" or ti > 0)
+            ):  # (the usual case: everything is legal)
+                row = _ALL_LEGAL[letter]
             else:
-                rows.append((*moves, zti < z_hi, zti > z_lo, free and ti > 0))
+                moves = (
+                    (True, x >= sp, x <= hi_lim, y >= sp, y <= hi_lim) if free else _HOMING_MOVES
+                )
+                if letter == "P":
+                    row = (*moves, zti < z_hi, zti > z_lo)
+                elif letter == "A":
+                    row = (*moves, free and ti > 0)
+                else:
+                    row = (*moves, zti < z_hi, zti > z_lo, free and ti > 0)
+            rows.append(row)
+            # (the tuple says its agent's role by its length: one cached array per tuple)
+            arr = cache.get(row)
+            if arr is None:
+                arr = cache[row] = np.array(row, dtype=np.int8)
+            masks.append(arr.copy())
             free_all.append(free)
             cxs.append(int(x // cpx))
             cys.append(int(y // cpx))
         self._free_list = free_all
         self._mask_lists = rows
         vec = np.array(vecs, dtype=np.float32).reshape(self._n, _N_AGENT_FEATURES)
-        return vec, np.array(rows, dtype=np.int8), cxs, cys
+        return vec, masks, cxs, cys
 
     def _masks(self) -> np.ndarray:
         """(n, 8) int8 legal actions, from a (n, 8) table of conditions picked per action."""
@@ -579,19 +600,13 @@ class MotionEnv(_parallel_base()):
         return v
 
     def _observe(self) -> dict:
-        maps = self._maps
-        vec, mask, cx, cy = self._agent_arrays()
-        k = self._n_actions_list
-        rows = [mask[i, : k[i]] for i in range(self._n)]
-        maps.place_agents(cx, cy)
-        fov = maps.crops(cx, cy, _N_FOV)  # (n, 7, V, V), a fresh array
-        # known and pruned come scaled and clipped; staleness and agents are clipped here
-        fov[:, LAST_SEEN] += maps.stamp(self._world.tick)
-        fov[:, AGENTS, self._r, self._r] -= 1.0  # others only
-        tail = fov[:, LAST_SEEN : AGENTS + 1]
-        np.minimum(tail, 1.0, out=tail)
+        vec, masks, cx, cy = self._agent_arrays()
+        # (N, 7, V, V), a fresh array: known and pruned come scaled and clipped, the agents
+        # layer as "another agent is there", staleness clipped
+        fov = self._maps.observe(cx, cy, self._world.tick, _N_FOV)
+        # (indexing the arrays: iterating over them costs more)
         return {
-            a: {"fov": fov[i], "agent": vec[i], "action_mask": rows[i]}
+            a: {"fov": fov[i], "agent": vec[i], "action_mask": masks[i]}
             for i, a in enumerate(self.possible_agents)
         }
 
@@ -605,7 +620,7 @@ class MotionEnv(_parallel_base()):
         np.minimum(maps.burning_layer() * inv_c, 1.0, out=s[0])
         np.minimum(inner[KNOWN_N] * inv_c, 1.0, out=s[1])
         np.minimum(inner[PRUNED_N] * inv_c, 1.0, out=s[2])
-        np.minimum(inner[LAST_SEEN] + maps.stamp(self._world.tick), 1.0, out=s[3])
+        s[3] = maps.staleness(self._world.tick)
         cx, cy = maps.cells(team.pos)
         np.add.at(s[4], (cx[team.can_sense], cy[team.can_sense]), 1.0)
         np.add.at(s[5], (cx[team.can_act], cy[team.can_act]), 1.0)

@@ -78,7 +78,7 @@ from __future__ import annotations
 import numpy as np
 
 from fcplan.env import EnvError
-from fcplan.env.motion_presets import MOVES, PresetEnv, rf1_structure_penalty
+from fcplan.env.motion_presets import MOVES, PresetEnv, rf1_penalty_small, rf1_structure_penalty
 
 __all__ = ["BaseEnv", "STATIONARY_FIRE"]
 
@@ -91,6 +91,9 @@ _PALETTE = np.array(
 
 #: The reference's fixed firespots (flat indices; ``x = i // W``, ``y = i % W``).
 STATIONARY_FIRE = (39, 5, 22, 81, 69)
+_MOVES = [tuple(m) for m in MOVES.tolist()]
+#: teams up to this size compute the RF1 structure penalty in Python
+_PY_AGENTS = 16
 
 
 class BaseEnv(PresetEnv):
@@ -167,6 +170,16 @@ class BaseEnv(PresetEnv):
             spaces.Box(0.0, 3.0, (1 + self.n, w, w), np.float32),
         )
         self._palette = _PALETTE
+        self._is_p = self.is_perception.tolist()
+        self._p_rows = np.flatnonzero(self.is_perception).tolist()
+        self._a_rows = np.flatnonzero(~self.is_perception).tolist()
+        self._local = self.local_reward.tolist()
+        # the one-hot layers of the observation over the whole grid, padded by the vision
+        # (then every crop is a plain slice); channel 0 (outside) never changes
+        self._layers = np.zeros((self.n_channels, w + 2 * v, w + 2 * v), dtype=np.float32)
+        self._layers[0] = 1.0
+        self._inner = self._layers[:, self.vision : self.vision + w, self.vision : self.vision + w]
+        self._inner[0] = 0.0
 
     # ------------------------------------------------------------------ episode
     def reset(self, seed: int | None = None, options: dict | None = None):
@@ -188,7 +201,7 @@ class BaseEnv(PresetEnv):
             self._pos = np.stack([vals[: self.n], vals[self.n :]], axis=1).astype(np.int64)
         self.steps = 0
         self._score = 0.0  # 2 |sensed| + 20 |pruned| for RF1
-        self._dumping = np.zeros(self.n, dtype=bool)
+        self._dumping = [False] * self.n
         self.agents = list(self.possible_agents)
         return self._observe(), {a: self._progress() for a in self.agents}
 
@@ -198,51 +211,66 @@ class BaseEnv(PresetEnv):
             raise EnvError("step: the episode is over; call reset()")
         acts = self._actions(actions)
         w, v = self.world_size, self.vision
-        moving = acts < 4
-        self._pos[moving] = np.clip(self._pos[moving] + MOVES[acts[moving]], 0, w - 1)
+        # a loop over a few agents on Python ints: cheaper than numpy here
+        pos = self._pos.tolist()
+        for i, a in enumerate(acts):
+            if a < 4:
+                dx, dy = _MOVES[a]
+                x, y = pos[i][0] + dx, pos[i][1] + dy
+                pos[i] = [min(max(x, 0), w - 1), min(max(y, 0), w - 1)]
+        self._pos[:] = pos
         # sensing: every fire cell in each perception agent's scope
-        contrib = np.zeros(self.n, dtype=np.int64)
+        contrib = [0] * self.n
         burning = self.fire & ~self.pruned
-        for i in np.flatnonzero(self.is_perception):
-            x, y = self._pos[i]
-            box = burning[max(x - v, 0) : x + v + 1, max(y - v, 0) : y + v + 1]
-            contrib[i] = int(box.sum())
-            self.sensed[max(x - v, 0) : x + v + 1, max(y - v, 0) : y + v + 1] |= box
+        for i in self._p_rows:
+            x, y = pos[i]
+            x0, y0 = max(x - v, 0), max(y - v, 0)
+            box = burning[x0 : x + v + 1, y0 : y + v + 1]
+            contrib[i] = int(np.count_nonzero(box))
+            if contrib[i]:
+                self.sensed[x0 : x + v + 1, y0 : y + v + 1] |= box
         # pruning: the sensed burning cell under each dumping action agent
-        dumping = ~self.is_perception & ((acts == 4) | (not self.water_dump))
-        self._dumping = ~self.is_perception & (acts == 4)
-        for i in np.flatnonzero(dumping):
-            x, y = self._pos[i]
-            if self.fire[x, y] and self.sensed[x, y] and not self.pruned[x, y]:
-                self.pruned[x, y] = True
-                contrib[i] = 1
+        fire, sensed, pruned = self.fire, self.sensed, self.pruned
+        dumping = [False] * self.n
+        for i in self._a_rows:
+            dumping[i] = acts[i] == 4
+            if dumping[i] or not self.water_dump:
+                x, y = pos[i]
+                if fire[x, y] and sensed[x, y] and not pruned[x, y]:
+                    pruned[x, y] = True
+                    contrib[i] = 1
+        self._dumping = dumping
         self.steps += 1
-        n_pruned = int(self.pruned.sum())
+        n_pruned = int(np.count_nonzero(pruned))
         remaining = self.n_fires - n_pruned
-        glob = self._global_reward(remaining)
-        local = (
-            (self.global_penalty if remaining > 0 else 0.0)
-            + self.local_reward * contrib
-            + self.a_penalty * self._dumping
-        )
+        glob = self._global_reward(remaining, pos)
+        gp = self.global_penalty if remaining > 0 else 0.0
         ratio = self.local_reward_ratio
-        rew = ratio * local + (1.0 - ratio) * glob
         success = n_pruned / self.n_fires >= self.a_c_threshold
         timeout = self.steps >= self.max_steps and not success
-        if self.termination_reward:
-            rew = rew + (10.0 * self.n_fires if success else 0.0)
-            rew = rew - (10.0 * remaining if timeout else 0.0)
+        bonus = 10.0 * self.n_fires if success else 0.0
+        malus = 10.0 * remaining if timeout else 0.0
+        ap = self.a_penalty
+        rewards = {}
+        for a, lr, c, d in zip(self.agents, self._local, contrib, dumping, strict=True):
+            # (the operations of the reference's array expression, element by element)
+            rew = ratio * (gp + lr * c + ap * d) + (1.0 - ratio) * glob
+            if self.termination_reward:
+                rew = rew + bonus
+                rew = rew - malus
+            rewards[a] = rew
         obs = self._observe()
-        rewards = {a: float(rew[i]) for i, a in enumerate(self.agents)}
         return self._finish(obs, rewards, success, timeout)
 
-    def _global_reward(self, remaining: int) -> float:
+    def _global_reward(self, remaining: int, pos: list) -> float:
         if self.reward_name == "rf2":
             return -1.0 if remaining > 0 else 0.0
         if self.reward_name == "rf3":
-            return self.global_penalty * remaining + self.a_penalty * int(self._dumping.sum())
-        score = 2.0 * int(self.sensed.sum()) + 20.0 * int(self.pruned.sum())
+            return self.global_penalty * remaining + self.a_penalty * sum(self._dumping)
+        score = 2.0 * int(np.count_nonzero(self.sensed)) + 20.0 * int(np.count_nonzero(self.pruned))
         delta, self._score = score - self._score, score
+        if self.n <= _PY_AGENTS:
+            return delta - rf1_penalty_small(pos, self._is_p, self.comm_range)
         return delta - rf1_structure_penalty(self._pos, self.is_perception, self.comm_range)
 
     def _progress(self) -> dict:
@@ -276,30 +304,29 @@ class BaseEnv(PresetEnv):
     def _observe(self) -> dict:
         w, v = self.world_size, self.vision
         side = 2 * v + 1
-        # one-hot layers of the whole grid, padded by v: then every crop is a plain slice
-        layers = np.zeros((self.n_channels, w + 2 * v, w + 2 * v), dtype=np.float32)
-        inner = layers[:, v : v + w, v : v + w]
-        layers[0] = 1.0
-        inner[0] = 0.0
-        inner[1] = self.fire & ~self.sensed & ~self.pruned
-        inner[2] = self.fire & self.sensed & ~self.pruned
-        inner[3] = self.pruned
+        layers, inner = self._layers, self._inner
+        fire, sensed, pruned = self.fire, self.sensed, self.pruned
+        live = fire & ~pruned
+        np.logical_and(live, ~sensed, out=inner[1], casting="unsafe")
+        np.logical_and(live, sensed, out=inner[2], casting="unsafe")
+        inner[3] = pruned
+        layers[4:] = 0.0
         np_ = self.n_perception
-        for i, (x, y) in enumerate(self._pos.tolist()):
+        pos = self._pos.tolist()
+        for i, (x, y) in enumerate(pos):
             if i < np_:
                 inner[4 + i, x, y] = 1.0
                 inner[4 + np_ + i, max(x - v, 0) : x + v + 1, max(y - v, 0) : y + v + 1] = 1.0
             else:
                 inner[4 + 2 * np_ + (i - np_), x, y] = 1.0
-        obs = {}
-        for i, a in enumerate(self.possible_agents):
-            x, y = self._pos[i]
-            agent = np.array(
-                [x / (w - 1), y / (w - 1), float(self.is_perception[i])], dtype=np.float32
-            )
-            obs[a] = {
-                "fov": layers[:, x : x + side, y : y + side].copy(),
-                "agent": agent,
-                "action_mask": self._masks[i].copy(),
-            }
-        return obs
+        fov = np.empty((self.n, self.n_channels, side, side), dtype=np.float32)
+        vec = []
+        for i, (x, y) in enumerate(pos):
+            fov[i] = layers[:, x : x + side, y : y + side]
+            vec += (x / (w - 1), y / (w - 1), float(self._is_p[i]))
+        agent = np.array(vec, dtype=np.float32).reshape(self.n, 3)
+        masks = self._masks
+        return {
+            a: {"fov": fov[i], "agent": agent[i], "action_mask": masks[i].copy()}
+            for i, a in enumerate(self.possible_agents)
+        }

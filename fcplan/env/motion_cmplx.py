@@ -78,9 +78,10 @@ True
 from __future__ import annotations
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from fcplan.env import EnvError
-from fcplan.env.motion_presets import MOVES, PresetEnv, rf1_structure_penalty
+from fcplan.env.motion_presets import MOVES, PresetEnv, rf1_penalty_small, rf1_structure_penalty
 
 __all__ = ["CmplxEnv", "WIND_DIRECTIONS"]
 
@@ -94,6 +95,11 @@ _PALETTE = np.array(
 #: Wind directions (degrees) the reference draws from.
 WIND_DIRECTIONS = (0, 45, 90, 135, 180)
 _N_FOV = 6
+# fov channels
+_BOX, _THIS_STEP, _KNOWN, _PRUNED, _OUTSIDE, _AGENTS = range(_N_FOV)
+_MOVES = [tuple(m) for m in MOVES.tolist()]
+#: teams up to this size compute the RF1 structure penalty in Python
+_PY_AGENTS = 16
 
 
 class CmplxEnv(PresetEnv):
@@ -161,6 +167,28 @@ class CmplxEnv(PresetEnv):
             n_actions, (_N_FOV, side, side), 4, spaces.Box(0.0, 6.0, (w, w), np.float32)
         )
         self._palette = _PALETTE
+        self._speed_l = self._speed.tolist()
+        self._is_p = self.is_perception.tolist()
+        self._p_rows = np.flatnonzero(self.is_perception).tolist()
+        self._a_rows = np.flatnonzero(~self.is_perception).tolist()
+        # the map padded by max_alt on every side, one layer per fov channel: channels 2-4 are
+        # kept up to date by the step (known fire and pruned cells change in a few cells), 5
+        # marks the cells with an agent; 0-1 stay zero (each crop gets its own); a crop is a
+        # window of it
+        h = w + 2 * self.max_alt
+        self._h = h
+        self._grid = np.zeros((_N_FOV, h, h), dtype=np.float32)
+        self._windows = sliding_window_view(self._grid, (side, side), axis=(1, 2))
+        self._flat = [self._grid[k].reshape(-1) for k in range(_N_FOV)]
+        r = self.max_alt
+        cx = np.arange(w, dtype=np.int64) + r
+        #: flat map cell x * W + y -> flat index in a padded layer
+        self._lut = (cx[:, None] * h + cx[None, :]).reshape(-1)
+        #: the windows with the channel axis third: ``[xs, ys]`` gathers (N, 6, side, side)
+        self._windows_t = np.moveaxis(self._windows, 0, 2)
+        xs = np.arange(w, dtype=np.int64)
+        #: flat map cell x * W + y -> x * side + y
+        self._side_lut = (xs[:, None] * side + xs[None, :]).reshape(-1)
 
     # ------------------------------------------------------------------ episode
     def reset(self, seed: int | None = None, options: dict | None = None):
@@ -193,6 +221,12 @@ class CmplxEnv(PresetEnv):
         self._pos = np.tile(np.array([w - 10, w // 10], dtype=np.int64), (self.n, 1))
         self._z = np.full(self.n, self.init_alt, dtype=np.int64)
         self._this_step = [np.zeros(0, dtype=np.int64) for _ in range(self.n)]
+        g, r = self._grid, self.max_alt
+        g[:] = 0.0
+        g[_OUTSIDE] = 1.0
+        g[_OUTSIDE, r : r + w, r : r + w] = 0.0
+        self._agent_cells: list[int] = []
+        self._shared: list[float] = []
         self._score = 0.0
         self._n_sensed = 0
         self.steps = 0
@@ -207,58 +241,87 @@ class CmplxEnv(PresetEnv):
 
         acts = self._actions(actions)
         w = self.world_size
-        # 1. move
-        moving = acts < 4
-        step = MOVES[np.minimum(acts, 3)] * self._speed[:, None]
-        self._pos = np.where(moving[:, None], np.clip(self._pos + step, 0, w - 1), self._pos)
-        dz = np.where(self.is_perception & (acts == 4), self.vert_vel, 0)
-        dz = np.where(self.is_perception & (acts == 5), -self.vert_vel, dz)
-        self._z = np.clip(self._z + dz, self.min_alt, self.max_alt)
+        # 1. move (a loop over a few agents on Python ints: cheaper than numpy here)
+        pos, zs = self._pos.tolist(), self._z.tolist()
+        lo, hi, vz = self.min_alt, self.max_alt, self.vert_vel
+        for i, (a, sp, is_p) in enumerate(zip(acts, self._speed_l, self._is_p, strict=True)):
+            if a < 4:
+                dx, dy = _MOVES[a]
+                x, y = pos[i][0] + dx * sp, pos[i][1] + dy * sp
+                pos[i] = [min(max(x, 0), w - 1), min(max(y, 0), w - 1)]
+            z = zs[i]
+            if is_p and a == 4:
+                z += vz
+            elif is_p and a == 5:
+                z -= vz
+            zs[i] = min(max(z, lo), hi)
+        self._pos = np.array(pos, dtype=np.int64).reshape(self.n, 2)
+        self._z = np.array(zs, dtype=np.int64)
         # 2. fire
         self.fire.step()
         state = self.fire.state
+        known, pruned = self._flat[_KNOWN], self._flat[_PRUNED]
+        lut = self._lut
+        sensed = self.sensed.reshape(-1)
         # 3. sensing by each perception agent
-        for i in np.flatnonzero(self.is_perception):
-            cells = self._burning_in_box(i, state, BURNING)
-            c = min(1.0, max(0.0, 1.0 - 0.06 * (self._z[i] - 10)))
-            k = int(np.round(c * cells.size))
+        for i in self._p_rows:
+            cells = self._burning_in_box(self._box_of(pos[i], zs[i]), state, BURNING)
+            c = min(1.0, max(0.0, 1.0 - 0.06 * (zs[i] - 10)))
+            k = round(c * cells.size)  # (half to even, as np.round)
             got = self._rng_sense.choice(cells, size=k, replace=False) if k else cells[:0]
-            flat = self.sensed.reshape(-1)
-            self._n_sensed += int(np.count_nonzero(~flat[got]))
-            flat[got] = True
+            if got.size:
+                self._n_sensed += int(np.count_nonzero(~sensed[got]))
+                sensed[got] = True
+                known[lut[got]] = 1.0  # (sensed cells burn: pruned ones are never sensed)
             self._this_step[i] = got
         # 4. pruning by each action agent (every step in cmplx1, on dump in cmplx2)
-        prunes = ~self.is_perception & ((acts == 4) | (self.variant == "cmplx1"))
-        for i in np.flatnonzero(~self.is_perception):
-            got = np.zeros(0, dtype=np.int64)
-            if prunes[i]:
-                cells = self._burning_in_box(i, state, BURNING)
-                k = int(np.round(self.prune_confidence * cells.size))
+        every = self.variant == "cmplx1"
+        for i in self._a_rows:
+            got = _EMPTY
+            if every or acts[i] == 4:
+                cells = self._burning_in_box(self._box_of(pos[i], zs[i]), state, BURNING)
+                k = round(self.prune_confidence * cells.size)
                 pick = self._rng_prune.choice(cells, size=k, replace=False) if k else cells[:0]
-                if pick.size and self.sensed.reshape(-1)[pick].any():
+                if pick.size and sensed[pick].any():
                     got = self.fire.prune(pick)
+                    idx = lut[got]
+                    known[idx] = 0.0
+                    pruned[idx] = 1.0
             self._this_step[i] = got
         self.steps += 1
         n_burn, n_pruned = int(self.fire.n_burning), int(self.fire.n_pruned)
         total = n_burn + n_pruned
         success = total > 0 and n_pruned / total >= self.a_c_threshold
-        r = self._reward(n_burn, n_pruned) + (self.success_bonus if success else 0.0)
+        r = self._reward(n_burn, n_pruned, pos) + (self.success_bonus if success else 0.0)
         timeout = self.steps >= self.max_steps and not success
         obs = self._observe()
         return self._finish(obs, dict.fromkeys(self.agents, r), success, timeout)
+
+    def _box_of(self, p: list, z: int) -> tuple[int, int, int, int]:
+        """The ``+-z`` box around position ``p`` (Python ints), clipped to the map."""
+        x, y = p
+        w = self.world_size
+        return max(x - z, 0), min(x + z + 1, w), max(y - z, 0), min(y + z + 1, w)
 
     def _box(self, i: int) -> tuple[int, int, int, int]:
         x, y = self._pos[i]
         z, w = int(self._z[i]), self.world_size
         return max(x - z, 0), min(x + z + 1, w), max(y - z, 0), min(y + z + 1, w)
 
-    def _burning_in_box(self, i: int, state: np.ndarray, burning: int) -> np.ndarray:
-        """Flat indices of the burning cells in agent ``i``'s ``+-z`` box."""
-        x0, x1, y0, y1 = self._box(i)
+    def _burning_in_box(self, box: tuple, state: np.ndarray, burning: int) -> np.ndarray:
+        """Flat indices of the burning cells in the cell range ``box`` (``x0, x1, y0, y1``), in
+        row-major order."""
+        x0, x1, y0, y1 = box
+        # only the part inside the fire's bounding box (inclusive) can hold burning cells
+        bx0, bx1, by0, by1 = self.fire.burn_box
+        x0, x1 = max(x0, bx0), min(x1, bx1 + 1)
+        y0, y1 = max(y0, by0), min(y1, by1 + 1)
+        if x1 <= x0 or y1 <= y0:
+            return _EMPTY
         bx, by = np.nonzero(state[x0:x1, y0:y1] == burning)
         return (bx + x0) * self.world_size + (by + y0)
 
-    def _reward(self, n_burn: int, n_pruned: int) -> float:
+    def _reward(self, n_burn: int, n_pruned: int, pos: list) -> float:
         if self.reward_name == "rf2":
             return -1.0 if n_burn > 0 else 0.0
         if self.reward_name == "rf3":
@@ -266,6 +329,8 @@ class CmplxEnv(PresetEnv):
         score = 2.0 * self._n_sensed + 20.0 * n_pruned
         if self.rf1_mode == "change":
             score, self._score = score - self._score, score
+        if self.n <= _PY_AGENTS:
+            return score - rf1_penalty_small(pos, self._is_p, self.comm_range)
         return score - rf1_structure_penalty(self._pos, self.is_perception, self.comm_range)
 
     def _progress(self) -> dict:
@@ -300,40 +365,49 @@ class CmplxEnv(PresetEnv):
         return codes
 
     def _observe(self) -> dict:
-        from fcplan.fire import BURNING, PRUNED
-
         w, r = self.world_size, self.max_alt
         side = 2 * r + 1
-        state, sensed = self.fire.state, self.sensed
+        n = self.n
         pos = self._pos.tolist()
-        obs = {}
-        for i, a in enumerate(self.possible_agents):
-            x, y = pos[i]
-            fov = np.zeros((_N_FOV, side, side), dtype=np.float32)
-            # the map part of the crop, as slices of the map and of the crop
-            x0, x1, y0, y1 = max(x - r, 0), min(x + r + 1, w), max(y - r, 0), min(y + r + 1, w)
-            view = fov[:, x0 - x + r : x1 - x + r, y0 - y + r : y1 - y + r]
-            sub = state[x0:x1, y0:y1]
-            np.logical_and(sub == BURNING, sensed[x0:x1, y0:y1], out=view[2], casting="unsafe")
-            np.equal(sub, PRUNED, out=view[3], casting="unsafe")
-            fov[4] = 1.0
-            view[4] = 0.0
-            for j, (xj, yj) in enumerate(pos):
-                if j != i and abs(xj - x) <= r and abs(yj - y) <= r:
-                    fov[5, xj - x + r, yj - y + r] = 1.0
-            bx0, bx1, by0, by1 = self._box(i)
-            fov[0, bx0 - x + r : bx1 - x + r, by0 - y + r : by1 - y + r] = 1.0
+        zs = self._z.tolist()
+        # the agents layer: 1 at every agent's cell; each crop's centre says whether another
+        # agent shares the cell
+        h = self._h
+        cells = [(x + r) * h + y + r for x, y in pos]
+        if cells != self._agent_cells:
+            layer = self._flat[_AGENTS]
+            for c in self._agent_cells:
+                layer[c] = 0.0
+            for c in cells:
+                layer[c] = 1.0
+            count: dict[int, int] = {}
+            for c in cells:
+                count[c] = count.get(c, 0) + 1
+            self._shared = [1.0 if count[c] > 1 else 0.0 for c in cells]
+            self._agent_cells = cells
+        xs, ys = [p[0] for p in pos], [p[1] for p in pos]
+        fov = self._windows_t[xs, ys]  # (one gather of the agents' windows, a fresh array)
+        flat = fov.reshape(-1)
+        area = side * side
+        vec = []
+        dz = max(self.max_alt - self.min_alt, 1)
+        for i, ((x, y), z) in enumerate(zip(pos, zs, strict=True)):
+            bx0, bx1, by0, by1 = self._box_of((x, y), z)
+            fov[i, _BOX, bx0 - x + r : bx1 - x + r, by0 - y + r : by1 - y + r] = 1.0
             got = self._this_step[i]
-            if got.size:
-                fov[1, got // w - x + r, got % w - y + r] = 1.0
-            agent = np.array(
-                [
-                    x / (w - 1),
-                    y / (w - 1),
-                    (self._z[i] - self.min_alt) / max(self.max_alt - self.min_alt, 1),
-                    float(self.is_perception[i]),
-                ],
-                dtype=np.float32,
-            )
-            obs[a] = {"fov": fov, "agent": agent, "action_mask": self._masks[i].copy()}
-        return obs
+            if got.size:  # (map cell -> its place in the crop, through the cell's x * side + y)
+                flat[
+                    self._side_lut[got]
+                    + ((i * _N_FOV + _THIS_STEP) * area - (x - r) * side - (y - r))
+                ] = 1.0
+            vec += (x / (w - 1), y / (w - 1), (z - self.min_alt) / dz, float(self._is_p[i]))
+        fov[:, _AGENTS, r, r] = self._shared
+        agent = np.array(vec, dtype=np.float32).reshape(n, 4)
+        masks = self._masks
+        return {
+            a: {"fov": fov[i], "agent": agent[i], "action_mask": masks[i].copy()}
+            for i, a in enumerate(self.possible_agents)
+        }
+
+
+_EMPTY = np.zeros(0, dtype=np.int64)

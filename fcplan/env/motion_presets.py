@@ -29,7 +29,7 @@ import numpy as np
 
 from fcplan.env import EnvError
 
-__all__ = ["make_preset", "rf1_structure_penalty", "PresetEnv"]
+__all__ = ["make_preset", "rf1_structure_penalty", "rf1_penalty_small", "PresetEnv"]
 
 #: The reference presets' moves, by action 0-3: x-1, x+1, y-1, y+1 (spec section 6).
 MOVES = np.array([[-1, 0], [1, 0], [0, -1], [0, 1]], dtype=np.int64)
@@ -79,6 +79,36 @@ def rf1_structure_penalty(pos: np.ndarray, is_perception: np.ndarray, comm_range
     return float(lonely.sum() + 3 * unpaired.sum())
 
 
+def rf1_penalty_small(pos: list, is_perception: list, comm_range: float) -> float:
+    """:func:`rf1_structure_penalty` for a small team, on Python lists (the same value; a
+    double loop over the agents beats numpy's setup for a handful of them).
+
+    Parameters
+    ----------
+    pos : list of [x, y]
+    is_perception : list of bool
+    comm_range : float
+
+    Returns
+    -------
+    float
+        The penalty magnitude (RF1 subtracts it).
+    """
+    n = len(pos)
+    near = [False] * n
+    paired = [False] * n
+    c = comm_range
+    for i in range(n):
+        xi, yi = pos[i]
+        for j in range(i + 1, n):  # (each pair once: the relation is symmetric)
+            dx, dy = pos[j][0] - xi, pos[j][1] - yi
+            if -c <= dx <= c and -c <= dy <= c:  # Chebyshev distance <= c
+                near[i] = near[j] = True
+                if is_perception[i] != is_perception[j]:
+                    paired[i] = paired[j] = True
+    return float((n - sum(near)) + 3 * (n - sum(paired)))
+
+
 def _parallel_base():
     from pettingzoo import ParallelEnv
 
@@ -113,7 +143,9 @@ class PresetEnv(_parallel_base()):
         from gymnasium import spaces
 
         self._n_actions = n_actions
-        pairs = list(zip(self.possible_agents, n_actions.tolist(), strict=True))
+        self._n_actions_list = n_actions.tolist()
+        self._default_list: list[int] | None = None  # (from self._default_action, on first use)
+        pairs = list(zip(self.possible_agents, self._n_actions_list, strict=True))
         self._action_spaces = {a: spaces.Discrete(k) for a, k in pairs}
         self._obs_spaces = {
             a: spaces.Dict(
@@ -168,14 +200,18 @@ class PresetEnv(_parallel_base()):
             self._reseed = np.random.default_rng()
         return np.random.SeedSequence(int(self._reseed.integers(2**63)))
 
-    def _actions(self, actions: dict) -> np.ndarray:
-        acts = np.zeros(self.n, dtype=np.int64)
-        for i, a in enumerate(self.possible_agents):
-            v = actions.get(a, self._default_action[i])
-            k = self._n_actions[i]
+    def _actions(self, actions: dict) -> list[int]:
+        """Each agent's action from ``{agent: action}`` (missing agents take their default),
+        checked, as Python ints in agent order."""
+        defaults = self._default_list
+        if defaults is None:
+            defaults = self._default_list = np.asarray(self._default_action).tolist()
+        acts = []
+        for a, d, k in zip(self.possible_agents, defaults, self._n_actions_list, strict=True):
+            v = actions.get(a, d)
             if not (isinstance(v, (int, np.integer)) and 0 <= v < k):
                 raise EnvError(f"action of {a}: must be an integer in 0..{k - 1} (got {v!r})")
-            acts[i] = v
+            acts.append(int(v))
         return acts
 
     def render(self):

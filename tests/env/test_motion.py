@@ -342,7 +342,10 @@ def test_small_team_python_path_equals_numpy_path(monkeypatch):
             monkeypatch.setattr(motion, "_PY_AGENTS", 0)
             vec_np, mask_np, cx_np, cy_np = env._agent_arrays()
             monkeypatch.setattr(motion, "_PY_AGENTS", 16)
-            np.testing.assert_array_equal(mask, mask_np)
+            assert len(mask) == len(mask_np) == len(env.possible_agents)
+            for m, m_np in zip(mask, mask_np, strict=True):
+                assert m.dtype == m_np.dtype == np.int8
+                np.testing.assert_array_equal(m, m_np)
             np.testing.assert_array_equal(vec, vec_np)
             assert (cx, cy) == (cx_np, cy_np)
 
@@ -371,3 +374,40 @@ def test_staleness_channel():
         env.step({"P1": 2})
     assert env.state()[3, cx, cy] == pytest.approx(min(1.0, before + 5 / 20), abs=1e-6)
     assert 0.0 < before < 1.0
+
+
+def test_coarse_maps_observe_equals_direct_crops():
+    """CoarseMaps.observe gives, per agent, the padded window of its cell with staleness
+    min(1, seen + tick * seen_scale) and, on the agents channel, the *other* agents only (a
+    shared cell shows at the centre); the crops are a fresh C-contiguous array, and
+    staleness(tick) equals the map part of the stale layer."""
+    from fcplan import load_scenario
+    from fcplan.env.motion_grid import AGENTS, LAST_SEEN, CoarseMaps
+
+    sc = load_scenario("practice")
+    maps = CoarseMaps(sc, cell_px=20, view=7, seen_scale=0.01)
+    rng = np.random.default_rng(5)
+    nc, r = maps.nc, maps.radius
+    for tick in (0, 3, 40, 250):
+        seen = -np.float32(0.01) * rng.integers(0, tick + 1, size=(nc, nc)).astype(np.float32)
+        seen[rng.random((nc, nc)) < 0.3] = np.inf
+        maps.seen[r : r + nc, r : r + nc] = seen
+        cx = rng.integers(0, nc, size=5).tolist()
+        cy = rng.integers(0, nc, size=5).tolist()
+        cx[1], cy[1] = cx[0], cy[0]  # two agents in one cell
+        out = maps.observe(cx, cy, tick, 7)
+        assert out.flags.c_contiguous and out.dtype == np.float32 and out.shape == (5, 7, 7, 7)
+        stale = np.ones((nc + 2 * r, nc + 2 * r), np.float32)
+        stale[r : r + nc, r : r + nc] = np.minimum(seen + np.float32(tick * 0.01), 1.0)
+        np.testing.assert_array_equal(maps.staleness(tick), stale[r : r + nc, r : r + nc])
+        occupied = np.zeros_like(stale)
+        for x, y in zip(cx, cy, strict=True):
+            occupied[x + r, y + r] += 1.0
+        for i, (x, y) in enumerate(zip(cx, cy, strict=True)):
+            np.testing.assert_array_equal(out[i, LAST_SEEN], stale[x : x + 7, y : y + 7])
+            others = occupied[x : x + 7, y : y + 7].copy()
+            others[r, r] -= 1.0
+            np.testing.assert_array_equal(out[i, AGENTS], np.minimum(others, 1.0))
+            for k in (0, 1, 4, 5, 6):
+                np.testing.assert_array_equal(out[i, k], maps.grid[k, x : x + 7, y : y + 7])
+        assert out[0, AGENTS, r, r] == out[1, AGENTS, r, r] == 1.0

@@ -13,7 +13,7 @@ from fcplan.env import EnvError
 from fcplan.env.motion import parallel_env
 from fcplan.env.motion_base import STATIONARY_FIRE, BaseEnv
 from fcplan.env.motion_cmplx import CmplxEnv
-from fcplan.env.motion_presets import rf1_structure_penalty
+from fcplan.env.motion_presets import rf1_penalty_small, rf1_structure_penalty
 from fcplan.fire import BURNING, PRUNED
 
 pettingzoo_test = pytest.importorskip("pettingzoo.test")
@@ -271,3 +271,40 @@ def test_cmplx_invariants(seed, variant):
         pruned, sensed = now, env.sensed.copy()
         for a in obs:
             assert obs[a] in env.observation_space(a)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(1, 8),
+    st.integers(0, 2**32 - 1),
+    st.sampled_from([0.0, 1.0, 2.5, 5.0, 30.0]),
+)
+def test_rf1_penalty_small_equals_numpy(n, seed, comm_range):
+    """The Python-list RF1 structure penalty used by small teams equals the numpy one for any
+    positions, roles and range (ties at the range included)."""
+    rng = np.random.default_rng(seed)
+    pos = rng.integers(0, 8, size=(n, 2))
+    is_p = rng.random(n) < 0.5
+    want = rf1_structure_penalty(pos, is_p, comm_range)
+    got = rf1_penalty_small(pos.tolist(), is_p.tolist(), comm_range)
+    assert got == want and type(got) is float
+
+
+@pytest.mark.parametrize("variant", ["cmplx1", "cmplx2"])
+def test_cmplx_incremental_layers_equal_the_fire(variant):
+    """The cmplx env's padded known-fire and pruned layers, kept up to date from each step's
+    sensed and pruned cells, equal a direct computation from the fire state and the sensed
+    grid at every step (also with agents moved by hand between steps)."""
+    env = CmplxEnv(variant=variant, max_steps=120)
+    env.reset(seed=3)
+    rng = np.random.default_rng(3)
+    w, r = env.world_size, env.max_alt
+    for t in range(120):
+        if t % 30 == 10:  # put the team on a fire region: pruning happens
+            env._pos[:] = [int(v) for v in env.regions[t % len(env.regions)].center]
+        env.step({a: int(rng.integers(env.action_space(a).n)) for a in env.agents})
+        inner = env._grid[:, r : r + w, r : r + w]
+        known = (env.fire.state == BURNING) & env.sensed
+        np.testing.assert_array_equal(inner[2], known.astype(np.float32))
+        np.testing.assert_array_equal(inner[3], (env.fire.state == PRUNED).astype(np.float32))
+    assert env.fire.n_pruned > 0
