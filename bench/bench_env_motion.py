@@ -1,10 +1,12 @@
-"""Benchmark the motion-level environment: steps per second with random legal actions.
+"""Benchmark the motion-level environment: steps per second with random legal and scheduler actions.
 
 For scenarios #1 and #24 (``fcplan.env.motion.MotionEnv``) and the presets ``base``,
 ``cmplx1``, ``cmplx2`` it plays whole episodes with random legal actions (drawn from each
-agent's ``action_mask``) and prints, per env step:
+agent's ``action_mask``), and on #1 and #24 also with the greedy scheduler's plans followed move
+by move (``greedy`` rows: :class:`fcplan.env.motion_expert.PlanFollower`, whose belief updates,
+replans and action choices are the ``policy us`` column), and prints, per env step:
 
-* ``steps/s``: ``env.step`` calls per second (the action draw is timed apart, ``policy us``);
+* ``steps/s``: ``env.step`` calls per second (choosing the actions is timed apart, ``policy us``);
 * for the scenario envs, ``world us`` (the ``World.step`` inside) and ``env overhead us`` (the rest:
   action decoding, observation crops, masks and agent vectors for the whole team, reward);
 * ``overhead, world stubbed``: the same episode replayed with ``World.step`` replaced by a stub
@@ -14,7 +16,9 @@ agent's ``action_mask``) and prints, per env step:
 Timings are the median over blocks of 100 steps (``best`` is the fastest block: on a loaded
 machine it is the better estimate of the code's own cost). The baseline measured in the same run
 is PettingZoo's MPE ``simple_spread`` (3 agents, random actions, the same timing), if ``mpe2``
-(or an old ``pettingzoo.mpe``) is importable; otherwise the script says it skipped it.
+(or an old ``pettingzoo.mpe``) is importable; otherwise the script says it skipped it. Install it
+with ``pip install --no-deps mpe2`` (it asks for pygame-ce, which would replace the game's
+pygame; it runs with either).
 
 ``--cpu`` times with the thread's CPU clock instead of the wall clock: time spent waiting for a
 core is left out, so on a machine loaded by other processes the figures stay close to the quiet
@@ -38,6 +42,7 @@ import time
 import numpy as np
 
 from fcplan.env.motion import MotionEnv, parallel_env
+from fcplan.env.motion_expert import PlanFollower
 
 BLOCK = 100
 _CLOCKS = {"wall": time.perf_counter_ns, "cpu": time.thread_time_ns}
@@ -68,13 +73,17 @@ def _sampler(env, rng: np.random.Generator):
     return draw
 
 
-def run_env(make, episodes: int, max_steps: int, seed: int = 0) -> Timed:
-    """Play ``episodes`` episodes (at most ``max_steps`` steps each) and time every step."""
+def run_env(make, episodes: int, max_steps: int, seed: int = 0, expert: str | None = None) -> Timed:
+    """Play ``episodes`` episodes (at most ``max_steps`` steps each) and time every step, with
+    random legal actions or, given a scheduler name, a :class:`PlanFollower` of its plans."""
     rec = Timed()
     env = make()
-    draw = _sampler(env, np.random.default_rng(seed))
+    follower = PlanFollower(env, expert) if expert else None
+    draw = follower.actions if follower else _sampler(env, np.random.default_rng(seed))
     for ep in range(episodes):
         obs, _ = env.reset(seed=seed + ep)
+        if follower:
+            follower.reset()
         world = getattr(env, "world", None)
         if world is not None:
             inner = type(world).step
@@ -178,13 +187,15 @@ def main(argv=None) -> int:
     cases = [
         ("motion #1", lambda: MotionEnv(1), 1800),
         ("motion #24", lambda: MotionEnv(24), 1800),
+        ("motion #1 greedy", lambda: MotionEnv(1), 1800),
+        ("motion #24 greedy", lambda: MotionEnv(24), 1800),
         ("preset base", lambda: parallel_env(preset="base"), 1000),
         ("preset cmplx1", lambda: parallel_env(preset="cmplx1"), 200),
         ("preset cmplx2", lambda: parallel_env(preset="cmplx2"), 200),
     ]
     for name, make, cap in cases:
         n_eps = eps if cap >= 1000 else eps * 3
-        rec = run_env(make, n_eps, cap)
+        rec = run_env(make, n_eps, cap, expert="greedy" if name.endswith("greedy") else None)
         st_med, st_best = blocks_us(rec.step_ns)
         pol, _ = blocks_us(rec.policy_ns)
         n_agents = len(make().possible_agents)
@@ -207,7 +218,10 @@ def main(argv=None) -> int:
         print(f"{name}: env overhead with World.step stubbed {med:.1f} us ({best:.1f} best block)")
     make_mpe = mpe_env()
     if make_mpe is None:
-        print("MPE simple_spread: skipped (install mpe2: pip install mpe2)")
+        print(
+            "MPE simple_spread: skipped (pip install --no-deps mpe2: its pygame-ce dependency "
+            "would replace the game's pygame)"
+        )
     else:
         rec = run_env(lambda: make_mpe(N=3, max_cycles=25), 40 * eps, 25)
         st_med, st_best = blocks_us(rec.step_ns)

@@ -223,7 +223,7 @@ class CoarseMaps:
             self._add(PRUNED, pruned, 1.0)
             seen = pruned[world.sensed.reshape(-1)[pruned]]
             self._add(KNOWN, seen, -1.0)
-        self._cover(info.fov.tolist(), self._sensing_rows, -float(self.stamp(info.tick)))
+        self._cover(info.fov_rects, self._sensing_rows, -float(self.stamp(info.tick)))
         if len(self._pending) + len(self._pending_out) > 512:
             self.burning_layer()
 
