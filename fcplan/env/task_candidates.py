@@ -159,8 +159,19 @@ def legal_tasks(graph: TaskGraph) -> np.ndarray:
 def _legal(graph: TaskGraph, forced: np.ndarray, forced_l: list) -> np.ndarray:
     """:func:`legal_tasks` given the forced-return flags (array and list)."""
     dh = graph.task_home_distance
-    ok = 2.0 * dh <= (graph.agent_full_range + 1e-6)[:, None]
-    ok &= graph.can_do
+    full, can = graph.agent_full_range, graph.can_do
+    if dh.flags.writeable or full.flags.writeable or can.flags.writeable:
+        ok = 2.0 * dh <= (full + 1e-6)[:, None]
+        ok &= can
+    else:  # read-only inputs shared by graphs (build_task_graph without fire): once per inputs
+        hit = _HOME_OK.get(id(dh))
+        if hit is None or hit[0] is not dh or hit[1] is not full or hit[2] is not can:
+            if len(_HOME_OK) >= 16:
+                _HOME_OK.pop(next(iter(_HOME_OK)))
+            ok = 2.0 * dh <= (full + 1e-6)[:, None]
+            ok &= can
+            hit = _HOME_OK[id(dh)] = (dh, full, can, ok)
+        ok = hit[3].copy()
     if all(forced_l):
         return ok
     reach = graph.agent_task_distance + dh
@@ -171,18 +182,32 @@ def _legal(graph: TaskGraph, forced: np.ndarray, forced_l: list) -> np.ndarray:
     return ok
 
 
-def _candidates(rows, start_distance, priority, freshness, legal) -> Candidates:
+#: id(read-only home-distance table) -> (the table, the read-only full-range and can_do arrays,
+#: the part of the legality they give); an entry holds its inputs, so their ids are not reused
+#: while cached, and read-only arrays keep their values
+_HOME_OK: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+
+
+def _candidates(rows, start_distance, priority, freshness, legal, valid=None) -> Candidates:
     """``Candidates(...)`` without the frozen dataclass's per-field ``object.__setattr__``."""
     c = object.__new__(Candidates)
     c.__dict__.update(
         rows=rows,
-        valid=rows >= 0,
+        valid=rows >= 0 if valid is None else valid,
         start_distance=start_distance,
         priority=priority,
         freshness=freshness,
         legal=legal,
     )
     return c
+
+
+@lru_cache(maxsize=16)
+def _ones(n: int) -> np.ndarray:
+    """(n,) float64 ones (read-only): the freshness of search blocks."""
+    out = np.ones(n)
+    out.flags.writeable = False
+    return out
 
 
 def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candidates:
@@ -196,27 +221,30 @@ def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candid
         d_start = np.where(forced[:, None], graph.task_home_distance, d_start)
     kind = graph.task_kind
     n_f = n_t - int(np.count_nonzero(kind)) if n_t else 0  # fires (kind 0) come first
-    fresh = np.ones(n_t)
     value = graph.task_value
     if n_f:
+        fresh = np.ones(n_t)
         stale = graph.task_staleness[:n_f]
         fresh[:n_f] = np.minimum(np.exp(-(stale - fresh_s) / max(fresh_s, 1e-9)), 1.0)
         value = value * fresh  # (x * 1.0 == x: skipped when there is no fire)
+    else:
+        fresh = _ones(n_t)
     prio = value / (1.0 + d_start / graph.agent_speed[:, None])
     prio = np.where(legal, prio, -np.inf)
-    rows = np.full((n_a, k), -1, dtype=np.int64)
     if n_t == 0 or n_a == 0:
-        return _candidates(rows, d_start, prio, fresh, legal)
+        return _candidates(np.full((n_a, k), -1, dtype=np.int64), d_start, prio, fresh, legal)
     m = min(k, n_t)
-    neg = np.negative(prio)
-    order = np.argsort(neg, axis=1, kind="stable")  # illegal (-inf) last
+    order = np.argsort(np.negative(prio), axis=1, kind="stable")  # illegal (-inf) last
     n_legal = legal.sum(axis=1)
-    if n_f == 0:  # search blocks only: the best legal ones, in order
-        take = np.minimum(n_legal, k)
-        head = order[:, :m]
-        rows[:, :m] = np.where(_POS1[:m] <= take[:, None], head, -1)
-        return _candidates(rows, d_start, prio, fresh, legal)
-    ai = np.arange(n_a)[:, None]
+    if n_f == 0:  # search blocks only: the best legal ones (the first n_legal), in order
+        valid = _POS1[:m] <= n_legal[:, None]
+        rows = np.where(valid, order[:, :m], -1)
+        if m < k:
+            rows = np.concatenate([rows, np.full((n_a, k - m), -1, dtype=np.int64)], axis=1)
+            valid = None
+        return _candidates(rows, d_start, prio, fresh, legal, valid)
+    rows = np.full((n_a, k), -1, dtype=np.int64)
+    ai = _ROWS[:n_a] if n_a <= _ROWS.shape[0] else np.arange(n_a)[:, None]
     n_fire = legal[:, :n_f].sum(axis=1)
     n_search = n_legal - n_fire
     take_fire = np.minimum(n_fire, np.maximum(k - k // 2, k - n_search))[:, None]
@@ -247,27 +275,26 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     pos = graph.task_pos[r]  # (A, k, 2)
     dist = cand.start_distance[ai, r]
     # other capable agents: how many are closer, and how close is the nearest
-    d_all = cand.start_distance[:, r]  # (A_other, A, k)
-    capable = graph.can_do[:, r]
+    capable = graph.can_do[:, r]  # (A_other, A, k)
     capable &= _not_self(n_a)
     n_cap = capable.sum(axis=0)
-    closer = d_all < dist
-    closer &= capable
-    n_closer = closer.sum(axis=0)
-    nearest = np.where(capable, d_all, np.inf).min(axis=0)
+    # incapable others at +inf: never closer (distances are finite), never the nearest
+    d_cap = np.where(capable, cand.start_distance[:, r], np.inf)
+    n_closer = (d_cap < dist).sum(axis=0)
+    nearest = d_cap.min(axis=0)
     prio = np.where(valid, cand.priority[ai, r], 0.0)
     best = prio.max(axis=1)
     # per-task columns, computed once over all tasks and gathered
     per_task = np.empty((graph.n_tasks, 7))
-    per_task[:, 0] = graph.task_kind == _FIRE
-    per_task[:, 1] = 1.0 - per_task[:, 0]
+    per_task[:, 1] = graph.task_kind  # is_search: kinds are 0 (fire) and 1 (search)
+    np.subtract(1.0, per_task[:, 1], out=per_task[:, 0])
     per_task[:, 2] = graph.task_value
     per_task[:, 3] = graph.task_cells
     per_task[:, 4] = graph.task_threat
     np.log1p(per_task[:, 2:5], out=per_task[:, 2:5])
     per_task[:, 2:4] *= 0.2
     per_task[:, 5] = per_task[:, 4]
-    per_task[:, 4] = graph.task_staleness / 60.0
+    np.divide(graph.task_staleness, 60.0, out=per_task[:, 4])
     per_task[:, 6] = cand.freshness
     # float64 work table, cast once (clipping before or after the cast gives the same float32)
     out = np.zeros((n_a, k, len(TASK_FEATURES)))
@@ -281,9 +308,13 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     out[..., 11] = dist / (10.0 * graph.agent_speed[:, None])
     out[..., 13] = n_closer / np.maximum(n_cap, 1)
     out[..., 15] = prio / np.where(best > 0, best, np.inf)[:, None]
-    gd = pos - goal[:, None, :]
-    gd = np.hypot(gd[..., 0], gd[..., 1])
-    out[..., 16] = np.where(np.isnan(gd), 0.0, np.exp(gd / -50.0))  # NaN: no goal yet
+    no_goal = np.isnan(goal[:, 0]).tolist()  # a goal is set (or not) as a whole position
+    if False in no_goal:  # (no agent with a goal: the column stays 0)
+        gd = pos - goal[:, None, :]
+        gd = np.exp(np.hypot(gd[..., 0], gd[..., 1]) / -50.0)
+        if True in no_goal:  # NaN: no goal yet
+            gd[np.isnan(gd)] = 0.0
+        out[..., 16] = gd
     out[~valid] = 0.0
     _clip(out)
     return out.astype(np.float32)
