@@ -302,15 +302,13 @@ def _pairwise(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _rect_distance(points: np.ndarray, rects: np.ndarray) -> np.ndarray:
     """(P, F) distance from points to axis-aligned rectangles (0 inside)."""
-    dx = np.maximum(
-        np.maximum(rects[None, :, 0] - points[:, None, 0], 0.0),
-        points[:, None, 0] - rects[None, :, 1],
-    )
-    dy = np.maximum(
-        np.maximum(rects[None, :, 2] - points[:, None, 1], 0.0),
-        points[:, None, 1] - rects[None, :, 3],
-    )
-    return np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+    x, y = points[:, 0, None], points[:, 1, None]
+    # per axis max(lo - p, p - hi, 0): the gap to the rectangle's span (0 inside it)
+    dx = np.maximum(rects[:, 0] - x, x - rects[:, 1])
+    np.maximum(dx, 0.0, out=dx)
+    dy = np.maximum(rects[:, 2] - y, y - rects[:, 3])
+    np.maximum(dy, 0.0, out=dy)
+    return np.hypot(dx, dy, out=dx)
 
 
 def default_tile(team) -> tuple[float, float]:
@@ -551,16 +549,15 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         threat_time = np.full((n_fire, 0), np.inf)
 
     # search value: age (capped) times (1 + nearby known fire)
-    fb = (
-        np.minimum(fire_pos[:, 0] // blk, nb - 1) * nb + np.minimum(fire_pos[:, 1] // blk, nb - 1)
-    ).astype(np.int64)
-    near = np.bincount(fb, weights=counts, minlength=nb * nb).reshape(nb, nb)
-    # spread to the 8 neighbours: fire grows across block borders
-    padded = np.zeros((nb + 2, nb + 2))
-    padded[1:-1, 1:-1] = near
-    # 3 x 3 box sum, separably (sums of whole cell counts: exact in any order)
-    rows = padded[:-2] + padded[1:-1] + padded[2:]
-    near_fire = (rows[:, :-2] + rows[:, 1:-1] + rows[:, 2:]).ravel()
+    fbxy = fire_pos // blk
+    np.minimum(fbxy, nb - 1, out=fbxy)
+    fb = (fbxy @ (nb, 1.0)).astype(np.int64)  # block index bx * nb + by (small whole numbers)
+    # the known cells of the blocks around each block, itself included (fire grows across block
+    # borders): every tile's cells counted in the 3 x 3 blocks around its own (sums of whole
+    # cell counts: exact in any order)
+    near_fire = np.bincount(
+        _neighbours(nb)[fb].ravel(), weights=np.repeat(counts, 9), minlength=nb * nb + 1
+    )[: nb * nb]
     fire_block = n_fire + fb
     search_value = np.minimum(search_age, p.search_value_cap_s) * (
         1.0 + np.minimum(near_fire, 50) / 10.0
@@ -652,7 +649,22 @@ def _task_graph(**fields) -> TaskGraph:
 
 def _cat_int(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Concatenation as int64 (as ``np.r_[a, b].astype(np.int64)``)."""
-    return np.concatenate([a, b]).astype(np.int64)
+    return np.concatenate([a, b]).astype(np.int64, copy=False)
+
+
+@lru_cache(maxsize=16)
+def _neighbours(nb: int) -> np.ndarray:
+    """(nb * nb, 9) the blocks of the 3 x 3 neighbourhood of each block of an ``nb x nb`` grid
+    (flat ``bx * nb + by``); neighbours off the grid are ``nb * nb`` (read-only)."""
+    b = np.arange(nb)
+    bx, by = np.meshgrid(b, b, indexing="ij")
+    d = np.array([-1, 0, 1])
+    nx_ = bx.ravel()[:, None, None] + d[None, :, None]
+    ny_ = by.ravel()[:, None, None] + d[None, None, :]
+    inside = (nx_ >= 0) & (nx_ < nb) & (ny_ >= 0) & (ny_ < nb)
+    out = np.where(inside, nx_ * nb + ny_, nb * nb).reshape(nb * nb, 9)
+    out.flags.writeable = False
+    return out
 
 
 @lru_cache(maxsize=16)
@@ -670,30 +682,61 @@ _SMALL_CLUSTER = 256  # up to this many tiles, label by pairwise adjacency (no s
 
 def _clusters(tx: np.ndarray, ty: np.ndarray, nx_: int, ny_: int) -> np.ndarray:
     """Connected-fire labels of occupied tiles (8-connectivity), numbered like
-    ``scipy.ndimage.label`` (by first tile in raster order; the tiles come sorted that way)."""
+    ``scipy.ndimage.label`` (by first tile in raster order; the tiles come sorted that way).
+
+    Labels depend on the tiles only: the last few answers are kept (read-only) for tiles that
+    did not change since (the fire often keeps its tiles for several replans).
+    """
     n = len(tx)
     if n == 1:
         return np.zeros(1, dtype=np.int64)
+    key = (tx.dtype.str, ty.dtype.str, tx.tobytes() + ty.tobytes())
+    hit = _CLUSTER_MEMO.get(key)
+    if hit is not None:
+        return hit
     if n <= _SMALL_CLUSTER:
-        # min-label propagation with pointer jumping: each tile ends up pointing at the first
-        # (lowest-index) tile of its component, and components are numbered in that order
         adj = np.abs(tx[:, None] - tx) <= 1
         adj &= np.abs(ty[:, None] - ty) <= 1
         idx = np.arange(n)
-        lab = np.where(adj, idx, n).min(axis=1)
-        while True:
-            nxt = np.where(adj, lab, n).min(axis=1)
-            nxt = nxt[nxt]
-            if np.array_equal(nxt, lab):
-                break
-            lab = nxt
-        return (np.cumsum(lab == idx) - 1)[lab]
-    from scipy.ndimage import label
+        if n <= _CLOSURE_CLUSTER:
+            # transitive closure by boolean matrix squaring (reflexive: it only grows); the
+            # first tile reached from a tile is the first tile of its component
+            m, count = adj, np.count_nonzero(adj)
+            while True:
+                m = m @ m
+                c = np.count_nonzero(m)
+                if c == count:
+                    break
+                count = c
+            lab = m.argmax(axis=1)
+        else:
+            # min-label propagation with pointer jumping: each tile ends up pointing at the
+            # first (lowest-index) tile of its component
+            lab = np.where(adj, idx, n).min(axis=1)
+            while True:
+                nxt = np.where(adj, lab, n).min(axis=1)
+                nxt = nxt[nxt]
+                if np.array_equal(nxt, lab):
+                    break
+                lab = nxt
+        # components are numbered in the order of their first tiles
+        out = (np.cumsum(lab == idx) - 1)[lab]
+    else:
+        from scipy.ndimage import label
 
-    grid = np.zeros((nx_ + 1, ny_ + 1), dtype=bool)
-    grid[tx, ty] = True
-    labels, _ = label(grid, structure=_EIGHT)
-    return labels[tx, ty].astype(np.int64) - 1
+        grid = np.zeros((nx_ + 1, ny_ + 1), dtype=bool)
+        grid[tx, ty] = True
+        labels, _ = label(grid, structure=_EIGHT)
+        out = labels[tx, ty].astype(np.int64) - 1
+    if len(_CLUSTER_MEMO) >= 8:
+        _CLUSTER_MEMO.pop(next(iter(_CLUSTER_MEMO)))
+    _CLUSTER_MEMO[key] = _frozen(out)
+    return out
+
+
+_CLOSURE_CLUSTER = 24  # up to this many tiles, label by closure (few, cheap matrix products)
+#: tiles (dtypes, then x and y coordinates as bytes; equal lengths) -> labels (read-only)
+_CLUSTER_MEMO: dict[tuple[str, str, bytes], np.ndarray] = {}
 
 
 def synthetic_task_graph(
