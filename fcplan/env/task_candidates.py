@@ -266,58 +266,64 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     ``goal`` is (A, 2): the position the environment last sent each agent to (NaN: none).
     """
     n_a, k = cand.rows.shape
-    if graph.n_tasks == 0:
+    n_t = graph.n_tasks
+    if n_t == 0:
         return np.zeros((n_a, k, len(TASK_FEATURES)), dtype=np.float32)
     w = float(graph.world_size)
     valid = cand.valid
     r = np.maximum(cand.rows, 0)
     ai = _ROWS[:n_a] if n_a <= _ROWS.shape[0] else np.arange(n_a)[:, None]
-    pos = graph.task_pos[r]  # (A, k, 2)
-    dist = cand.start_distance[ai, r]
+    sd = cand.start_distance
+    # float64 work table, feature-major (F, A, k) so that every feature is a contiguous row;
+    # transposed and cast once at the end (clipping before or after the cast gives the same
+    # float32)
+    out = np.empty((len(TASK_FEATURES), n_a, k))
+    # per-task rows (features 1 .. 9), computed once over all tasks and gathered at once
+    pt = np.empty((9, n_t))
+    pt[1] = graph.task_kind  # is_search: kinds are 0 (fire) and 1 (search)
+    np.subtract(1.0, pt[1], out=pt[0])
+    pt[2] = graph.task_value
+    pt[3] = graph.task_cells
+    np.log1p(pt[2:4], out=pt[2:4])
+    pt[2:4] *= 0.2
+    np.divide(graph.task_staleness, 60.0, out=pt[4])
+    np.log1p(graph.task_threat, out=pt[5])
+    pt[6] = cand.freshness
+    pt[7:9] = graph.task_pos.T
+    np.take(pt, r, axis=1, out=out[1:10])  # rows 8, 9: the task's position for now
+    out[0] = 1.0
+    no_goal = np.isnan(goal[:, 0]).tolist()  # a goal is set (or not) as a whole position
+    if False in no_goal:
+        gd = out[8:10] - goal.T[:, :, None]
+        gd = np.hypot(gd[0], gd[1])
+        gd /= -50.0
+        np.exp(gd, out=out[16])
+        if True in no_goal:  # NaN: no goal yet
+            out[16][np.isnan(out[16])] = 0.0
+    else:  # no agent has a goal yet
+        out[16] = 0.0
+    out[8:10] -= graph.agent_pos.T[:, :, None]
+    dist = sd[ai, r]
+    out[10] = dist
+    out[12] = graph.task_home_distance[ai, r]
     # other capable agents: how many are closer, and how close is the nearest
     capable = graph.can_do[:, r]  # (A_other, A, k)
     capable &= _not_self(n_a)
-    n_cap = capable.sum(axis=0)
     # incapable others at +inf: never closer (distances are finite), never the nearest
-    d_cap = np.where(capable, cand.start_distance[:, r], np.inf)
-    n_closer = (d_cap < dist).sum(axis=0)
-    nearest = d_cap.min(axis=0)
+    d_cap = np.where(capable, sd[:, r], np.inf)
+    # min(d / w, 1) == min(d, w) / w
+    np.minimum(np.minimum.reduce(d_cap, axis=0), w, out=out[14])
+    out[8:15] /= w
+    np.divide(dist, (10.0 * graph.agent_speed)[:, None], out=out[11])
+    n_cap = np.add.reduce(capable, axis=0)
+    np.maximum(n_cap, 1, out=n_cap)
+    np.divide(np.add.reduce(d_cap < dist, axis=0), n_cap, out=out[13])
     prio = np.where(valid, cand.priority[ai, r], 0.0)
-    best = prio.max(axis=1)
-    # per-task columns, computed once over all tasks and gathered
-    per_task = np.empty((graph.n_tasks, 7))
-    per_task[:, 1] = graph.task_kind  # is_search: kinds are 0 (fire) and 1 (search)
-    np.subtract(1.0, per_task[:, 1], out=per_task[:, 0])
-    per_task[:, 2] = graph.task_value
-    per_task[:, 3] = graph.task_cells
-    per_task[:, 4] = graph.task_threat
-    np.log1p(per_task[:, 2:5], out=per_task[:, 2:5])
-    per_task[:, 2:4] *= 0.2
-    per_task[:, 5] = per_task[:, 4]
-    np.divide(graph.task_staleness, 60.0, out=per_task[:, 4])
-    per_task[:, 6] = cand.freshness
-    # float64 work table, cast once (clipping before or after the cast gives the same float32)
-    out = np.zeros((n_a, k, len(TASK_FEATURES)))
-    out[..., 0] = 1.0
-    out[..., 1:8] = per_task[r]
-    np.subtract(pos, graph.agent_pos[:, None, :], out=out[..., 8:10])
-    out[..., 10] = dist
-    out[..., 12] = graph.task_home_distance[ai, r]
-    np.minimum(nearest, w, out=out[..., 14])  # min(d / w, 1) == min(d, w) / w
-    out[..., 8:15] /= w
-    out[..., 11] = dist / (10.0 * graph.agent_speed[:, None])
-    out[..., 13] = n_closer / np.maximum(n_cap, 1)
-    out[..., 15] = prio / np.where(best > 0, best, np.inf)[:, None]
-    no_goal = np.isnan(goal[:, 0]).tolist()  # a goal is set (or not) as a whole position
-    if False in no_goal:  # (no agent with a goal: the column stays 0)
-        gd = pos - goal[:, None, :]
-        gd = np.exp(np.hypot(gd[..., 0], gd[..., 1]) / -50.0)
-        if True in no_goal:  # NaN: no goal yet
-            gd[np.isnan(gd)] = 0.0
-        out[..., 16] = gd
-    out[~valid] = 0.0
+    best = np.maximum.reduce(prio, axis=1)
+    np.divide(prio, np.where(best > 0, best, np.inf)[:, None], out=out[15])
+    out[:, ~valid] = 0.0
     _clip(out)
-    return out.astype(np.float32)
+    return out.transpose(1, 2, 0).astype(np.float32, order="C")
 
 
 def _clip(out: np.ndarray) -> None:
@@ -340,8 +346,8 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
     # a handful of agents: plain Python floats (the same IEEE arithmetic as numpy's)
     w = float(graph.world_size)
     n_a = graph.n_agents
-    known = float(np.log1p(graph.known_cells)) / 10.0
-    if graph.n_tasks:
+    known = float(np.log1p(graph.known_cells)) / 10.0 if graph.known_cells else 0.0
+    if graph.n_tasks and graph.task_kind[0] == _FIRE:  # (fires come first: else none)
         fire = graph.task_kind[np.maximum(cand.rows, 0)] == _FIRE
         fire &= cand.valid
         share = (fire.sum(axis=1) / max(cand.k, 1)).tolist()
