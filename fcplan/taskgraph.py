@@ -511,26 +511,34 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     fac_pos = consts.fac_pos
 
     # ---- fire tiles from known cells
-    xy = belief.known_xy()
     ntx = int(np.ceil(w / tw))
     nty = int(np.ceil(w / th)) + 1
-    txy = (xy // np.array([tw, th])).astype(np.int64)
-    key = txy[:, 0] * nty + txy[:, 1]  # tile row-major (ty < nty)
+    known = belief.known
+    kx, ky = np.divmod(known, w)  # known = flat x * W + y
+    if tw.is_integer() and th.is_integer() and tw >= 1.0 and th >= 1.0:
+        # whole-px tiles (the default): integer floor division, the same as the float one
+        key = kx // int(tw)
+        key *= nty
+        key += ky // int(th)  # tile row-major (ty < nty)
+    else:
+        key = (kx // tw).astype(np.int64) * nty + (ky // th).astype(np.int64)
     order = np.argsort(key, kind="stable")
     ks = key[order]
     first = np.empty(len(ks), dtype=bool)
     first[:1] = True
     np.not_equal(ks[1:], ks[:-1], out=first[1:])
     starts = first.nonzero()[0]
-    fxy = xy[order].astype(np.float64)
-    seen = belief.last_seen.ravel()[belief.known[order]]  # known = flat x * W + y
-    lo = np.minimum.reduceat(fxy, starts, axis=0)
-    hi = np.maximum.reduceat(fxy, starts, axis=0)
+    xs, ys = kx[order], ky[order]
+    seen = belief.last_seen.ravel()[known[order]]
     last = np.maximum.reduceat(seen, starts)
+    # tile centre: the middle of the cells' bounding box ((lo + hi) / 2 of whole px: exact)
+    fire_pos = np.empty((len(starts), 2))
+    np.add(np.minimum.reduceat(xs, starts), np.maximum.reduceat(xs, starts), out=fire_pos[:, 0])
+    np.add(np.minimum.reduceat(ys, starts), np.maximum.reduceat(ys, starts), out=fire_pos[:, 1])
+    fire_pos /= 2.0
     counts = np.empty_like(starts)  # tile sizes: gaps between starts
     np.subtract(starts[1:], starts[:-1], out=counts[:-1])
     counts[-1] = len(ks) - starts[-1]
-    fire_pos = (lo + hi) / 2.0
     fire_stale = (tick - last) / tps
     tile_x, tile_y = np.divmod(ks[starts], nty)
     cluster = _clusters(tile_x, tile_y, ntx, nty)
@@ -563,7 +571,8 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         1.0 + np.minimum(near_fire, 50) / 10.0
     )
 
-    fire_ids = tuple([f"fire:{int(x)}:{int(y)}" for x, y in fire_pos.tolist()])
+    # ids from the truncated position (astype truncates toward zero, as int() does)
+    fire_ids = tuple([f"fire:{x}:{y}" for x, y in fire_pos.astype(np.int64).tolist()])
     # keep ids unique when two tiles round to the same point
     if len(set(fire_ids)) != len(fire_ids):
         fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))

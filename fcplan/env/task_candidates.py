@@ -109,6 +109,7 @@ _FIRE, _SEARCH = int(TaskKind.FIRE), int(TaskKind.SEARCH)
 _RETURNING = int(Mode.RETURNING)
 _POS1 = np.arange(1, 1 << 16)  # 1-based positions (task graphs hold far fewer tasks)
 _ROWS = np.arange(256)[:, None]  # agent rows as a column, for fancy indexing
+_NONE_FORCED = np.zeros(0, dtype=bool)  # forced-return flags when no agent is on one (unused)
 
 
 @dataclass(frozen=True, eq=False)
@@ -213,14 +214,16 @@ def _ones(n: int) -> np.ndarray:
 def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candidates:
     """The ``k`` most relevant legal tasks of every agent (see the module docstring)."""
     n_a, n_t = graph.n_agents, graph.n_tasks
-    forced = graph.agent_mode == _RETURNING
-    forced_l = forced.tolist()  # a handful of agents: Python any/all beat numpy's reductions
+    # a handful of agents: Python any/all beat numpy's reductions
+    forced_l = [m == _RETURNING for m in graph.agent_mode.tolist()]
+    forced = np.array(forced_l, dtype=bool) if True in forced_l else _NONE_FORCED
     legal = _legal(graph, forced, forced_l)
     d_start = graph.agent_task_distance
     if True in forced_l:
         d_start = np.where(forced[:, None], graph.task_home_distance, d_start)
     kind = graph.task_kind
-    n_f = n_t - int(np.count_nonzero(kind)) if n_t else 0  # fires (kind 0) come first
+    # fires (kind 0) come first: none when the first task is a search block
+    n_f = n_t - int(np.count_nonzero(kind)) if n_t and kind[0] == _FIRE else 0
     value = graph.task_value
     if n_f:
         fresh = np.ones(n_t)
@@ -235,7 +238,7 @@ def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candid
         return _candidates(np.full((n_a, k), -1, dtype=np.int64), d_start, prio, fresh, legal)
     m = min(k, n_t)
     order = np.argsort(np.negative(prio), axis=1, kind="stable")  # illegal (-inf) last
-    n_legal = legal.sum(axis=1)
+    n_legal = np.add.reduce(legal, axis=1)
     if n_f == 0:  # search blocks only: the best legal ones (the first n_legal), in order
         valid = _POS1[:m] <= n_legal[:, None]
         rows = np.where(valid, order[:, :m], -1)
@@ -279,17 +282,10 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     # float32)
     out = np.empty((len(TASK_FEATURES), n_a, k))
     # per-task rows (features 1 .. 9), computed once over all tasks and gathered at once
-    pt = np.empty((9, n_t))
-    pt[1] = graph.task_kind  # is_search: kinds are 0 (fire) and 1 (search)
-    np.subtract(1.0, pt[1], out=pt[0])
-    pt[2] = graph.task_value
-    pt[3] = graph.task_cells
-    np.log1p(pt[2:4], out=pt[2:4])
-    pt[2:4] *= 0.2
+    pt = _task_rows(graph, cand.freshness)
+    np.log1p(graph.task_value, out=pt[2])
+    pt[2] *= 0.2
     np.divide(graph.task_staleness, 60.0, out=pt[4])
-    np.log1p(graph.task_threat, out=pt[5])
-    pt[6] = cand.freshness
-    pt[7:9] = graph.task_pos.T
     np.take(pt, r, axis=1, out=out[1:10])  # rows 8, 9: the task's position for now
     out[0] = 1.0
     no_goal = np.isnan(goal[:, 0]).tolist()  # a goal is set (or not) as a whole position
@@ -306,17 +302,22 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     dist = sd[ai, r]
     out[10] = dist
     out[12] = graph.task_home_distance[ai, r]
-    # other capable agents: how many are closer, and how close is the nearest
-    capable = graph.can_do[:, r]  # (A_other, A, k)
-    capable &= _not_self(n_a)
-    # incapable others at +inf: never closer (distances are finite), never the nearest
-    d_cap = np.where(capable, sd[:, r], np.inf)
+    # other capable agents: how many are closer, and how close is the nearest; incapable others
+    # at +inf: never closer (distances are finite), never the nearest
+    per_agent = _capable_per_agent(graph.can_do, n_a)
+    if per_agent is None:
+        capable = graph.can_do[:, r]  # (A_other, A, k)
+        capable &= _not_self(n_a)
+        d_cap = np.where(capable, sd[:, r], np.inf)
+        n_cap = np.add.reduce(capable, axis=0)
+        np.maximum(n_cap, 1, out=n_cap)
+    else:  # who can serve does not depend on the task: (A_other, A, 1) and (A, 1)
+        capable, n_cap = per_agent
+        d_cap = np.where(capable, sd[:, r], np.inf)
     # min(d / w, 1) == min(d, w) / w
     np.minimum(np.minimum.reduce(d_cap, axis=0), w, out=out[14])
     out[8:15] /= w
     np.divide(dist, (10.0 * graph.agent_speed)[:, None], out=out[11])
-    n_cap = np.add.reduce(capable, axis=0)
-    np.maximum(n_cap, 1, out=n_cap)
     np.divide(np.add.reduce(d_cap < dist, axis=0), n_cap, out=out[13])
     prio = np.where(valid, cand.priority[ai, r], 0.0)
     best = np.maximum.reduce(prio, axis=1)
@@ -324,6 +325,67 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     out[:, ~valid] = 0.0
     _clip(out)
     return out.transpose(1, 2, 0).astype(np.float32, order="C")
+
+
+def _capable_per_agent(can_do: np.ndarray, n_a: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """For a read-only ``can_do`` whose every row is constant (graphs without fire: only the
+    agent's camera matters), the (A_other, A, 1) bool "other agent j can serve agent i's
+    tasks" and the (A, 1) int64 ``max(count, 1)`` of those agents; else None."""
+    if can_do.flags.writeable or can_do.shape[1] == 0:
+        return None
+    hit = _CAPABLE.get(id(can_do))
+    if hit is None or hit[0] is not can_do:
+        per_agent = None
+        if (can_do == can_do[:, :1]).all():
+            capable = can_do[:, :1][:, None, :] & _not_self(n_a)  # (A_other, A, 1)
+            n_cap = np.add.reduce(capable, axis=0)
+            np.maximum(n_cap, 1, out=n_cap)
+            capable.flags.writeable = n_cap.flags.writeable = False
+            per_agent = (capable, n_cap)
+        if len(_CAPABLE) >= 16:
+            _CAPABLE.pop(next(iter(_CAPABLE)))
+        hit = _CAPABLE[id(can_do)] = (can_do, per_agent)
+    return hit[1]
+
+
+#: id(read-only can_do) -> (the array, its _capable_per_agent); an entry holds its array, so the
+#: id is not reused while cached, and a read-only array keeps its values
+_CAPABLE: dict[int, tuple[np.ndarray, tuple[np.ndarray, np.ndarray] | None]] = {}
+
+
+def _task_rows(graph: TaskGraph, freshness: np.ndarray) -> np.ndarray:
+    """(9, T) float64 rows of task features 1 .. 9 (kinds, log value and cells, staleness, log
+    threat, freshness, position) with the rows that do not depend on the step filled in: all but
+    rows 2 (log value) and 4 (staleness), which the caller fills.
+
+    Graphs without fire share their kind, cell, threat and position arrays (read-only, see
+    :func:`fcplan.taskgraph.build_task_graph`) and their freshness (all ones): those rows are
+    computed once per set of arrays and copied.
+    """
+    src = (graph.task_kind, graph.task_cells, graph.task_threat, graph.task_pos, freshness)
+    shared = not any(a.flags.writeable for a in src)
+    if shared:
+        hit = _TASK_ROWS.get(id(src[0]))
+        if hit is not None and all(a is b for a, b in zip(hit[0], src, strict=True)):
+            return hit[1].copy()
+    pt = np.empty((9, len(src[0])))
+    pt[1] = graph.task_kind  # is_search: kinds are 0 (fire) and 1 (search)
+    np.subtract(1.0, pt[1], out=pt[0])
+    np.log1p(graph.task_cells, out=pt[3])
+    pt[3] *= 0.2
+    np.log1p(graph.task_threat, out=pt[5])
+    pt[6] = freshness
+    pt[7:9] = graph.task_pos.T
+    if shared:
+        if len(_TASK_ROWS) >= 16:
+            _TASK_ROWS.pop(next(iter(_TASK_ROWS)))
+        _TASK_ROWS[id(src[0])] = (src, pt.copy())
+    return pt
+
+
+#: id(read-only task kinds) -> (the read-only source arrays, their _task_rows); an entry holds
+#: its arrays, so their ids are not reused while cached, and read-only arrays keep their values
+_TASK_ROWS: dict[int, tuple[tuple[np.ndarray, ...], np.ndarray]] = {}
 
 
 def _clip(out: np.ndarray) -> None:
@@ -375,14 +437,14 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
             graph.agent_pos.tolist(),
             graph.agent_z.tolist(),
             graph.agent_battery.tolist(),
-            graph.agent_full_range.tolist(),
+            _as_list(graph.agent_full_range),
             graph.agent_tank.tolist(),
-            graph.agent_tank_capacity.tolist(),
-            graph.agent_can_sense.tolist(),
-            graph.agent_can_act.tolist(),
+            _as_list(graph.agent_tank_capacity),
+            _as_list(graph.agent_can_sense),
+            _as_list(graph.agent_can_act),
             graph.agent_mode.tolist(),
             graph.agent_range.tolist(),
-            graph.agent_home.tolist(),
+            _as_list(graph.agent_home),
             share,
             strict=True,
         )
@@ -390,6 +452,24 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
     out = np.array(rows, dtype=np.float64).reshape(n_a, len(AGENT_FEATURES))
     _clip(out)
     return out.astype(np.float32)
+
+
+def _as_list(a: np.ndarray) -> list:
+    """``a.tolist()``, kept for read-only arrays (the per-team constants graphs share); the
+    caller must not change the list."""
+    if a.flags.writeable:
+        return a.tolist()
+    hit = _LISTS.get(id(a))
+    if hit is None or hit[0] is not a:
+        if len(_LISTS) >= 64:
+            _LISTS.pop(next(iter(_LISTS)))
+        hit = _LISTS[id(a)] = (a, a.tolist())
+    return hit[1]
+
+
+#: id(read-only array) -> (the array, its tolist()); an entry holds its array, so the id is not
+#: reused while cached, and a read-only array keeps its values
+_LISTS: dict[int, tuple[np.ndarray, list]] = {}
 
 
 _MODE_ONE_HOT = np.eye(4)[[int(Mode.IDLE), int(Mode.ACTIVE), int(Mode.RETURNING), int(Mode.HOMING)]]
