@@ -167,8 +167,14 @@ class Belief:
             # every block holds m coarse cells: gathered as (m, B * B), row j = the j-th cell of
             # each block in raster order, so the sum down the columns adds each block's cells
             # one after the other in raster order (what bincount does)
-            ticks = cov.take(perm).view(np.uint32)
-            np.minimum(ticks, never, out=ticks)
+            if isinstance(perm, int):  # square blocks of perm x perm coarse cells: a view
+                m = perm
+                blocks = cov.view(np.uint32).reshape(nb, m, nb, m).transpose(1, 3, 0, 2)
+                ticks = np.empty((m, m, nb, nb), dtype=np.uint32)
+                np.minimum(blocks, never, out=ticks)
+            else:
+                ticks = cov.take(perm).view(np.uint32)
+                np.minimum(ticks, never, out=ticks)
             # int - int is exact in float64 (ticks << 2**53): one pass, no int32 temporary
             age = np.subtract(self.tick, ticks.view(np.int32), dtype=np.float64)
             age /= self.ticks_per_second
@@ -216,7 +222,8 @@ def _block_layout(w: int, c: int, nc: int, block_px: int):
     per side, block of each coarse cell, coarse cells per block (at least 1: divisors), blocks
     holding no coarse cell centre, for those the coarse cell under the block's centre, and when
     every block holds the same number ``m`` of coarse cells, the (m * B * B,) flat coarse cells
-    ordered by position within the block (raster order), then by block (else None)."""
+    ordered by position within the block (raster order), then by block, or, when the blocks are
+    squares of ``s x s`` coarse cells tiling the grid, just ``s`` (else None)."""
     nb = -(-w // block_px)
     bi = np.minimum(((np.arange(nc) + 0.5) * c // block_px).astype(np.int64), nb - 1)
     key = (bi[:, None] * nb + bi[None, :]).ravel()
@@ -230,7 +237,14 @@ def _block_layout(w: int, c: int, nc: int, block_px: int):
     if empty.size == 0 and (counts == counts[0]).all():
         by_block = np.argsort(key, kind="stable")  # blocks in order, raster order within
         perm = by_block.reshape(nb * nb, -1).T.ravel().copy()
-    for a in (key, counts, empty, centre_cells, perm):
-        if a is not None:
-            a.flags.writeable = False
+        perm.flags.writeable = False
+        m = block_px // c
+        if block_px % c == 0 and nb * m == nc:
+            # square sub-blocks: the gather is a transposed view of the (nc, nc) grid (no index
+            # array to read); checked against the general order
+            view = np.arange(nc * nc).reshape(nb, m, nb, m).transpose(1, 3, 0, 2).ravel()
+            if np.array_equal(view, perm):
+                perm = m
+    for a in (key, counts, empty, centre_cells):
+        a.flags.writeable = False
     return nb, key, counts, empty, centre_cells, perm

@@ -316,6 +316,7 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
         d_cap = np.where(capable, sd[:, r], np.inf)
     # min(d / w, 1) == min(d, w) / w
     np.minimum(np.minimum.reduce(d_cap, axis=0), w, out=out[14])
+    out[11:14:2] = 0.0  # (rows 11 and 13, written below: no garbage through the division)
     out[8:15] /= w
     np.divide(dist, (10.0 * graph.agent_speed)[:, None], out=out[11])
     np.divide(np.add.reduce(d_cap < dist, axis=0), n_cap, out=out[13])
