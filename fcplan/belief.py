@@ -179,7 +179,7 @@ class Belief:
             age = np.subtract(self.tick, ticks.view(np.int32), dtype=np.float64)
             age /= self.ticks_per_second
             out = np.add.reduce(age.reshape(-1, nb * nb), axis=0)
-            out /= counts
+            out /= int(counts[0])  # every block's count (the same divisor as dividing by counts)
             return out.reshape(nb, nb)
         ticks = np.minimum(cov.view(np.uint32), never).view(np.int32)
         age = np.subtract(self.tick, ticks, dtype=np.float64)

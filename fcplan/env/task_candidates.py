@@ -288,7 +288,8 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     np.divide(graph.task_staleness, 60.0, out=pt[4])
     np.take(pt, r, axis=1, out=out[1:10])  # rows 8, 9: the task's position for now
     out[0] = 1.0
-    no_goal = np.isnan(goal[:, 0]).tolist()  # a goal is set (or not) as a whole position
+    # a goal is set (or not) as a whole position; NaN != NaN (Python floats: no numpy call)
+    no_goal = [x != x for x in goal[:, 0].tolist()]
     if False in no_goal:
         gd = out[8:10] - goal.T[:, :, None]
         gd = np.hypot(gd[0], gd[1])
@@ -321,8 +322,8 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     np.divide(dist, (10.0 * graph.agent_speed)[:, None], out=out[11])
     np.divide(np.add.reduce(d_cap < dist, axis=0), n_cap, out=out[13])
     prio = np.where(valid, cand.priority[ai, r], 0.0)
-    best = np.maximum.reduce(prio, axis=1)
-    np.divide(prio, np.where(best > 0, best, np.inf)[:, None], out=out[15])
+    best = [b if b > 0 else np.inf for b in np.maximum.reduce(prio, axis=1).tolist()]
+    np.divide(prio, np.array(best)[:, None], out=out[15])
     out[:, ~valid] = 0.0
     _clip(out)
     return out.transpose(1, 2, 0).astype(np.float32, order="C")
@@ -410,10 +411,15 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
     w = float(graph.world_size)
     n_a = graph.n_agents
     known = float(np.log1p(graph.known_cells)) / 10.0 if graph.known_cells else 0.0
-    if graph.n_tasks and graph.task_kind[0] == _FIRE:  # (fires come first: else none)
-        fire = graph.task_kind[np.maximum(cand.rows, 0)] == _FIRE
-        fire &= cand.valid
-        share = (fire.sum(axis=1) / max(cand.k, 1)).tolist()
+    kind = graph.task_kind
+    if graph.n_tasks and kind[0] == _FIRE:  # (fires come first: else none)
+        # valid slots holding one of the n_f fires (rows 0 .. n_f - 1), counted in Python
+        n_f = graph.n_tasks - int(np.count_nonzero(kind))
+        k = max(cand.k, 1)
+        share = [
+            sum(1 for r, v in zip(rw, vl, strict=True) if v and r < n_f) / k
+            for rw, vl in zip(cand.rows.tolist(), cand.valid.tolist(), strict=True)
+        ]
     else:
         share = [0.0] * n_a
     one_hot = _MODE_ROWS
