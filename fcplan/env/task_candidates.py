@@ -248,10 +248,14 @@ def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candid
         return _candidates(rows, d_start, prio, fresh, legal, valid)
     rows = np.full((n_a, k), -1, dtype=np.int64)
     ai = _ROWS[:n_a] if n_a <= _ROWS.shape[0] else np.arange(n_a)[:, None]
-    n_fire = legal[:, :n_f].sum(axis=1)
-    n_search = n_legal - n_fire
-    take_fire = np.minimum(n_fire, np.maximum(k - k // 2, k - n_search))[:, None]
-    take_search = np.minimum(n_search[:, None], k - take_fire)
+    # per agent, how many fires and search blocks to take (a handful of agents: Python ints)
+    takes = [
+        (tf := min(nf, max(k - k // 2, k - (nl - nf))), min(nl - nf, k - tf))
+        for nl, nf in zip(
+            n_legal.tolist(), np.add.reduce(legal[:, :n_f], axis=1).tolist(), strict=True
+        )
+    ]
+    take_fire, take_search = np.array(takes, dtype=np.int64).T[:, :, None]
     # rank of each sorted task within its kind (1-based); illegal tasks rank beyond every take
     s_fire = order < n_f
     fire_rank = np.cumsum(s_fire, axis=1)
