@@ -20,7 +20,10 @@ with an estimated time to reach it from the fastest spread rate of the scenario'
 
 Solvers should use the numpy views (``agent_*``, ``task_*``, :attr:`TaskGraph.agent_task_distance`,
 :attr:`TaskGraph.task_distance`); the networkx view (:attr:`TaskGraph.graph`) is built on first
-use, for inspection, drawing and teaching.
+use, for inspection, drawing and teaching. Graphs from :func:`build_task_graph` share the arrays
+that do not change between replans (the agents' roles, speeds, capacities and depot slots, the
+facilities, and without known fire the search blocks' kinds, positions and depot distances):
+those are read-only, so treat every graph array as read-only.
 
 Examples
 --------
@@ -465,7 +468,8 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
     The per-agent constants (role, speed, depot slots ...) and, without known fire, the
     belief-independent task fields are read-only arrays shared by the graphs of a team; the
     agent-task distance tables (:attr:`TaskGraph.agent_task_distance`,
-    :attr:`TaskGraph.task_home_distance`) are filled in at once (every consumer reads them).
+    :attr:`TaskGraph.task_home_distance`) are filled in at once (every consumer reads them),
+    and without known fire :attr:`TaskGraph.can_do` too.
 
     Parameters
     ----------

@@ -24,6 +24,12 @@ Relevance (the deterministic ranking)
 Task features (one row of the ``k x F`` table, see :data:`TASK_FEATURES`)
     all finite, clipped to ``[-FEATURE_BOUND, FEATURE_BOUND]``; padding rows are all zero.
 
+Shared arrays
+    What depends only on read-only arrays that :func:`fcplan.taskgraph.build_task_graph` shares
+    between graphs (the depot round-trip part of the legality, the constant task-feature rows
+    and who can serve a task of a fire-free graph, lists of per-agent constants) is computed once
+    per set of arrays, keyed by their identity: the same values as computing it every step.
+
 Examples
 --------
 >>> import numpy as np
