@@ -31,8 +31,6 @@ import numpy as np
 
 __all__ = ["Belief"]
 
-_ZERO32 = np.int32(0)
-
 
 class Belief:
     """The team's knowledge, updated from each tick's :class:`fcplan.world.StepInfo`.
@@ -158,12 +156,32 @@ class Belief:
         the stalest.
         """
         cov = self.coverage
-        nb, key, counts, empty, centre_cells = _block_layout(
+        nb, key, counts, empty, centre_cells, perm = _block_layout(
             self.world_size, self.coverage_px, cov.shape[0], int(block_px)
         )
-        never = np.int32(-60 * self.ticks_per_second)
-        ticks = np.where(cov >= _ZERO32, cov, never)
-        # int - int is exact in float64 (ticks << 2**53): one pass, no int32 temporary
+        # never-covered cells (-1) count as covered at tick -60 s: as uint32, -1 is above every
+        # tick and min(., -60 s as uint32) turns exactly the negative values >= -60 s (here -1)
+        # into -60 s and keeps the ticks (one pass instead of a compare and a select)
+        never = np.uint32(2**32 - 60 * self.ticks_per_second)
+        if perm is not None:
+            # every block holds m coarse cells: gathered as (m, B * B), row j = the j-th cell of
+            # each block in raster order, so the sum down the columns adds each block's cells
+            # one after the other in raster order (what bincount does)
+            if isinstance(perm, int):  # square blocks of perm x perm coarse cells: a view
+                m = perm
+                blocks = cov.view(np.uint32).reshape(nb, m, nb, m).transpose(1, 3, 0, 2)
+                ticks = np.empty((m, m, nb, nb), dtype=np.uint32)
+                np.minimum(blocks, never, out=ticks)
+            else:
+                ticks = cov.take(perm).view(np.uint32)
+                np.minimum(ticks, never, out=ticks)
+            # int - int is exact in float64 (ticks << 2**53): one pass, no int32 temporary
+            age = np.subtract(self.tick, ticks.view(np.int32), dtype=np.float64)
+            age /= self.ticks_per_second
+            out = np.add.reduce(age.reshape(-1, nb * nb), axis=0)
+            out /= int(counts[0])  # every block's count (the same divisor as dividing by counts)
+            return out.reshape(nb, nb)
+        ticks = np.minimum(cov.view(np.uint32), never).view(np.int32)
         age = np.subtract(self.tick, ticks, dtype=np.float64)
         age /= self.ticks_per_second
         sums = np.bincount(key, weights=age.ravel(), minlength=nb * nb)
@@ -201,8 +219,11 @@ def _raise_to(cov: np.ndarray, box: tuple[int, int, int, int], tick: int) -> Non
 @lru_cache(maxsize=32)
 def _block_layout(w: int, c: int, nc: int, block_px: int):
     """How coarse coverage cells fall into ``block_px`` blocks (constant per map): block count
-    per side, block of each coarse cell, coarse cells per block (at least 1: divisors), blocks holding no coarse cell
-    centre, and for those the coarse cell under the block's centre."""
+    per side, block of each coarse cell, coarse cells per block (at least 1: divisors), blocks
+    holding no coarse cell centre, for those the coarse cell under the block's centre, and when
+    every block holds the same number ``m`` of coarse cells, the (m * B * B,) flat coarse cells
+    ordered by position within the block (raster order), then by block, or, when the blocks are
+    squares of ``s x s`` coarse cells tiling the grid, just ``s`` (else None)."""
     nb = -(-w // block_px)
     bi = np.minimum(((np.arange(nc) + 0.5) * c // block_px).astype(np.int64), nb - 1)
     key = (bi[:, None] * nb + bi[None, :]).ravel()
@@ -212,6 +233,18 @@ def _block_layout(w: int, c: int, nc: int, block_px: int):
     centre = (np.arange(nb) + 0.5) * block_px
     ci = np.minimum((centre // c).astype(np.int64), nc - 1)
     centre_cells = ci[empty // nb] * nc + ci[empty % nb]
+    perm = None
+    if empty.size == 0 and (counts == counts[0]).all():
+        by_block = np.argsort(key, kind="stable")  # blocks in order, raster order within
+        perm = by_block.reshape(nb * nb, -1).T.ravel().copy()
+        perm.flags.writeable = False
+        m = block_px // c
+        if block_px % c == 0 and nb * m == nc:
+            # square sub-blocks: the gather is a transposed view of the (nc, nc) grid (no index
+            # array to read); checked against the general order
+            view = np.arange(nc * nc).reshape(nb, m, nb, m).transpose(1, 3, 0, 2).ravel()
+            if np.array_equal(view, perm):
+                perm = m
     for a in (key, counts, empty, centre_cells):
         a.flags.writeable = False
-    return nb, key, counts, empty, centre_cells
+    return nb, key, counts, empty, centre_cells, perm

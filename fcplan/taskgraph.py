@@ -20,7 +20,10 @@ with an estimated time to reach it from the fastest spread rate of the scenario'
 
 Solvers should use the numpy views (``agent_*``, ``task_*``, :attr:`TaskGraph.agent_task_distance`,
 :attr:`TaskGraph.task_distance`); the networkx view (:attr:`TaskGraph.graph`) is built on first
-use, for inspection, drawing and teaching.
+use, for inspection, drawing and teaching. Graphs from :func:`build_task_graph` share the arrays
+that do not change between replans (the agents' roles, speeds, capacities and depot slots, the
+facilities, and without known fire the search blocks' kinds, positions and depot distances):
+those are read-only, so treat every graph array as read-only.
 
 Examples
 --------
@@ -302,15 +305,13 @@ def _pairwise(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _rect_distance(points: np.ndarray, rects: np.ndarray) -> np.ndarray:
     """(P, F) distance from points to axis-aligned rectangles (0 inside)."""
-    dx = np.maximum(
-        np.maximum(rects[None, :, 0] - points[:, None, 0], 0.0),
-        points[:, None, 0] - rects[None, :, 1],
-    )
-    dy = np.maximum(
-        np.maximum(rects[None, :, 2] - points[:, None, 1], 0.0),
-        points[:, None, 1] - rects[None, :, 3],
-    )
-    return np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+    x, y = points[:, 0, None], points[:, 1, None]
+    # per axis max(lo - p, p - hi, 0): the gap to the rectangle's span (0 inside it)
+    dx = np.maximum(rects[:, 0] - x, x - rects[:, 1])
+    np.maximum(dx, 0.0, out=dx)
+    dy = np.maximum(rects[:, 2] - y, y - rects[:, 3])
+    np.maximum(dy, 0.0, out=dy)
+    return np.hypot(dx, dy, out=dx)
 
 
 def default_tile(team) -> tuple[float, float]:
@@ -333,7 +334,8 @@ def _default_tile(can_act: bytes, role: bytes, alt_lo: bytes) -> tuple[float, fl
 
 @dataclass(frozen=True, eq=False)
 class _ScenarioConsts:
-    """What a task graph needs from a scenario that never changes during an episode."""
+    """What a task graph needs from a scenario that never changes during an episode (read-only
+    arrays, shared by the graphs)."""
 
     fac_pos: np.ndarray
     fac_rect: np.ndarray
@@ -353,17 +355,98 @@ def _scenario_consts(scenario) -> _ScenarioConsts:
         return hit[1]
     facilities = scenario.scored_facilities
     consts = _ScenarioConsts(
-        fac_pos=np.array([f.center for f in facilities], dtype=np.float64).reshape(-1, 2),
-        fac_rect=np.array([f.footprint for f in facilities], dtype=np.float64).reshape(-1, 4),
-        fac_pen=np.array([f.penalty for f in facilities], dtype=np.float64),
+        fac_pos=_frozen(np.array([f.center for f in facilities], dtype=np.float64).reshape(-1, 2)),
+        fac_rect=_frozen(
+            np.array([f.footprint for f in facilities], dtype=np.float64).reshape(-1, 4)
+        ),
+        fac_pen=_frozen(np.array([f.penalty for f in facilities], dtype=np.float64)),
         fac_kinds=tuple(f.kind for f in facilities),
-        depot_pos=np.asarray(scenario.depot.center, dtype=np.float64),
+        depot_pos=_frozen(np.array(scenario.depot.center, dtype=np.float64)),
         max_fuel=max((r.fuel for r in scenario.regions), default=1.0),
     )
     if len(_CONSTS) >= 32:
         _CONSTS.pop(next(iter(_CONSTS)))
     _CONSTS[id(scenario)] = (scenario, consts)
     return consts
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only (shared between graphs: a consumer writing to it gets an error)."""
+    a.flags.writeable = False
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class _TeamConsts:
+    """The agent fields of a task graph that never change during a team's life (a team's role,
+    altitude bounds, speed, battery and tank capacities and depot slots are set when it is
+    built and never written), as read-only arrays shared by every graph of the team, and per
+    (map side, block side) the px from each depot slot to each search block and who can serve
+    them."""
+
+    tps: int
+    role: np.ndarray
+    alt_range: np.ndarray
+    speed: np.ndarray
+    full_range: np.ndarray
+    tank_capacity: np.ndarray
+    home: np.ndarray
+    can_sense: np.ndarray
+    can_act: np.ndarray
+    search_home: dict
+
+
+_TEAMS: dict[int, tuple[object, _TeamConsts]] = {}
+
+
+def _team_consts(team, tps: int) -> _TeamConsts:
+    """Per-team constants, cached by identity (the cache holds the team, so its id is not
+    reused while cached)."""
+    hit = _TEAMS.get(id(team))
+    if hit is not None and hit[0] is team and hit[1].tps == tps:
+        return hit[1]
+    consts = _TeamConsts(
+        tps=tps,
+        role=_frozen(team.role.copy()),
+        alt_range=_frozen(_columns(team.alt_lo, team.alt_hi)),
+        speed=_frozen(team.speed * tps),
+        full_range=_frozen(team.battery_capacity / DRAIN_PER_PX),
+        tank_capacity=_frozen(team.tank_capacity.copy()),
+        home=_frozen(team.home.copy()),
+        can_sense=_frozen(team.can_sense.copy()),
+        can_act=_frozen(team.can_act.copy()),
+        search_home={},
+    )
+    if len(_TEAMS) >= 16:
+        _TEAMS.pop(next(iter(_TEAMS)))
+    _TEAMS[id(team)] = (team, consts)
+    return consts
+
+
+def _search_home(tc: _TeamConsts, w: int, blk: int) -> tuple[np.ndarray, np.ndarray]:
+    """(A, nb * nb) px from each depot slot to each search block, and the (A, nb * nb)
+    :attr:`TaskGraph.can_do` of a graph of search blocks only (read-only, cached)."""
+    hit = tc.search_home.get((w, blk))
+    if hit is None:
+        d = _frozen(_pairwise(tc.home, _search_grid(w, blk)))
+        can = _frozen(np.repeat(tc.can_sense[:, None], d.shape[1], axis=1))
+        hit = tc.search_home[(w, blk)] = (d, can)
+    return hit
+
+
+@lru_cache(maxsize=16)
+def _search_only(n_search: int, n_fac: int) -> dict[str, np.ndarray]:
+    """The task fields of a graph without fire tasks that do not depend on the belief
+    (read-only)."""
+    minus = np.full(n_search, -1, dtype=np.int64)
+    return {
+        "task_kind": _frozen(np.full(n_search, int(TaskKind.SEARCH), dtype=np.int8)),
+        "task_cells": _frozen(np.zeros(n_search, dtype=np.int64)),
+        "task_threat": _frozen(np.zeros(n_search)),
+        "task_cluster": _frozen(minus),
+        "task_block": minus,
+        "threat_time_s": _frozen(np.full((0, n_fac), np.inf)),
+    }
 
 
 @lru_cache(maxsize=16)
@@ -382,6 +465,12 @@ def _search_grid(w: int, blk: int) -> np.ndarray:
 def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = None) -> TaskGraph:
     """Build the task graph from the scenario, the team's own state and the belief.
 
+    The per-agent constants (role, speed, depot slots ...) and, without known fire, the
+    belief-independent task fields are read-only arrays shared by the graphs of a team; the
+    agent-task distance tables (:attr:`TaskGraph.agent_task_distance`,
+    :attr:`TaskGraph.task_home_distance`) are filled in at once (every consumer reads them),
+    and without known fire :attr:`TaskGraph.can_do` too.
+
     Parameters
     ----------
     scenario : fcplan.scenario.Scenario
@@ -391,161 +480,168 @@ def build_task_graph(scenario, team, belief, params: TaskGraphParams | None = No
         What the team knows about the fire and what it has covered.
     params : TaskGraphParams, optional
     """
-    p = params or TaskGraphParams()
+    p = params or _DEFAULT_PARAMS
     w = scenario.world_size
     tps = scenario.ticks_per_second
     tick = belief.tick
-    tile = p.tile_px or default_tile(team)
-    tw, th = float(tile[0]), float(tile[1])
-
     consts = _scenario_consts(scenario)
-    fac_pos, fac_rect, fac_pen = (
-        consts.fac_pos.copy(),
-        consts.fac_rect.copy(),
-        consts.fac_pen.copy(),
-    )
+    tc = _team_consts(team, tps)
 
     # ---- search blocks
     blk = int(p.search_block_px)
     nb = -(-w // blk)
-    age = belief.coverage_age_s(blk)  # (nb, nb) indexed [bx, by]
+    search_age = belief.coverage_age_s(blk).ravel()  # (nb, nb) indexed [bx, by], raveled
     search_pos = _search_grid(w, blk)
-    search_age = age.ravel()
+    search_ids = _search_ids(nb, blk)
+    agent_pos = team.pos.copy()
+
+    if belief.known.size == 0:  # no known fire: search blocks only
+        tile = p.tile_px or default_tile(team)
+        fields = dict(_search_only(len(search_pos), len(consts.fac_pos)))
+        # min(age, cap) * (1 + min(0, 50) / 10) == min(age, cap): the factor is exactly 1
+        fields.update(
+            task_ids=search_ids,
+            task_pos=search_pos,
+            task_value=np.minimum(search_age, p.search_value_cap_s),
+            task_staleness=search_age,
+            known_cells=0,
+            agent_task_distance=_pairwise(agent_pos, search_pos),
+        )
+        fields["task_home_distance"], fields["can_do"] = _search_home(tc, w, blk)
+        return _finish(scenario, team, consts, tc, tick, agent_pos, (tile[0], tile[1]), fields)
+
+    tile = p.tile_px or default_tile(team)
+    tw, th = float(tile[0]), float(tile[1])
+    fac_pos = consts.fac_pos
 
     # ---- fire tiles from known cells
-    xy = belief.known_xy()
-    if len(xy):
-        ntx = int(np.ceil(w / tw))
-        nty = int(np.ceil(w / th)) + 1
-        txy = (xy // np.array([tw, th])).astype(np.int64)
-        key = txy[:, 0] * nty + txy[:, 1]  # tile row-major (ty < nty)
-        order = np.argsort(key, kind="stable")
-        ks = key[order]
-        first = np.empty(len(ks), dtype=bool)
-        first[:1] = True
-        np.not_equal(ks[1:], ks[:-1], out=first[1:])
-        starts = first.nonzero()[0]
-        fxy = xy[order].astype(np.float64)
-        seen = belief.last_seen.ravel()[belief.known[order]]  # known = flat x * W + y
-        lo = np.minimum.reduceat(fxy, starts, axis=0)
-        hi = np.maximum.reduceat(fxy, starts, axis=0)
-        last = np.maximum.reduceat(seen, starts)
-        counts = np.empty_like(starts)  # tile sizes: gaps between starts
-        np.subtract(starts[1:], starts[:-1], out=counts[:-1])
-        counts[-1] = len(ks) - starts[-1]
-        fire_pos = (lo + hi) / 2.0
-        fire_stale = (tick - last) / tps
-        tile_x, tile_y = np.divmod(ks[starts], nty)
-        cluster = _clusters(tile_x, tile_y, ntx, nty)
+    ntx = int(np.ceil(w / tw))
+    nty = int(np.ceil(w / th)) + 1
+    known = belief.known
+    kx, ky = np.divmod(known, w)  # known = flat x * W + y
+    if tw.is_integer() and th.is_integer() and tw >= 1.0 and th >= 1.0:
+        # whole-px tiles (the default): integer floor division, the same as the float one
+        key = kx // int(tw)
+        key *= nty
+        key += ky // int(th)  # tile row-major (ty < nty)
     else:
-        fire_pos = np.zeros((0, 2))
-        fire_stale = np.zeros(0)
-        counts = np.zeros(0, dtype=np.int64)
-        cluster = np.zeros(0, dtype=np.int64)
+        key = (kx // tw).astype(np.int64) * nty + (ky // th).astype(np.int64)
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    first = np.empty(len(ks), dtype=bool)
+    first[:1] = True
+    np.not_equal(ks[1:], ks[:-1], out=first[1:])
+    starts = first.nonzero()[0]
+    xs, ys = kx[order], ky[order]
+    seen = belief.last_seen.ravel()[known[order]]
+    last = np.maximum.reduceat(seen, starts)
+    # tile centre: the middle of the cells' bounding box ((lo + hi) / 2 of whole px: exact)
+    fire_pos = np.empty((len(starts), 2))
+    np.add(np.minimum.reduceat(xs, starts), np.maximum.reduceat(xs, starts), out=fire_pos[:, 0])
+    np.add(np.minimum.reduceat(ys, starts), np.maximum.reduceat(ys, starts), out=fire_pos[:, 1])
+    fire_pos /= 2.0
+    counts = np.empty_like(starts)  # tile sizes: gaps between starts
+    np.subtract(starts[1:], starts[:-1], out=counts[:-1])
+    counts[-1] = len(ks) - starts[-1]
+    fire_stale = (tick - last) / tps
+    tile_x, tile_y = np.divmod(ks[starts], nty)
+    cluster = _clusters(tile_x, tile_y, ntx, nty)
 
     n_fire = len(fire_pos)
     # threat: penalty-weighted closeness of each fire tile to each facility footprint
-    if n_fire and len(fac_pos):
-        d_fac = _rect_distance(fire_pos, fac_rect)
+    if len(fac_pos):
+        d_fac = _rect_distance(fire_pos, consts.fac_rect)
         close = np.minimum(np.maximum(1.0 - d_fac / p.threat_radius_px, 0.0), 1.0)
-        threat = close @ fac_pen
+        threat = close @ consts.fac_pen
         fuel = consts.max_fuel
         speed = max(0.24 * fuel * 10.0, 1e-9)  # px/s, first-tick spread at wind 5 (fastest)
         threat_time = np.where(d_fac < p.threat_radius_px, d_fac / speed, np.inf)
     else:
         threat = np.zeros(n_fire)
-        threat_time = np.full((n_fire, len(fac_pos)), np.inf)
+        threat_time = np.full((n_fire, 0), np.inf)
 
     # search value: age (capped) times (1 + nearby known fire)
-    near_fire = np.zeros(nb * nb)
-    if n_fire:
-        fb = (
-            np.minimum(fire_pos[:, 0] // blk, nb - 1) * nb
-            + np.minimum(fire_pos[:, 1] // blk, nb - 1)
-        ).astype(np.int64)
-        near = np.bincount(fb, weights=counts, minlength=nb * nb).reshape(nb, nb)
-        # spread to the 8 neighbours: fire grows across block borders
-        padded = np.zeros((nb + 2, nb + 2))
-        padded[1:-1, 1:-1] = near
-        # 3 x 3 box sum, separably (sums of whole cell counts: exact in any order)
-        rows = padded[:-2] + padded[1:-1] + padded[2:]
-        near_fire = (rows[:, :-2] + rows[:, 1:-1] + rows[:, 2:]).ravel()
-        fire_block = n_fire + fb
-    else:
-        fire_block = np.zeros(0, dtype=np.int64)
+    fbxy = fire_pos // blk
+    np.minimum(fbxy, nb - 1, out=fbxy)
+    fb = (fbxy @ (nb, 1.0)).astype(np.int64)  # block index bx * nb + by (small whole numbers)
+    # the known cells of the blocks around each block, itself included (fire grows across block
+    # borders): every tile's cells counted in the 3 x 3 blocks around its own (sums of whole
+    # cell counts: exact in any order)
+    near_fire = np.bincount(
+        _neighbours(nb)[fb].ravel(), weights=np.repeat(counts, 9), minlength=nb * nb + 1
+    )[: nb * nb]
+    fire_block = n_fire + fb
     search_value = np.minimum(search_age, p.search_value_cap_s) * (
         1.0 + np.minimum(near_fire, 50) / 10.0
     )
 
-    fire_ids = tuple(
-        f"fire:{int(x)}:{int(y)}" for x, y in zip(fire_pos[:, 0], fire_pos[:, 1], strict=True)
-    )
-    search_ids = _search_ids(nb, blk)
+    # ids from the truncated position (astype truncates toward zero, as int() does)
+    fire_ids = tuple([f"fire:{x}:{y}" for x, y in fire_pos.astype(np.int64).tolist()])
     # keep ids unique when two tiles round to the same point
     if len(set(fire_ids)) != len(fire_ids):
         fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))
 
-    k_total = n_fire + len(search_pos)
     n_search = len(search_pos)
+    k_total = n_fire + n_search
     task_kind = np.full(k_total, int(TaskKind.SEARCH), dtype=np.int8)
     task_kind[:n_fire] = int(TaskKind.FIRE)
-    minus_s = np.full(n_search, -1, dtype=np.int64)
-    if n_fire:
-        task_pos = np.concatenate([fire_pos, search_pos]).reshape(k_total, 2)
-        task_value = np.concatenate([counts * (1.0 + threat), search_value])
-        task_cells = _cat_int(counts, np.zeros(n_search, dtype=np.int64))
-        task_staleness = np.concatenate([fire_stale, search_age])
-        task_threat = np.concatenate([threat, np.zeros(n_search)])
-        task_cluster = _cat_int(cluster, minus_s)
-        task_block = _cat_int(fire_block, minus_s)
-    else:  # search blocks only: the same arrays without the empty concatenations
-        task_pos = search_pos.copy()
-        task_value = search_value
-        task_cells = np.zeros(n_search, dtype=np.int64)
-        task_staleness = search_age.copy()
-        task_threat = np.zeros(n_search)
-        task_cluster = minus_s
-        task_block = minus_s.copy()
-
-    range_px = team.range_px()
-    return _task_graph(
-        tick=tick,
-        time_s=tick / tps,
-        world_size=w,
-        depot_pos=consts.depot_pos.copy(),
-        agent_ids=team.ids,
-        agent_role=team.role.copy(),
-        agent_pos=team.pos.copy(),
-        agent_z=team.z.copy(),
-        agent_alt_range=_columns(team.alt_lo, team.alt_hi),
-        agent_speed=team.speed * tps,
-        agent_range=range_px,
-        agent_full_range=team.battery_capacity / DRAIN_PER_PX,
-        agent_battery=team.battery.copy(),
-        agent_tank=team.tank.copy(),
-        agent_tank_capacity=team.tank_capacity.copy(),
-        agent_mode=team.mode.copy(),
-        agent_home=team.home.copy(),
-        agent_can_sense=team.can_sense.copy(),
-        agent_can_act=team.can_act.copy(),
+    minus_s = _search_only(n_search, len(fac_pos))["task_cluster"]
+    task_pos = np.concatenate([fire_pos, search_pos])
+    # both (A, K) distance tables in one pass, as TaskGraph._agent_distances computes them
+    both = _pairwise(np.concatenate([agent_pos, tc.home]), task_pos)
+    n_a = len(agent_pos)
+    fields = dict(
         task_ids=fire_ids + search_ids,
         task_kind=task_kind,
         task_pos=task_pos,
-        task_value=task_value,
-        task_cells=task_cells,
-        task_staleness=task_staleness,
-        task_threat=task_threat,
-        task_cluster=task_cluster,
-        task_block=task_block,
-        facility_kinds=consts.fac_kinds,
-        facility_pos=fac_pos,
-        facility_rect=fac_rect,
-        facility_penalty=fac_pen,
+        task_value=np.concatenate([counts * (1.0 + threat), search_value]),
+        task_cells=_cat_int(counts, _search_only(n_search, len(fac_pos))["task_cells"]),
+        task_staleness=np.concatenate([fire_stale, search_age]),
+        task_threat=np.concatenate([threat, np.zeros(n_search)]),
+        task_cluster=_cat_int(cluster, minus_s),
+        task_block=_cat_int(fire_block, minus_s),
         threat_time_s=threat_time,
-        tile_px=(tw, th),
         known_cells=int(counts.sum()),
+        agent_task_distance=both[:n_a],
+        task_home_distance=both[n_a:],
+    )
+    return _finish(scenario, team, consts, tc, tick, agent_pos, (tw, th), fields)
+
+
+_DEFAULT_PARAMS = TaskGraphParams()
+
+
+def _finish(scenario, team, consts, tc, tick, agent_pos, tile, fields) -> TaskGraph:
+    """The graph from its task fields: the agent and facility fields added."""
+    tps = tc.tps
+    fields.update(
+        tick=tick,
+        time_s=tick / tps,
+        world_size=scenario.world_size,
+        depot_pos=consts.depot_pos,
+        agent_ids=team.ids,
+        agent_role=tc.role,
+        agent_pos=agent_pos,
+        agent_z=team.z.copy(),
+        agent_alt_range=tc.alt_range,
+        agent_speed=tc.speed,
+        agent_range=team.range_px(),
+        agent_full_range=tc.full_range,
+        agent_battery=team.battery.copy(),
+        agent_tank=team.tank.copy(),
+        agent_tank_capacity=tc.tank_capacity,
+        agent_mode=team.mode.copy(),
+        agent_home=tc.home,
+        agent_can_sense=tc.can_sense,
+        agent_can_act=tc.can_act,
+        facility_kinds=consts.fac_kinds,
+        facility_pos=consts.fac_pos,
+        facility_rect=consts.fac_rect,
+        facility_penalty=consts.fac_pen,
+        tile_px=(float(tile[0]), float(tile[1])),
         comm_range=scenario.comm_range,
     )
+    return _task_graph(**fields)
 
 
 def _columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -566,7 +662,22 @@ def _task_graph(**fields) -> TaskGraph:
 
 def _cat_int(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Concatenation as int64 (as ``np.r_[a, b].astype(np.int64)``)."""
-    return np.concatenate([a, b]).astype(np.int64)
+    return np.concatenate([a, b]).astype(np.int64, copy=False)
+
+
+@lru_cache(maxsize=16)
+def _neighbours(nb: int) -> np.ndarray:
+    """(nb * nb, 9) the blocks of the 3 x 3 neighbourhood of each block of an ``nb x nb`` grid
+    (flat ``bx * nb + by``); neighbours off the grid are ``nb * nb`` (read-only)."""
+    b = np.arange(nb)
+    bx, by = np.meshgrid(b, b, indexing="ij")
+    d = np.array([-1, 0, 1])
+    nx_ = bx.ravel()[:, None, None] + d[None, :, None]
+    ny_ = by.ravel()[:, None, None] + d[None, None, :]
+    inside = (nx_ >= 0) & (nx_ < nb) & (ny_ >= 0) & (ny_ < nb)
+    out = np.where(inside, nx_ * nb + ny_, nb * nb).reshape(nb * nb, 9)
+    out.flags.writeable = False
+    return out
 
 
 @lru_cache(maxsize=16)
@@ -584,30 +695,61 @@ _SMALL_CLUSTER = 256  # up to this many tiles, label by pairwise adjacency (no s
 
 def _clusters(tx: np.ndarray, ty: np.ndarray, nx_: int, ny_: int) -> np.ndarray:
     """Connected-fire labels of occupied tiles (8-connectivity), numbered like
-    ``scipy.ndimage.label`` (by first tile in raster order; the tiles come sorted that way)."""
+    ``scipy.ndimage.label`` (by first tile in raster order; the tiles come sorted that way).
+
+    Labels depend on the tiles only: the last few answers are kept (read-only) for tiles that
+    did not change since (the fire often keeps its tiles for several replans).
+    """
     n = len(tx)
     if n == 1:
         return np.zeros(1, dtype=np.int64)
+    key = (tx.dtype.str, ty.dtype.str, tx.tobytes() + ty.tobytes())
+    hit = _CLUSTER_MEMO.get(key)
+    if hit is not None:
+        return hit
     if n <= _SMALL_CLUSTER:
-        # min-label propagation with pointer jumping: each tile ends up pointing at the first
-        # (lowest-index) tile of its component, and components are numbered in that order
         adj = np.abs(tx[:, None] - tx) <= 1
         adj &= np.abs(ty[:, None] - ty) <= 1
         idx = np.arange(n)
-        lab = np.where(adj, idx, n).min(axis=1)
-        while True:
-            nxt = np.where(adj, lab, n).min(axis=1)
-            nxt = nxt[nxt]
-            if np.array_equal(nxt, lab):
-                break
-            lab = nxt
-        return (np.cumsum(lab == idx) - 1)[lab]
-    from scipy.ndimage import label
+        if n <= _CLOSURE_CLUSTER:
+            # transitive closure by boolean matrix squaring (reflexive: it only grows); the
+            # first tile reached from a tile is the first tile of its component
+            m, count = adj, np.count_nonzero(adj)
+            while True:
+                m = m @ m
+                c = np.count_nonzero(m)
+                if c == count:
+                    break
+                count = c
+            lab = m.argmax(axis=1)
+        else:
+            # min-label propagation with pointer jumping: each tile ends up pointing at the
+            # first (lowest-index) tile of its component
+            lab = np.where(adj, idx, n).min(axis=1)
+            while True:
+                nxt = np.where(adj, lab, n).min(axis=1)
+                nxt = nxt[nxt]
+                if np.array_equal(nxt, lab):
+                    break
+                lab = nxt
+        # components are numbered in the order of their first tiles
+        out = (np.cumsum(lab == idx) - 1)[lab]
+    else:
+        from scipy.ndimage import label
 
-    grid = np.zeros((nx_ + 1, ny_ + 1), dtype=bool)
-    grid[tx, ty] = True
-    labels, _ = label(grid, structure=_EIGHT)
-    return labels[tx, ty].astype(np.int64) - 1
+        grid = np.zeros((nx_ + 1, ny_ + 1), dtype=bool)
+        grid[tx, ty] = True
+        labels, _ = label(grid, structure=_EIGHT)
+        out = labels[tx, ty].astype(np.int64) - 1
+    if len(_CLUSTER_MEMO) >= 8:
+        _CLUSTER_MEMO.pop(next(iter(_CLUSTER_MEMO)))
+    _CLUSTER_MEMO[key] = _frozen(out)
+    return out
+
+
+_CLOSURE_CLUSTER = 24  # up to this many tiles, label by closure (few, cheap matrix products)
+#: tiles (dtypes, then x and y coordinates as bytes; equal lengths) -> labels (read-only)
+_CLUSTER_MEMO: dict[tuple[str, str, bytes], np.ndarray] = {}
 
 
 def synthetic_task_graph(

@@ -473,3 +473,62 @@ def test_graph_reports_team_state():
         np.testing.assert_allclose(g.agent_home[i], a.start)
         assert g.agent_speed[i] == pytest.approx(a.speed * 10.0)
         np.testing.assert_allclose(g.agent_alt_range[i], a.altitude)
+
+
+@settings(max_examples=80, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), nx=st.integers(2, 12), ny=st.integers(2, 12))
+def test_small_fire_clusters_match_scipy_label_also_when_repeated(seed, nx, ny):
+    """Up to a few dozen tiles (the closure path), cluster labels equal scipy.ndimage.label
+    (8-connected, numbered by first tile in raster order), and asking again for the same tiles
+    (the memo) gives the same labels."""
+    from scipy.ndimage import label
+
+    from fcplan.taskgraph import _EIGHT, _clusters
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, min(nx * ny, 40) + 1))
+    flat = np.sort(rng.choice(nx * ny, size=n, replace=False))
+    tx, ty = np.divmod(flat, ny)
+    grid = np.zeros((nx + 1, ny + 1), dtype=bool)
+    grid[tx, ty] = True
+    labels, _ = label(grid, structure=_EIGHT)
+    want = labels[tx, ty].astype(np.int64) - 1
+    assert np.array_equal(_clusters(tx, ty, nx, ny), want)
+    assert np.array_equal(_clusters(tx.copy(), ty.copy(), nx, ny), want)
+
+
+@pytest.mark.parametrize("nb", [1, 2, 5, 12])
+def test_neighbour_table_is_the_3x3_box_sum(nb):
+    """Counting each fire block's cells in its 3 x 3 neighbourhood through the neighbour table
+    equals the padded 3 x 3 box sum of the per-block counts."""
+    from fcplan.taskgraph import _neighbours
+
+    rng = np.random.default_rng(nb)
+    fb = rng.integers(0, nb * nb, 20)
+    counts = rng.integers(1, 50, 20)
+    near = np.bincount(fb, weights=counts, minlength=nb * nb).reshape(nb, nb)
+    padded = np.zeros((nb + 2, nb + 2))
+    padded[1:-1, 1:-1] = near
+    box = sum(padded[i : i + nb, j : j + nb] for i in range(3) for j in range(3)).ravel()
+    got = np.bincount(
+        _neighbours(nb)[fb].ravel(), weights=np.repeat(counts, 9), minlength=nb * nb + 1
+    )
+    assert np.array_equal(got[: nb * nb], box)
+
+
+def test_graph_shares_read_only_constants_between_builds():
+    """Two graphs of one team share their per-agent constants as read-only arrays, and their
+    belief-dependent arrays are their own (writing to them does not touch the other graph)."""
+    world = World().reset(load_scenario(1), seed=0)
+    belief = Belief(world.scenario)
+    belief.update(world.step())
+    a = build_task_graph(world.scenario, world.team, belief)
+    belief.update(world.step())
+    b = build_task_graph(world.scenario, world.team, belief)
+    for name in ("agent_home", "agent_speed", "agent_role", "agent_can_sense", "facility_pos"):
+        assert getattr(a, name) is getattr(b, name)
+        assert not getattr(a, name).flags.writeable
+    for name in ("agent_pos", "agent_battery", "task_value", "task_staleness"):
+        assert getattr(a, name) is not getattr(b, name)
+        assert getattr(a, name).flags.writeable
+    assert np.array_equal(a.agent_home, world.team.home)

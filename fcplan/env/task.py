@@ -109,7 +109,7 @@ import numpy as np
 
 from fcplan.belief import Belief
 from fcplan.env import EnvError
-from fcplan.env.task_actions import actions_commands, actions_plan, decode_actions
+from fcplan.env.task_actions import actions_plan, decode_actions, rows_commands
 from fcplan.env.task_candidates import (
     AGENT_FEATURES,
     FEATURE_BOUND,
@@ -259,15 +259,22 @@ class TaskEnv(_Base):
         noop = self.k
         act = [noop if (x := actions.get(a)) is None else int(x) for a in self.possible_agents]
         rows, illegal, conflict = decode_actions(graph, cand, act, illegal=self.illegal_action)
-        alts = dict(watch_altitude=self.watch_altitude, search_altitude=self.search_altitude)
-        sent = np.flatnonzero(rows >= 0)
-        if self.validate and not cand.legal[sent, rows[sent]].all():
-            # legal_tasks is validate_plan's arithmetic for one-task routes: only a bug gets
-            # here, and validate_plan names the offending agent and task
-            validate_plan(actions_plan(graph, rows, **alts), graph)
-        commands = actions_commands(graph, rows, **alts)
-        if sent.size:
-            self._goal[sent] = graph.task_pos[rows[sent]]
+        # a handful of agents: plain Python lists from here
+        rows_l = rows.tolist()
+        sent = [i for i, t in enumerate(rows_l) if t >= 0]
+        if sent and self.validate:
+            legal = cand.legal
+            if not all(legal[i, rows_l[i]] for i in sent):
+                # legal_tasks is validate_plan's arithmetic for one-task routes: only a bug gets
+                # here, and validate_plan names the offending agent and task
+                alts = dict(
+                    watch_altitude=self.watch_altitude, search_altitude=self.search_altitude
+                )
+                validate_plan(actions_plan(graph, rows, **alts), graph)
+        commands, pos = rows_commands(graph, rows_l, self.watch_altitude, self.search_altitude)
+        goal = self._goal
+        for i, p in zip(sent, pos, strict=True):
+            goal[i] = p
         self._rows = rows
         reward = self._advance(commands)
         self.steps += 1
@@ -278,13 +285,14 @@ class TaskEnv(_Base):
         rewards = dict.fromkeys(agents, reward)
         terms = dict.fromkeys(agents, False)
         truncs = dict.fromkeys(agents, done)
-        tids = graph.task_ids
+        tids, tick = graph.task_ids, self.world.tick
+        illegal_l, conflict_l = illegal.tolist(), conflict.tolist()
         infos = {
             a: {
-                "tick": self.world.tick,
-                "illegal": bool(illegal[i]),
-                "conflict": bool(conflict[i]),
-                "task": tids[rows[i]] if rows[i] >= 0 else None,
+                "tick": tick,
+                "illegal": illegal_l[i],
+                "conflict": conflict_l[i],
+                "task": tids[rows_l[i]] if rows_l[i] >= 0 else None,
             }
             for i, a in enumerate(agents)
         }

@@ -48,12 +48,19 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from fcplan.env.task_candidates import Candidates
+from fcplan.env.task_candidates import Candidates, _as_list
 from fcplan.plan import Plan
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Command
 
-__all__ = ["decode_actions", "actions_plan", "actions_commands", "plan_to_actions", "MappingCounts"]
+__all__ = [
+    "decode_actions",
+    "actions_plan",
+    "actions_commands",
+    "rows_commands",
+    "plan_to_actions",
+    "MappingCounts",
+]
 
 _FIRE = int(TaskKind.FIRE)
 
@@ -79,12 +86,15 @@ def decode_actions(
         Agents whose action was illegal / lost a conflict.
     """
     n_a, k = cand.rows.shape
-    a = np.asarray(actions, dtype=np.int64).reshape(n_a)
+    if type(actions) is list and len(actions) == n_a and all(type(x) is int for x in actions):
+        a = actions  # the environment's own list of Python ints
+    else:
+        a = np.asarray(actions, dtype=np.int64).reshape(n_a).tolist()
     # a handful of agents: plain Python over the (A,) actions beats a dozen numpy calls
     cand_rows, valid = cand.rows.tolist(), cand.valid.tolist()
     out: list[int] = []
     bad_l: list[bool] = []
-    for i, x in enumerate(a.tolist()):
+    for i, x in enumerate(a):
         r = cand_rows[i][x] if 0 <= x < k and valid[i][x] else -1
         out.append(r)
         bad_l.append(r < 0 and x != k)
@@ -102,7 +112,7 @@ def decode_actions(
     conflict = np.zeros(n_a, dtype=bool)
     sent = [i for i, r in enumerate(out) if r >= 0]
     if len(sent) > 1:
-        role = graph.agent_role.tolist()
+        role = _as_list(graph.agent_role)
         keys = [out[i] * 8 + role[i] for i in sent]
         if len(set(keys)) < len(keys):  # rare: resolve by arrival time
             chosen = np.array(sent)
@@ -160,24 +170,33 @@ def actions_commands(
     >>> actions_commands(g, rows) == plan_commands(actions_plan(g, rows), g)
     True
     """
-    sel = np.flatnonzero(rows >= 0)
-    if not sel.size:
-        return {}
-    t = rows[sel]
+    return rows_commands(graph, rows.tolist(), watch_altitude, search_altitude)[0]
+
+
+def rows_commands(
+    graph: TaskGraph, rows: list[int], watch_altitude: float, search_altitude: float
+) -> tuple[dict[str, Command], list[list[float]]]:
+    """:func:`actions_commands` from the rows as a list of ints; also returns the ``[x, y]``
+    task position of each agent sent somewhere (agent row order)."""
+    sel = [i for i, t in enumerate(rows) if t >= 0]
+    if not sel:
+        return {}, []
+    t = [rows[i] for i in sel]
     pos = graph.task_pos[t].tolist()
-    fire = (graph.task_kind[t] == _FIRE).tolist()
-    sense = graph.agent_can_sense[sel].tolist()
-    bounds = graph.agent_alt_range[sel].tolist()
+    kind = graph.task_kind[t].tolist()
+    sense = _as_list(graph.agent_can_sense)
+    bounds = _as_list(graph.agent_alt_range)
     ids = graph.agent_ids
     out: dict[str, Command] = {}
-    for j, i in enumerate(sel.tolist()):
+    for j, i in enumerate(sel):
         z = None
-        if sense[j]:
-            z = watch_altitude if fire[j] else search_altitude
-            z = float(min(max(z, bounds[j][0]), bounds[j][1]))
+        if sense[i]:
+            z = watch_altitude if kind[j] == _FIRE else search_altitude
+            lo, hi = bounds[i]
+            z = float(min(max(z, lo), hi))
         x, y = pos[j]
         out[ids[i]] = Command(route=((x, y),), patrol=False, altitude=z)
-    return out
+    return out, pos
 
 
 class MappingCounts(dict):

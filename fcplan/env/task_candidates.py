@@ -24,6 +24,12 @@ Relevance (the deterministic ranking)
 Task features (one row of the ``k x F`` table, see :data:`TASK_FEATURES`)
     all finite, clipped to ``[-FEATURE_BOUND, FEATURE_BOUND]``; padding rows are all zero.
 
+Shared arrays
+    What depends only on read-only arrays that :func:`fcplan.taskgraph.build_task_graph` shares
+    between graphs (the depot round-trip part of the legality, the constant task-feature rows
+    and who can serve a task of a fire-free graph, lists of per-agent constants) is computed once
+    per set of arrays, keyed by their identity: the same values as computing it every step.
+
 Examples
 --------
 >>> import numpy as np
@@ -109,6 +115,7 @@ _FIRE, _SEARCH = int(TaskKind.FIRE), int(TaskKind.SEARCH)
 _RETURNING = int(Mode.RETURNING)
 _POS1 = np.arange(1, 1 << 16)  # 1-based positions (task graphs hold far fewer tasks)
 _ROWS = np.arange(256)[:, None]  # agent rows as a column, for fancy indexing
+_NONE_FORCED = np.zeros(0, dtype=bool)  # forced-return flags when no agent is on one (unused)
 
 
 @dataclass(frozen=True, eq=False)
@@ -159,8 +166,19 @@ def legal_tasks(graph: TaskGraph) -> np.ndarray:
 def _legal(graph: TaskGraph, forced: np.ndarray, forced_l: list) -> np.ndarray:
     """:func:`legal_tasks` given the forced-return flags (array and list)."""
     dh = graph.task_home_distance
-    ok = 2.0 * dh <= (graph.agent_full_range + 1e-6)[:, None]
-    ok &= graph.can_do
+    full, can = graph.agent_full_range, graph.can_do
+    if dh.flags.writeable or full.flags.writeable or can.flags.writeable:
+        ok = 2.0 * dh <= (full + 1e-6)[:, None]
+        ok &= can
+    else:  # read-only inputs shared by graphs (build_task_graph without fire): once per inputs
+        hit = _HOME_OK.get(id(dh))
+        if hit is None or hit[0] is not dh or hit[1] is not full or hit[2] is not can:
+            if len(_HOME_OK) >= 16:
+                _HOME_OK.pop(next(iter(_HOME_OK)))
+            ok = 2.0 * dh <= (full + 1e-6)[:, None]
+            ok &= can
+            hit = _HOME_OK[id(dh)] = (dh, full, can, ok)
+        ok = hit[3].copy()
     if all(forced_l):
         return ok
     reach = graph.agent_task_distance + dh
@@ -171,12 +189,18 @@ def _legal(graph: TaskGraph, forced: np.ndarray, forced_l: list) -> np.ndarray:
     return ok
 
 
-def _candidates(rows, start_distance, priority, freshness, legal) -> Candidates:
+#: id(read-only home-distance table) -> (the table, the read-only full-range and can_do arrays,
+#: the part of the legality they give); an entry holds its inputs, so their ids are not reused
+#: while cached, and read-only arrays keep their values
+_HOME_OK: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+
+
+def _candidates(rows, start_distance, priority, freshness, legal, valid=None) -> Candidates:
     """``Candidates(...)`` without the frozen dataclass's per-field ``object.__setattr__``."""
     c = object.__new__(Candidates)
     c.__dict__.update(
         rows=rows,
-        valid=rows >= 0,
+        valid=rows >= 0 if valid is None else valid,
         start_distance=start_distance,
         priority=priority,
         freshness=freshness,
@@ -185,42 +209,59 @@ def _candidates(rows, start_distance, priority, freshness, legal) -> Candidates:
     return c
 
 
+@lru_cache(maxsize=16)
+def _ones(n: int) -> np.ndarray:
+    """(n,) float64 ones (read-only): the freshness of search blocks."""
+    out = np.ones(n)
+    out.flags.writeable = False
+    return out
+
+
 def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candidates:
     """The ``k`` most relevant legal tasks of every agent (see the module docstring)."""
     n_a, n_t = graph.n_agents, graph.n_tasks
-    forced = graph.agent_mode == _RETURNING
-    forced_l = forced.tolist()  # a handful of agents: Python any/all beat numpy's reductions
+    # a handful of agents: Python any/all beat numpy's reductions
+    forced_l = [m == _RETURNING for m in graph.agent_mode.tolist()]
+    forced = np.array(forced_l, dtype=bool) if True in forced_l else _NONE_FORCED
     legal = _legal(graph, forced, forced_l)
     d_start = graph.agent_task_distance
     if True in forced_l:
         d_start = np.where(forced[:, None], graph.task_home_distance, d_start)
     kind = graph.task_kind
-    n_f = n_t - int(np.count_nonzero(kind)) if n_t else 0  # fires (kind 0) come first
-    fresh = np.ones(n_t)
+    # fires (kind 0) come first: none when the first task is a search block
+    n_f = n_t - int(np.count_nonzero(kind)) if n_t and kind[0] == _FIRE else 0
     value = graph.task_value
     if n_f:
+        fresh = np.ones(n_t)
         stale = graph.task_staleness[:n_f]
         fresh[:n_f] = np.minimum(np.exp(-(stale - fresh_s) / max(fresh_s, 1e-9)), 1.0)
         value = value * fresh  # (x * 1.0 == x: skipped when there is no fire)
+    else:
+        fresh = _ones(n_t)
     prio = value / (1.0 + d_start / graph.agent_speed[:, None])
     prio = np.where(legal, prio, -np.inf)
-    rows = np.full((n_a, k), -1, dtype=np.int64)
     if n_t == 0 or n_a == 0:
-        return _candidates(rows, d_start, prio, fresh, legal)
+        return _candidates(np.full((n_a, k), -1, dtype=np.int64), d_start, prio, fresh, legal)
     m = min(k, n_t)
-    neg = np.negative(prio)
-    order = np.argsort(neg, axis=1, kind="stable")  # illegal (-inf) last
-    n_legal = legal.sum(axis=1)
-    if n_f == 0:  # search blocks only: the best legal ones, in order
-        take = np.minimum(n_legal, k)
-        head = order[:, :m]
-        rows[:, :m] = np.where(_POS1[:m] <= take[:, None], head, -1)
-        return _candidates(rows, d_start, prio, fresh, legal)
-    ai = np.arange(n_a)[:, None]
-    n_fire = legal[:, :n_f].sum(axis=1)
-    n_search = n_legal - n_fire
-    take_fire = np.minimum(n_fire, np.maximum(k - k // 2, k - n_search))[:, None]
-    take_search = np.minimum(n_search[:, None], k - take_fire)
+    order = np.argsort(np.negative(prio), axis=1, kind="stable")  # illegal (-inf) last
+    n_legal = np.add.reduce(legal, axis=1)
+    if n_f == 0:  # search blocks only: the best legal ones (the first n_legal), in order
+        valid = _POS1[:m] <= n_legal[:, None]
+        rows = np.where(valid, order[:, :m], -1)
+        if m < k:
+            rows = np.concatenate([rows, np.full((n_a, k - m), -1, dtype=np.int64)], axis=1)
+            valid = None
+        return _candidates(rows, d_start, prio, fresh, legal, valid)
+    rows = np.full((n_a, k), -1, dtype=np.int64)
+    ai = _ROWS[:n_a] if n_a <= _ROWS.shape[0] else np.arange(n_a)[:, None]
+    # per agent, how many fires and search blocks to take (a handful of agents: Python ints)
+    takes = [
+        (tf := min(nf, max(k - k // 2, k - (nl - nf))), min(nl - nf, k - tf))
+        for nl, nf in zip(
+            n_legal.tolist(), np.add.reduce(legal[:, :n_f], axis=1).tolist(), strict=True
+        )
+    ]
+    take_fire, take_search = np.array(takes, dtype=np.int64).T[:, :, None]
     # rank of each sorted task within its kind (1-based); illegal tasks rank beyond every take
     s_fire = order < n_f
     fire_rank = np.cumsum(s_fire, axis=1)
@@ -238,55 +279,125 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     ``goal`` is (A, 2): the position the environment last sent each agent to (NaN: none).
     """
     n_a, k = cand.rows.shape
-    if graph.n_tasks == 0:
+    n_t = graph.n_tasks
+    if n_t == 0:
         return np.zeros((n_a, k, len(TASK_FEATURES)), dtype=np.float32)
     w = float(graph.world_size)
     valid = cand.valid
     r = np.maximum(cand.rows, 0)
     ai = _ROWS[:n_a] if n_a <= _ROWS.shape[0] else np.arange(n_a)[:, None]
-    pos = graph.task_pos[r]  # (A, k, 2)
-    dist = cand.start_distance[ai, r]
-    # other capable agents: how many are closer, and how close is the nearest
-    d_all = cand.start_distance[:, r]  # (A_other, A, k)
-    capable = graph.can_do[:, r]
-    capable &= _not_self(n_a)
-    n_cap = capable.sum(axis=0)
-    closer = d_all < dist
-    closer &= capable
-    n_closer = closer.sum(axis=0)
-    nearest = np.where(capable, d_all, np.inf).min(axis=0)
+    sd = cand.start_distance
+    # float64 work table, feature-major (F, A, k) so that every feature is a contiguous row;
+    # transposed and cast once at the end (clipping before or after the cast gives the same
+    # float32)
+    out = np.empty((len(TASK_FEATURES), n_a, k))
+    # per-task rows (features 1 .. 9), computed once over all tasks and gathered at once
+    pt = _task_rows(graph, cand.freshness)
+    np.log1p(graph.task_value, out=pt[2])
+    pt[2] *= 0.2
+    np.divide(graph.task_staleness, 60.0, out=pt[4])
+    np.take(pt, r, axis=1, out=out[1:10])  # rows 8, 9: the task's position for now
+    out[0] = 1.0
+    # a goal is set (or not) as a whole position; NaN != NaN (Python floats: no numpy call)
+    no_goal = [x != x for x in goal[:, 0].tolist()]
+    if False in no_goal:
+        gd = out[8:10] - goal.T[:, :, None]
+        gd = np.hypot(gd[0], gd[1])
+        gd /= -50.0
+        np.exp(gd, out=out[16])
+        if True in no_goal:  # NaN: no goal yet
+            out[16][np.isnan(out[16])] = 0.0
+    else:  # no agent has a goal yet
+        out[16] = 0.0
+    out[8:10] -= graph.agent_pos.T[:, :, None]
+    dist = sd[ai, r]
+    out[10] = dist
+    out[12] = graph.task_home_distance[ai, r]
+    # other capable agents: how many are closer, and how close is the nearest; incapable others
+    # at +inf: never closer (distances are finite), never the nearest
+    per_agent = _capable_per_agent(graph.can_do, n_a)
+    if per_agent is None:
+        capable = graph.can_do[:, r]  # (A_other, A, k)
+        capable &= _not_self(n_a)
+        d_cap = np.where(capable, sd[:, r], np.inf)
+        n_cap = np.add.reduce(capable, axis=0)
+        np.maximum(n_cap, 1, out=n_cap)
+    else:  # who can serve does not depend on the task: (A_other, A, 1) and (A, 1)
+        capable, n_cap = per_agent
+        d_cap = np.where(capable, sd[:, r], np.inf)
+    # min(d / w, 1) == min(d, w) / w
+    np.minimum(np.minimum.reduce(d_cap, axis=0), w, out=out[14])
+    out[11:14:2] = 0.0  # (rows 11 and 13, written below: no garbage through the division)
+    out[8:15] /= w
+    np.divide(dist, (10.0 * graph.agent_speed)[:, None], out=out[11])
+    np.divide(np.add.reduce(d_cap < dist, axis=0), n_cap, out=out[13])
     prio = np.where(valid, cand.priority[ai, r], 0.0)
-    best = prio.max(axis=1)
-    # per-task columns, computed once over all tasks and gathered
-    per_task = np.empty((graph.n_tasks, 7))
-    per_task[:, 0] = graph.task_kind == _FIRE
-    per_task[:, 1] = 1.0 - per_task[:, 0]
-    per_task[:, 2] = graph.task_value
-    per_task[:, 3] = graph.task_cells
-    per_task[:, 4] = graph.task_threat
-    np.log1p(per_task[:, 2:5], out=per_task[:, 2:5])
-    per_task[:, 2:4] *= 0.2
-    per_task[:, 5] = per_task[:, 4]
-    per_task[:, 4] = graph.task_staleness / 60.0
-    per_task[:, 6] = cand.freshness
-    # float64 work table, cast once (clipping before or after the cast gives the same float32)
-    out = np.zeros((n_a, k, len(TASK_FEATURES)))
-    out[..., 0] = 1.0
-    out[..., 1:8] = per_task[r]
-    np.subtract(pos, graph.agent_pos[:, None, :], out=out[..., 8:10])
-    out[..., 10] = dist
-    out[..., 12] = graph.task_home_distance[ai, r]
-    np.minimum(nearest, w, out=out[..., 14])  # min(d / w, 1) == min(d, w) / w
-    out[..., 8:15] /= w
-    out[..., 11] = dist / (10.0 * graph.agent_speed[:, None])
-    out[..., 13] = n_closer / np.maximum(n_cap, 1)
-    out[..., 15] = prio / np.where(best > 0, best, np.inf)[:, None]
-    gd = pos - goal[:, None, :]
-    gd = np.hypot(gd[..., 0], gd[..., 1])
-    out[..., 16] = np.where(np.isnan(gd), 0.0, np.exp(gd / -50.0))  # NaN: no goal yet
-    out[~valid] = 0.0
+    best = [b if b > 0 else np.inf for b in np.maximum.reduce(prio, axis=1).tolist()]
+    np.divide(prio, np.array(best)[:, None], out=out[15])
+    out[:, ~valid] = 0.0
     _clip(out)
-    return out.astype(np.float32)
+    return out.transpose(1, 2, 0).astype(np.float32, order="C")
+
+
+def _capable_per_agent(can_do: np.ndarray, n_a: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """For a read-only ``can_do`` whose every row is constant (graphs without fire: only the
+    agent's camera matters), the (A_other, A, 1) bool "other agent j can serve agent i's
+    tasks" and the (A, 1) int64 ``max(count, 1)`` of those agents; else None."""
+    if can_do.flags.writeable or can_do.shape[1] == 0:
+        return None
+    hit = _CAPABLE.get(id(can_do))
+    if hit is None or hit[0] is not can_do:
+        per_agent = None
+        if (can_do == can_do[:, :1]).all():
+            capable = can_do[:, :1][:, None, :] & _not_self(n_a)  # (A_other, A, 1)
+            n_cap = np.add.reduce(capable, axis=0)
+            np.maximum(n_cap, 1, out=n_cap)
+            capable.flags.writeable = n_cap.flags.writeable = False
+            per_agent = (capable, n_cap)
+        if len(_CAPABLE) >= 16:
+            _CAPABLE.pop(next(iter(_CAPABLE)))
+        hit = _CAPABLE[id(can_do)] = (can_do, per_agent)
+    return hit[1]
+
+
+#: id(read-only can_do) -> (the array, its _capable_per_agent); an entry holds its array, so the
+#: id is not reused while cached, and a read-only array keeps its values
+_CAPABLE: dict[int, tuple[np.ndarray, tuple[np.ndarray, np.ndarray] | None]] = {}
+
+
+def _task_rows(graph: TaskGraph, freshness: np.ndarray) -> np.ndarray:
+    """(9, T) float64 rows of task features 1 .. 9 (kinds, log value and cells, staleness, log
+    threat, freshness, position) with the rows that do not depend on the step filled in: all but
+    rows 2 (log value) and 4 (staleness), which the caller fills.
+
+    Graphs without fire share their kind, cell, threat and position arrays (read-only, see
+    :func:`fcplan.taskgraph.build_task_graph`) and their freshness (all ones): those rows are
+    computed once per set of arrays and copied.
+    """
+    src = (graph.task_kind, graph.task_cells, graph.task_threat, graph.task_pos, freshness)
+    shared = not any(a.flags.writeable for a in src)
+    if shared:
+        hit = _TASK_ROWS.get(id(src[0]))
+        if hit is not None and all(a is b for a, b in zip(hit[0], src, strict=True)):
+            return hit[1].copy()
+    pt = np.empty((9, len(src[0])))
+    pt[1] = graph.task_kind  # is_search: kinds are 0 (fire) and 1 (search)
+    np.subtract(1.0, pt[1], out=pt[0])
+    np.log1p(graph.task_cells, out=pt[3])
+    pt[3] *= 0.2
+    np.log1p(graph.task_threat, out=pt[5])
+    pt[6] = freshness
+    pt[7:9] = graph.task_pos.T
+    if shared:
+        if len(_TASK_ROWS) >= 16:
+            _TASK_ROWS.pop(next(iter(_TASK_ROWS)))
+        _TASK_ROWS[id(src[0])] = (src, pt.copy())
+    return pt
+
+
+#: id(read-only task kinds) -> (the read-only source arrays, their _task_rows); an entry holds
+#: its arrays, so their ids are not reused while cached, and read-only arrays keep their values
+_TASK_ROWS: dict[int, tuple[tuple[np.ndarray, ...], np.ndarray]] = {}
 
 
 def _clip(out: np.ndarray) -> None:
@@ -309,11 +420,16 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
     # a handful of agents: plain Python floats (the same IEEE arithmetic as numpy's)
     w = float(graph.world_size)
     n_a = graph.n_agents
-    known = float(np.log1p(graph.known_cells)) / 10.0
-    if graph.n_tasks:
-        fire = graph.task_kind[np.maximum(cand.rows, 0)] == _FIRE
-        fire &= cand.valid
-        share = (fire.sum(axis=1) / max(cand.k, 1)).tolist()
+    known = float(np.log1p(graph.known_cells)) / 10.0 if graph.known_cells else 0.0
+    kind = graph.task_kind
+    if graph.n_tasks and kind[0] == _FIRE:  # (fires come first: else none)
+        # valid slots holding one of the n_f fires (rows 0 .. n_f - 1), counted in Python
+        n_f = graph.n_tasks - int(np.count_nonzero(kind))
+        k = max(cand.k, 1)
+        share = [
+            sum(1 for r, v in zip(rw, vl, strict=True) if v and r < n_f) / k
+            for rw, vl in zip(cand.rows.tolist(), cand.valid.tolist(), strict=True)
+        ]
     else:
         share = [0.0] * n_a
     one_hot = _MODE_ROWS
@@ -338,14 +454,14 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
             graph.agent_pos.tolist(),
             graph.agent_z.tolist(),
             graph.agent_battery.tolist(),
-            graph.agent_full_range.tolist(),
+            _as_list(graph.agent_full_range),
             graph.agent_tank.tolist(),
-            graph.agent_tank_capacity.tolist(),
-            graph.agent_can_sense.tolist(),
-            graph.agent_can_act.tolist(),
+            _as_list(graph.agent_tank_capacity),
+            _as_list(graph.agent_can_sense),
+            _as_list(graph.agent_can_act),
             graph.agent_mode.tolist(),
             graph.agent_range.tolist(),
-            graph.agent_home.tolist(),
+            _as_list(graph.agent_home),
             share,
             strict=True,
         )
@@ -353,6 +469,24 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
     out = np.array(rows, dtype=np.float64).reshape(n_a, len(AGENT_FEATURES))
     _clip(out)
     return out.astype(np.float32)
+
+
+def _as_list(a: np.ndarray) -> list:
+    """``a.tolist()``, kept for read-only arrays (the per-team constants graphs share); the
+    caller must not change the list."""
+    if a.flags.writeable:
+        return a.tolist()
+    hit = _LISTS.get(id(a))
+    if hit is None or hit[0] is not a:
+        if len(_LISTS) >= 64:
+            _LISTS.pop(next(iter(_LISTS)))
+        hit = _LISTS[id(a)] = (a, a.tolist())
+    return hit[1]
+
+
+#: id(read-only array) -> (the array, its tolist()); an entry holds its array, so the id is not
+#: reused while cached, and a read-only array keeps its values
+_LISTS: dict[int, tuple[np.ndarray, list]] = {}
 
 
 _MODE_ONE_HOT = np.eye(4)[[int(Mode.IDLE), int(Mode.ACTIVE), int(Mode.RETURNING), int(Mode.HOMING)]]

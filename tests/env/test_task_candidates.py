@@ -238,3 +238,53 @@ def test_deferred_coverage_equals_eager_writes(seed, backwards):
     ref._coverage[...] = eager
     ref.tick = belief.tick
     assert np.array_equal(belief.coverage_age_s(100), ref.coverage_age_s(100))
+
+
+def _writable_copy(g):
+    """The same graph with every array field a fresh writable copy (no shared read-only arrays,
+    no filled-in distance tables): the generic code paths."""
+    import dataclasses
+
+    fields = {
+        f.name: (np.array(v) if isinstance(v := getattr(g, f.name), np.ndarray) else v)
+        for f in dataclasses.fields(g)
+    }
+    return type(g)(**fields)
+
+
+@settings(max_examples=10, deadline=None)
+@given(name=st.sampled_from(["practice", "1", "24", "open_world_example"]), seed=st.integers(0, 9))
+def test_shared_array_shortcuts_equal_the_generic_paths(name, seed):
+    """On graphs built by build_task_graph (read-only per-team and fire-free task arrays, cached
+    legality, task rows and capable-agent tables), candidates, masks and features are bit for
+    bit those of the same graph with fresh writable arrays, with and without known fire."""
+    from fcplan import World, load_scenario, make_scheduler
+    from fcplan.belief import Belief
+    from fcplan.plan import plan_commands
+    from fcplan.taskgraph import build_task_graph
+
+    world = World().reset(load_scenario(name), seed=seed)
+    belief = Belief(world.scenario)
+    sched = make_scheduler("greedy")
+    goal = np.full((len(world.team.ids), 2), np.nan)
+    goal[0] = (100.0, 200.0)
+    commands = None
+    for tick in range(1, 601):
+        belief.update(world.step(commands))
+        commands = None
+        if tick % 10:
+            continue
+        g = build_task_graph(world.scenario, world.team, belief)
+        commands = plan_commands(sched.plan(g, time_limit=None, rng=world.controller_rng), g)
+        if tick % 50:
+            continue
+        for f in (g, build_task_graph(world.scenario, world.team, belief)):  # caches warm
+            h = _writable_copy(f)
+            a, b = rank_candidates(f, 6), rank_candidates(h, 6)
+            for field in ("rows", "valid", "start_distance", "priority", "freshness", "legal"):
+                assert np.array_equal(getattr(a, field), getattr(b, field)), field
+            for x, y in (
+                (task_features(f, a, goal), task_features(h, b, goal)),
+                (agent_features(f, a, 0.3), agent_features(h, b, 0.3)),
+            ):
+                assert x.dtype == y.dtype and x.tobytes() == y.tobytes()

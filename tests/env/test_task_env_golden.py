@@ -1,0 +1,216 @@
+"""Golden episodes of the task-level environment: its API outputs pinned step by step, so speed
+work on the observation side cannot change them.
+
+Every run below (scenario x policy x seed x env options) plays one whole episode of
+:class:`fcplan.env.task.TaskEnv` and digests, at the reset and after every step: every observation
+array of every agent (``agent``, ``tasks``, ``action_mask``), :meth:`~fcplan.env.task.TaskEnv.state`,
+the rewards, terminations and truncations, and the infos (tick, illegal, conflict, task id, and
+on the last step the metrics and the return). Policies:
+
+* ``random``: uniformly random legal actions drawn from the masks by a seeded Generator;
+* ``greedy``: the greedy scheduler's plans mapped to actions by
+  :func:`fcplan.env.task_actions.plan_to_actions` (as ``bench/bench_env.py`` does);
+* ``any``: uniformly random actions in ``0..k`` ignoring the masks (illegal actions become
+  no-ops), which exercises the illegal and conflict paths.
+
+Each stream goes into a SHA-256 in two forms, as in ``tests/test_golden.py``:
+
+* ``exact``: the raw little-endian bytes (floats bit for bit), compared only on the platform the
+  golden file was written on (machine, numpy version, AVX-512 dispatch);
+* ``portable``: floats quantised to 1e-6 (non-finite values as sentinels), integers as int64,
+  compared everywhere.
+
+Regenerate the file only after an intended behaviour change (and say so in the commit)::
+
+    python tests/env/test_task_env_golden.py --regenerate
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import platform
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fcplan import load_scenario, make_scheduler
+from fcplan.env.task import TaskEnv
+from fcplan.env.task_actions import plan_to_actions
+
+GOLDEN = Path(__file__).parent.parent / "data" / "golden_task_env.json"
+
+# (run id, scenario, policy, seed, env keyword arguments)
+RUNS: list[tuple[str, str, str, int, dict]] = []
+for _sc in ("practice", "1", "12", "24", "open_world_example"):
+    for _seed in (0, 1):
+        RUNS.append((f"{_sc}-random-{_seed}", _sc, "random", _seed, {}))
+    RUNS.append((f"{_sc}-greedy-0", _sc, "greedy", 0, {}))
+RUNS += [
+    ("1-any-2", "1", "any", 2, {}),
+    ("24-any-3", "24", "any", 3, {"k": 4, "replan_period": 0.5, "max_steps": 150}),
+    ("12-random-4-k3-bonus", "12", "random", 4, {"k": 3, "prune_bonus": 0.5, "validate": False}),
+]
+
+
+def platform_key() -> str:
+    """Where exact (bit-level) float digests are reproducible."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_features__ as feats
+    except ImportError:  # numpy < 2
+        from numpy.core._multiarray_umath import __cpu_features__ as feats
+    simd = "avx512" if feats.get("AVX512_SKX") else ("avx2" if feats.get("AVX2") else "base")
+    return f"{sys.platform}-{platform.machine()}-numpy{np.__version__}-{simd}"
+
+
+class Digests:
+    """Values collected per named stream, hashed at the end (exact and portable)."""
+
+    def __init__(self) -> None:
+        self.items: dict[str, list] = {}
+
+    def add(self, name: str, value) -> None:
+        """Append one value (array, scalar, tuple of strings, None) to stream ``name``."""
+        if value is None:
+            value = np.zeros(0, np.int8)
+        elif not (isinstance(value, tuple) and value and isinstance(value[0], str)):
+            value = np.array(value)  # a copy: the caller may change its array later
+        self.items.setdefault(name, []).append(value)
+
+    @staticmethod
+    def _digest(values: list) -> tuple[str, str]:
+        if isinstance(values[0], tuple):
+            h = hashlib.sha256("\x1e".join("\x1f".join(v) for v in values).encode()).hexdigest()
+            return h[:16], h[:16]
+        head = np.array([d for a in values for d in (a.ndim, *a.shape)], dtype="<i8").tobytes()
+        dtypes = ",".join(a.dtype.str for a in values).encode()
+        flat = np.concatenate([a.ravel() for a in values])
+        if flat.dtype.kind == "f":
+            exact = hashlib.sha256(dtypes + head + flat.astype("<f8").tobytes()).hexdigest()
+            fin = np.isfinite(flat)
+            q = np.rint(np.where(fin, flat, 0.0) * 1e6).astype("<i8")
+            q[np.isposinf(flat)] = np.iinfo(np.int64).max
+            q[np.isneginf(flat)] = np.iinfo(np.int64).min
+            q[np.isnan(flat)] = np.iinfo(np.int64).min + 1
+            port = hashlib.sha256(head + q.tobytes()).hexdigest()
+        elif flat.dtype.kind in "iub":
+            data = flat.astype(np.int64).astype("<i8").tobytes()
+            port = hashlib.sha256(flat.dtype.kind.encode() + head + data).hexdigest()
+            exact = hashlib.sha256(dtypes + port.encode()).hexdigest()
+        else:
+            raise TypeError(f"cannot digest dtype {flat.dtype}")
+        return exact[:16], port[:16]
+
+    def result(self) -> dict[str, dict[str, str]]:
+        """``{"exact": {name: hex}, "portable": {name: hex}}`` (16 hex digits each)."""
+        out: dict[str, dict[str, str]] = {"exact": {}, "portable": {}}
+        for name in sorted(self.items):
+            out["exact"][name], out["portable"][name] = self._digest(self.items[name])
+        return out
+
+
+def _leaves(prefix: str, value, out: list) -> None:
+    """Flatten nested dicts into ``(dotted name, leaf)`` pairs, keys sorted."""
+    if isinstance(value, dict):
+        for key in sorted(value):
+            _leaves(f"{prefix}.{key}", value[key], out)
+    else:
+        out.append((prefix, value))
+
+
+def digest_obs(d: Digests, env: TaskEnv, obs: dict) -> None:
+    """Every observation array of every agent, and the global state."""
+    d.add("obs.agents", tuple(obs))
+    for a in env.possible_agents:
+        for key in ("agent", "tasks", "action_mask"):
+            d.add(f"obs.{key}", obs[a][key])
+    d.add("state", env.state())
+
+
+def digest_step(d: Digests, env: TaskEnv, out: tuple) -> None:
+    """Observations, rewards, terminations, truncations and infos of one step."""
+    obs, rewards, terms, truncs, infos = out
+    digest_obs(d, env, obs)
+    d.add("rewards.agents", tuple(rewards))
+    d.add("rewards", np.array(list(rewards.values()), dtype=np.float64))
+    d.add("terminations", np.array(list(terms.values()), dtype=bool))
+    d.add("truncations", np.array(list(truncs.values()), dtype=bool))
+    d.add("infos.agents", tuple(infos))
+    d.add("env.agents", tuple(env.agents) or ("",))
+    for a, info in infos.items():
+        d.add("infos.keys", tuple(sorted(info)))
+        d.add("infos.flags", np.array([info["tick"], info["illegal"], info["conflict"]], np.int64))
+        d.add("infos.task", ("-" if info["task"] is None else info["task"],))
+        rest = {k: v for k, v in info.items() if k not in ("tick", "illegal", "conflict", "task")}
+        leaves: list = []
+        _leaves(a, rest, leaves)
+        for name, v in leaves:
+            if isinstance(v, str):
+                d.add("infos.text", (name, v))
+            else:
+                d.add("infos.names", (name,))
+                d.add("infos.values", np.array([v], dtype=np.float64))
+
+
+def run_digest(run) -> dict[str, dict[str, str]]:
+    """Play one episode and digest everything the environment returned."""
+    _, name, policy, seed, kwargs = run
+    env = TaskEnv(load_scenario(name), **kwargs)
+    d = Digests()
+    obs, infos = env.reset(seed=seed)
+    digest_obs(d, env, obs)
+    d.add("reset.infos", np.array([info["tick"] for info in infos.values()], np.int64))
+    rng = np.random.default_rng(seed + 100)
+    sched = make_scheduler("greedy")
+    ids = env.possible_agents
+    while env.agents:
+        if policy == "random":
+            act = np.argmax(rng.random(env._mask.shape) * env._mask, axis=1)
+        elif policy == "any":
+            act = rng.integers(0, env.k + 1, size=len(ids))
+        else:
+            plan = sched.plan(env.graph, time_limit=None, rng=env.world.controller_rng)
+            act = plan_to_actions(plan, env.graph, env.candidates)
+        d.add("actions", act.astype(np.int64))
+        digest_step(d, env, env.step(dict(zip(ids, act.tolist(), strict=True))))
+    return d.result()
+
+
+def _load() -> dict:
+    return json.loads(GOLDEN.read_text())
+
+
+@pytest.mark.parametrize("run", RUNS, ids=[r[0] for r in RUNS])
+def test_golden_task_env(run):
+    """An episode reproduces the recorded digests of every observation, state, reward, flag and
+    info the task environment returned."""
+    golden = _load()
+    want = golden["runs"][run[0]]
+    got = run_digest(run)
+    kinds = ["portable"] + (["exact"] if golden["platform"] == platform_key() else [])
+    for kind in kinds:
+        bad = sorted(k for k in want[kind] if got[kind].get(k) != want[kind][k])
+        extra = sorted(set(got[kind]) - set(want[kind]))
+        assert not bad and not extra, f"{run[0]}: {kind} digests differ for {bad + extra}"
+
+
+def test_golden_task_env_file_covers_every_run():
+    """The golden file holds exactly the runs this module plays."""
+    assert sorted(_load()["runs"]) == sorted(r[0] for r in RUNS)
+
+
+def regenerate() -> None:
+    """Write the golden file from the current code (only after an intended behaviour change)."""
+    out = {"platform": platform_key(), "runs": {r[0]: run_digest(r) for r in RUNS}}
+    GOLDEN.parent.mkdir(parents=True, exist_ok=True)
+    GOLDEN.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+    print(f"wrote {GOLDEN} ({len(RUNS)} runs, platform {out['platform']})")
+
+
+if __name__ == "__main__":
+    if sys.argv[1:] == ["--regenerate"]:
+        regenerate()
+    else:
+        sys.exit("usage: python tests/env/test_task_env_golden.py --regenerate")
