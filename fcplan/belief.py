@@ -97,7 +97,7 @@ class Belief:
             self._known_mask[info.pruned] = False
             self.n_pruned += int(info.pruned.size)
             self._dirty = True
-        self._cover(info.fov, info.tick)
+        self._cover(info.fov_rects, info.tick)
 
     @property
     def coverage(self) -> np.ndarray:
@@ -106,8 +106,9 @@ class Belief:
         self._flush()
         return self._coverage
 
-    def _cover(self, fov: np.ndarray, tick: int) -> None:
-        """Mark coarse cells whose centres lie inside a sensing agent's field of view.
+    def _cover(self, rects: list, tick: int) -> None:
+        """Mark coarse cells whose centres lie inside a sensing agent's field of view (``rects``:
+        every agent's ``[x0, x1, y0, y1]`` as :attr:`fcplan.world.StepInfo.fov_rects`; read only).
 
         An agent whose field of view is exactly the last tick's (hovering) would rewrite the same
         cells: the write is deferred until it moves or the coverage is read. Ticks never
@@ -124,7 +125,6 @@ class Belief:
         c = self.coverage_px
         cov = self._coverage
         nc = cov.shape[0]
-        rects = fov.tolist()
         last, boxes, pending = self._last_rect, self._last_box, self._pending
         lazy = self._lazy
         for slot, k in enumerate(rows):

@@ -227,7 +227,9 @@ def test_deferred_coverage_equals_eager_writes(seed, backwards):
         )
         fov = np.where(moving[:, None], new, fov)
         tick = tick - 7 if backwards and step == 30 else tick + 1
-        belief.update(SimpleNamespace(tick=tick, sensed=empty, pruned=empty, fov=fov))
+        belief.update(
+            SimpleNamespace(tick=tick, sensed=empty, pruned=empty, fov_rects=fov.tolist())
+        )
         for k in belief._sensing_rows:
             i0, i1, j0, j1 = _coarse_box(fov[k].tolist(), c, eager.shape[0])
             eager[i0:i1, j0:j1] = tick
