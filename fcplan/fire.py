@@ -381,44 +381,75 @@ class Fire:
         if k + self.n_fronts > self._visit_queue.size:
             self._flush_visits()
             k = 0
-        if all_moving:  # common case: no gathers, update the positions in place
-            self._visit_queue[k : k + self.n_fronts] = self.cell
-            self._n_visits = k + self.n_fronts
+        # No front can leave the map this tick while the burn box keeps _edge_margin from the
+        # edges (moving fronts stand in burning cells); the box does not change until the
+        # ignitions below.
+        (x0, x1, y0, y1), m, w = self.burn_box, self._edge_margin, self.world_size
+        far = m <= x0 <= x1 and x1 + m < w and m <= y0 and y1 + m < w
+        # Whole-array step: every front, the ones that do not move with a zero spread (C = 0,
+        # so x + (+-0.0) = x: positions are never -0.0). Not for fires over _INTERP_MAX fronts
+        # (C/R's method depends on how many fronts move).
+        masked = not all_moving and ratio is not None
+        if all_moving or masked:  # no gathers: update the positions in place
+            if all_moving:
+                self._visit_queue[k : k + self.n_fronts] = self.cell
+                self._n_visits = k + self.n_fronts
+                fuel_dt = self._m_fuel_dt
+            else:
+                self._visit_queue[k : k + idx.size] = self.cell[idx]
+                self._n_visits = k + idx.size
+                fuel_dt = self._fuel_dt_masked
             xy, sc = self._xy, self._pre_sc[t]
             ratio = _ratio(self._pre_u[t]) if ratio is None else ratio[t]
+            # (dead fronts stand just off the map: clipped terrain reads, multiplied by 0)
+            cells = self._t_stride @ np.rint(xy).astype(np.int64)
+            if all_moving:
+                fuel = self._terrain_flat[cells]
+            else:
+                fuel = self._terrain_flat.take(cells, mode="clip")
+            c = fuel * fuel_dt * ratio
+            # x += C sin(Theta), y += C cos(Theta)
+            xy += np.multiply(sc, c, out=self._move)
         else:
-            np.take(self.cell, idx, out=self._visit_queue[k : k + idx.size])
+            self._visit_queue[k : k + idx.size] = self.cell[idx]
             self._n_visits = k + idx.size
             # gathers through flat indices (1-D takes are much cheaper than 2-D fancy indexing)
             idx2 = self._m_idx2
             xy = self._xy.reshape(-1)[idx2].reshape(2, -1)
             sc = self._pre_sc[t].reshape(-1)[idx2].reshape(2, -1)
             ratio = _ratio(self._pre_u[t][idx]) if ratio is None else ratio[t][idx]
-        fuel = self._terrain_flat[self._t_stride @ np.rint(xy).astype(np.int64)]
-        c = fuel * self._m_fuel_dt * ratio
-        # x += C sin(Theta), y += C cos(Theta)
-        xy += np.multiply(sc, c, out=self._move if all_moving else None)
-        if not all_moving:
+            fuel = self._terrain_flat[self._t_stride @ np.rint(xy).astype(np.int64)]
+            c = fuel * self._m_fuel_dt * ratio
+            xy += np.multiply(sc, c)
             self._xy.reshape(-1)[idx2] = xy.reshape(-1)
-        (x0, x1, y0, y1), m, w = self.burn_box, self._edge_margin, self.world_size
-        if m <= x0 <= x1 and x1 + m < w and m <= y0 and y1 + m < w:
-            inside_all = True  # (see _edge_margin: no front can have left)
+        if far:
+            inside_all = True
         else:
-            # as unsigned integers the bits of non-negative doubles keep their order and every
-            # negative double (and NaN) is larger: all below W's bits means all in [+0, W)
-            inside_all = np.count_nonzero(xy.view(np.uint64) < self._w_bits) == xy.size
+            # As unsigned integers the bits of non-negative doubles keep their order and every
+            # negative double (and NaN) is larger: all below W's bits means all in [+0, W). In
+            # the whole-array step the idle fronts add the same count as when they stopped.
+            inside_all = np.count_nonzero(xy.view(np.uint64) < self._w_bits) == (
+                self._idle_inside + 2 * idx.size if masked else xy.size
+            )
             if not inside_all:
                 ge, lt = xy >= _ZERO, xy < self._w_float
-                inside_all = np.count_nonzero(ge & lt) == xy.size
+                inside = (ge & lt).all(axis=0)
+                if masked:
+                    inside = inside[idx]
+                inside_all = np.count_nonzero(inside) == inside.size
         if inside_all:
             if all_moving:
                 idx = slice(None)
         else:
-            inside = (ge & lt).all(axis=0)
             self.alive[idx[~inside]] = False
             self._moving = None
-            idx, xy = idx[inside], xy[:, inside]
+            if masked:
+                idx = idx[inside]
+            else:
+                idx, xy = idx[inside], xy[:, inside]
         flat = self._stride @ xy.astype(np.int64)  # x w + y, exact on int64 (one call)
+        if masked:
+            flat = flat[idx]
         self.cell[idx] = flat
         # A front that stepped into a pruned cell freezes there (and does not burn it).
         st = self._state_flat[flat]
@@ -476,6 +507,12 @@ class Fire:
         self._all_moving = idx.size == self.n_fronts
         self._m_idx2 = np.concatenate([idx, idx + self.n_fronts])  # rows 0 and 1 of (2, n)
         self._m_fuel_dt = self._fuel[idx] * self.dt
+        fuel_dt = self._fuel * self.dt
+        idle = self.frozen | ~self.alive | ~self.region_active[self.region]
+        fuel_dt[idle] = 0.0
+        self._fuel_dt_masked = fuel_dt  # (n,): 0 for the fronts that do not move
+        # coordinates of the idle fronts inside the map, as the step's check counts them
+        self._idle_inside = int(np.count_nonzero(self._xy[:, idle].view(np.uint64) < self._w_bits))
 
     def prune(self, flat: np.ndarray) -> np.ndarray:
         """Put out burning cells; return the flat indices actually pruned (they were burning).
