@@ -289,7 +289,11 @@ class Team:
             if cmd.route is None:
                 continue
             route = np.asarray(cmd.route, dtype=np.float64).reshape(-1, 2)
-            if not np.isfinite(route).all():
+            if len(route) <= 4:  # (a few goals: the check on Python floats is cheaper)
+                finite = all(map(math.isfinite, route.ravel().tolist()))
+            else:
+                finite = bool(np.isfinite(route).all())
+            if not finite:
                 raise PlanError(f"agent {self.ids[i]}: route has a non-finite coordinate")
             self.routes[i] = route
             self.goal_index[i] = 0
