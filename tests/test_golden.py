@@ -10,7 +10,8 @@ goes into a SHA-256 per name and run, in two forms:
 * ``exact``: the raw little-endian bytes (floats bit for bit). Compared only on the platform the
   golden file was written on (machine, numpy version, AVX-512 dispatch), because libm and SIMD
   builds may round transcendental functions differently in the last bit.
-* ``portable``: floats quantised to 1e-6 (non-finite values as sentinels), integers as int64.
+* ``portable``: floats quantised to 1e-6 (non-finite values as sentinels), integers in their own
+  width (the machinery is in ``tests/golden.py``).
   Compared everywhere.
 
 Regenerate the file only after an intended behaviour change (and say so in the commit)::
@@ -21,9 +22,6 @@ Regenerate the file only after an intended behaviour change (and say so in the c
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
-import platform
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -32,12 +30,16 @@ from unittest import mock
 import numpy as np
 import pytest
 
-import fcplan.episode
-from fcplan import World, load_scenario, run_episode
-from fcplan.belief import Belief
-from fcplan.scheduling import make_scheduler
-from fcplan.taskgraph import build_task_graph
-from fcplan.team import Command
+if __name__ == "__main__":  # (run as a script: make ``tests`` and ``fcplan`` importable)
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import fcplan.episode  # noqa: E402
+from fcplan import World, load_scenario, run_episode  # noqa: E402
+from fcplan.belief import Belief  # noqa: E402
+from fcplan.scheduling import make_scheduler  # noqa: E402
+from fcplan.taskgraph import build_task_graph  # noqa: E402
+from fcplan.team import Command  # noqa: E402
+from tests.golden import Digests, GoldenFile  # noqa: E402
 
 GOLDEN = Path(__file__).parent / "data" / "golden_traces.json"
 
@@ -57,63 +59,6 @@ RUNS += [
     ("manual-24ref-6", "manual-reference", "24", None, 6, None),
     ("manual-scale_example-7", "manual", "scale_example", None, 7, 90.0),
 ]
-
-
-def platform_key() -> str:
-    """Where exact (bit-level) float digests are reproducible."""
-    try:
-        from numpy._core._multiarray_umath import __cpu_features__ as feats
-    except ImportError:  # numpy < 2
-        from numpy.core._multiarray_umath import __cpu_features__ as feats
-    simd = "avx512" if feats.get("AVX512_SKX") else ("avx2" if feats.get("AVX2") else "base")
-    return f"{sys.platform}-{platform.machine()}-numpy{np.__version__}-{simd}"
-
-
-class Digests:
-    """Values collected per named stream, hashed at the end (exact and portable)."""
-
-    def __init__(self) -> None:
-        self.items: dict[str, list] = {}
-
-    def add(self, name: str, value) -> None:
-        """Append one value (array, scalar, tuple of numbers or strings, None) to stream ``name``."""
-        if value is None:
-            value = np.zeros(0, np.int8)
-        elif not (isinstance(value, tuple) and value and isinstance(value[0], str)):
-            value = np.array(value)  # a copy: the caller may change its array later
-        self.items.setdefault(name, []).append(value)
-
-    @staticmethod
-    def _digest(values: list) -> tuple[str, str]:
-        if isinstance(values[0], tuple):
-            h = hashlib.sha256("\x1e".join("\x1f".join(v) for v in values).encode()).hexdigest()
-            return h[:16], h[:16]
-        head = np.array([d for a in values for d in (a.ndim, *a.shape)], dtype="<i8").tobytes()
-        dtypes = ",".join(a.dtype.str for a in values).encode()
-        flat = np.concatenate([a.ravel() for a in values])
-        if flat.dtype.kind == "f":
-            exact = hashlib.sha256(dtypes + head + flat.astype("<f8").tobytes()).hexdigest()
-            fin = np.isfinite(flat)
-            q = np.rint(np.where(fin, flat, 0.0) * 1e6).astype("<i8")
-            q[np.isposinf(flat)] = np.iinfo(np.int64).max
-            q[np.isneginf(flat)] = np.iinfo(np.int64).min
-            q[np.isnan(flat)] = np.iinfo(np.int64).min + 1
-            port = hashlib.sha256(head + q.tobytes()).hexdigest()
-        elif flat.dtype.kind in "iub":
-            # integers in their own width, little-endian (bytes are the same on every platform)
-            data = flat.astype(flat.dtype.newbyteorder("<"), copy=False).tobytes()
-            port = hashlib.sha256(flat.dtype.kind.encode() + head + data).hexdigest()
-            exact = hashlib.sha256(dtypes + port.encode()).hexdigest()
-        else:
-            raise TypeError(f"cannot digest dtype {flat.dtype}")
-        return exact[:16], port[:16]
-
-    def result(self) -> dict[str, dict[str, str]]:
-        """``{"exact": {name: hex}, "portable": {name: hex}}`` (16 hex digits each)."""
-        out: dict[str, dict[str, str]] = {"exact": {}, "portable": {}}
-        for name in sorted(self.items):
-            out["exact"][name], out["portable"][name] = self._digest(self.items[name])
-        return out
 
 
 def digest_info(d: Digests, info) -> None:
@@ -262,38 +207,19 @@ def run_digest(run) -> dict[str, dict[str, str]]:
     return d.result()
 
 
-def _load() -> dict:
-    return json.loads(GOLDEN.read_text())
+GOLDEN_FILE = GoldenFile(GOLDEN, RUNS, run_digest)
 
 
 @pytest.mark.parametrize("run", RUNS, ids=[r[0] for r in RUNS])
 def test_golden_trace(run):
     """A run reproduces the recorded digests of every trace, step, belief and graph array."""
-    golden = _load()
-    want = golden["runs"][run[0]]
-    got = run_digest(run)
-    kinds = ["portable"] + (["exact"] if golden["platform"] == platform_key() else [])
-    for kind in kinds:
-        bad = sorted(k for k in want[kind] if got[kind].get(k) != want[kind][k])
-        extra = sorted(set(got[kind]) - set(want[kind]))
-        assert not bad and not extra, f"{run[0]}: {kind} digests differ for {bad + extra}"
+    GOLDEN_FILE.check(run)
 
 
 def test_golden_file_covers_every_run():
     """The golden file holds exactly the runs this module plays."""
-    assert sorted(_load()["runs"]) == sorted(r[0] for r in RUNS)
-
-
-def regenerate() -> None:
-    """Write the golden file from the current code."""
-    out = {"platform": platform_key(), "runs": {r[0]: run_digest(r) for r in RUNS}}
-    GOLDEN.parent.mkdir(parents=True, exist_ok=True)
-    GOLDEN.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
-    print(f"wrote {GOLDEN} ({len(RUNS)} runs, platform {out['platform']})")
+    GOLDEN_FILE.check_covers_runs()
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] == ["--regenerate"]:
-        regenerate()
-    else:
-        sys.exit("usage: python tests/test_golden.py --regenerate")
+    GOLDEN_FILE.main(sys.argv[1:], "tests/test_golden.py")

@@ -22,7 +22,6 @@ Regenerate the file only after an intended behaviour change (and say so in the c
 from __future__ import annotations
 
 import hashlib
-import json
 import sys
 from pathlib import Path
 
@@ -35,7 +34,7 @@ if __name__ == "__main__":  # (run as a script: make ``tests`` and ``fcplan`` im
 
 from fcplan.env.motion import MotionEnv, parallel_env  # noqa: E402
 from tests.conftest import scenario_with  # noqa: E402
-from tests.test_golden import platform_key  # noqa: E402
+from tests.golden import GoldenFile  # noqa: E402
 
 GOLDEN = ROOT / "tests" / "data" / "golden_motion_env.json"
 
@@ -213,39 +212,20 @@ def run_digest(run) -> dict[str, dict[str, str]]:
     return d.result()
 
 
-def _load() -> dict:
-    return json.loads(GOLDEN.read_text())
+GOLDEN_FILE = GoldenFile(GOLDEN, RUNS, run_digest)
 
 
 @pytest.mark.parametrize("run", RUNS, ids=[r[0] for r in RUNS])
 def test_motion_env_golden(run):
     """A run reproduces the recorded digests of every observation, state, reward, flag and info
     of every step."""
-    golden = _load()
-    want = golden["runs"][run[0]]
-    got = run_digest(run)
-    kinds = ["portable"] + (["exact"] if golden["platform"] == platform_key() else [])
-    for kind in kinds:
-        bad = sorted(k for k in want[kind] if got[kind].get(k) != want[kind][k])
-        extra = sorted(set(got[kind]) - set(want[kind]))
-        assert not bad and not extra, f"{run[0]}: {kind} digests differ for {bad + extra}"
+    GOLDEN_FILE.check(run)
 
 
 def test_motion_golden_file_covers_every_run():
     """The golden file holds exactly the runs this module plays."""
-    assert sorted(_load()["runs"]) == sorted(r[0] for r in RUNS)
-
-
-def regenerate() -> None:
-    """Write the golden file from the current code (only after an intended behaviour change)."""
-    out = {"platform": platform_key(), "runs": {r[0]: run_digest(r) for r in RUNS}}
-    GOLDEN.parent.mkdir(parents=True, exist_ok=True)
-    GOLDEN.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
-    print(f"wrote {GOLDEN} ({len(RUNS)} runs, platform {out['platform']})")
+    GOLDEN_FILE.check_covers_runs()
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] == ["--regenerate"]:
-        regenerate()
-    else:
-        sys.exit("usage: python tests/env/test_motion_env_golden.py --regenerate")
+    GOLDEN_FILE.main(sys.argv[1:], "tests/env/test_motion_env_golden.py")
