@@ -237,6 +237,18 @@ class World:
         rows = {k: v[: self.tick].copy() for k, v in self._rows.items()}
         return Trace.from_rows(self.scenario, rows, self.team.ids)
 
+    def trace_sum(self, name: str, start: int, stop: int) -> np.ndarray:
+        """Sum over ticks ``start + 1 .. stop`` (trace rows ``start:stop``) of one trace array
+        (a name of :meth:`trace`'s rows, e.g. ``"active"``, ``"facility_burning"``), read in
+        place without copying the trace.
+
+        Returns
+        -------
+        ndarray
+            The array's row dtype and shape without the tick axis (zeros for an empty range).
+        """
+        return self._rows[name][start:stop].sum(axis=0)
+
     def ignite(self, xy) -> np.ndarray:
         """Set cells burning by hand (spot fires, tests); return the flat indices that ignited.
 
