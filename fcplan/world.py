@@ -49,6 +49,7 @@ __all__ = ["World", "StepInfo"]
 _EMPTY = np.zeros(0, dtype=np.int64)
 _EMPTY16 = np.zeros(0, dtype=np.int16)
 _ZERO16 = np.int16(0)
+_NO_OFFSETS = np.zeros((0, 0), dtype=np.int64)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -184,6 +185,7 @@ class World:
         self._can_act = self.team.can_act.tolist()
         self.sensed = np.zeros((w, w), dtype=bool)
         self._sensed_flat = self.sensed.reshape(-1)
+        self._box_offsets = _NO_OFFSETS  # (see _cells)
         facilities = scenario.scored_facilities
         self.facility_labels = np.full((w, w), -1, dtype=np.int16)
         for f, fac in enumerate(facilities):
@@ -324,14 +326,11 @@ class World:
             if box is None:
                 continue
             x0, x1, y0, y1 = box
-            bx, by = (state[x0:x1, y0:y1] == _BURNING8).nonzero()
-            if bx.size == 0:
+            flat = self._cells(state[x0:x1, y0:y1] == _BURNING8, x0, y0)
+            if flat.size == 0:
                 continue
-            keep = self.rng_sense.random(bx.size) < team._sensing_confidence_of(i)
+            keep = self.rng_sense.random(flat.size) < team._sensing_confidence_of(i)
             if np.count_nonzero(keep):
-                flat = bx * w  # (x0 + bx) w + (y0 + by), exact on int64, in place
-                flat += by
-                flat += x0 * w + y0
                 parts.append(flat[keep])
         if not parts:
             return _EMPTY, _EMPTY
@@ -344,6 +343,27 @@ class World:
         self.n_sensed_active += int(newly.size)
         self.n_sensed_ever += int(newly.size)
         return sensed, newly
+
+    def _cells(self, mask: np.ndarray, x0: int, y0: int) -> np.ndarray:
+        """(k,) int64 flat indices ``(x0 + i) W + y0 + j`` of the true cells ``(i, j)`` of a 2-D
+        bool ``mask`` over the cell box starting at ``(x0, y0)``, row-major (the order of
+        ``mask.nonzero()``).
+
+        One boolean selection from a cached grid of in-box offsets ``i W + j`` (grown on demand
+        to the largest box seen), then one add: far cheaper than the 2-D ``nonzero`` and the
+        arithmetic on its two index arrays.
+        """
+        h, bw = mask.shape
+        off = self._box_offsets
+        if h > off.shape[0] or bw > off.shape[1]:
+            h_max, bw_max = max(h, off.shape[0]), max(bw, off.shape[1])
+            off = np.arange(h_max, dtype=np.int64)[:, None] * self.world_size
+            off = off + np.arange(bw_max, dtype=np.int64)
+            off.flags.writeable = False
+            self._box_offsets = off
+        flat = off[:h, :bw][mask]
+        flat += x0 * self.world_size + y0
+        return flat
 
     def _prune(self, rects: list) -> tuple[np.ndarray, list[int]]:
         team, w = self.team, self.world_size
@@ -383,9 +403,9 @@ class World:
                 if not seen.any():
                     continue
                 cand = seen
-            bx, by = cand.nonzero()
-            keep = self.rng_prune.random(bx.size) < team.prune_confidence[i]
-            flat = (bx[keep] + x0) * w + (by[keep] + y0)
+            flat = self._cells(cand, x0, y0)
+            keep = self.rng_prune.random(flat.size) < team.prune_confidence[i]
+            flat = flat[keep]
             hit = self.fire.prune(flat)
             if hit.size:
                 counts = self._count_facilities(hit, -1)

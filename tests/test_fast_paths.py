@@ -1,8 +1,9 @@
 """Tests for the speed paths of fcplan.team, fcplan.fire and fcplan.world: the small-team Python
 path of ``Team.move`` gives bit-identical states to the numpy path, the fire's ``burn_box`` always
 holds every burning cell, queued front visits add up to the same grid, the world's field-of-view
-scan box is the one of the plain two-step computation, and ``World.step``'s StepInfo builder
-gives the dataclass's own instance."""
+scan box is the one of the plain two-step computation, its box cells (from a grid of offsets)
+are the flat indices of the mask's ``nonzero``, and ``World.step``'s StepInfo builder gives the
+dataclass's own instance."""
 
 from __future__ import annotations
 
@@ -183,3 +184,31 @@ def test_step_info_builder_gives_the_dataclass_instance(scenario):
         fast.tick = 8  # type: ignore[misc]
     info = world.step()
     assert isinstance(info, StepInfo) and info.tick == 31 and info.fov.shape == (4, 4)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    shapes=st.lists(st.tuples(st.integers(1, 40), st.integers(1, 40)), min_size=1, max_size=6),
+    seed=st.integers(0, 2**32 - 1),
+    density=st.sampled_from([0.0, 0.02, 0.3, 1.0]),
+)
+def test_box_cells_are_the_flat_indices_of_the_masks_nonzero(scenario, shapes, seed, density):
+    """World._cells(mask, x0, y0) is ``(x0 + i) W + (y0 + j)`` over ``mask.nonzero()`` (same
+    values, same order, int64) for boxes of any shape in any order (the offset grid grows and is
+    then sliced), and the cached offsets are never changed by a call."""
+    world = World().reset(scenario, seed=0)
+    w = world.world_size
+    rng = np.random.default_rng(seed)
+    for h, bw in shapes:
+        mask = rng.random((h, bw)) < density
+        x0, y0 = int(rng.integers(0, w - h + 1)), int(rng.integers(0, w - bw + 1))
+        before = world._box_offsets.copy()
+        got = world._cells(mask, x0, y0)
+        i, j = mask.nonzero()
+        assert got.dtype == np.int64
+        np.testing.assert_array_equal(got, (x0 + i) * w + (y0 + j))
+        off = world._box_offsets
+        np.testing.assert_array_equal(off[: before.shape[0], : before.shape[1]], before)
+        np.testing.assert_array_equal(
+            off, np.add.outer(np.arange(off.shape[0]) * w, np.arange(off.shape[1]))
+        )
