@@ -274,7 +274,8 @@ class World:
         if self.scenario is None:
             raise ValueError("World.step before World.reset")
         team, fire = self.team, self.fire
-        team.apply(commands)
+        if commands:  # (Team.apply does nothing without commands: the call is saved)
+            team.apply(commands)
         arrived = team.move()
         self.tick += 1
         ignited = fire.step()
@@ -395,12 +396,14 @@ class World:
             x0, x1, y0, y1 = box
             burning = state[x0:x1, y0:y1] == _BURNING8
             seen = burning & sensed[x0:x1, y0:y1]
+            # (np.count_nonzero: the cheapest "any" on these small masks)
             if reference_gate:
-                if not (seen.any() or self.n_sensed_active == 0) or not burning.any():
+                some_seen = self.n_sensed_active == 0 or np.count_nonzero(seen)
+                if not some_seen or not np.count_nonzero(burning):
                     continue
                 cand = burning
             else:
-                if not seen.any():
+                if not np.count_nonzero(seen):
                     continue
                 cand = seen
             flat = self._cells(cand, x0, y0)
@@ -411,7 +414,7 @@ class World:
                 counts = self._count_facilities(hit, -1)
                 if counts.size:
                     self.facility_pruned += counts
-                self.n_sensed_active -= int(self._sensed_flat[hit].sum())
+                self.n_sensed_active -= int(np.count_nonzero(self._sensed_flat[hit]))
                 parts.append(hit)
             team.record_dump(i)
             dumped.append(i)
