@@ -277,23 +277,27 @@ class World:
         if commands:  # (Team.apply does nothing without commands: the call is saved)
             team.apply(commands)
         arrived = team.move()
-        self.tick += 1
+        self.tick = tick = self.tick + 1
         ignited = fire.step()
         if ignited.size:
             self._count_facilities(ignited, +1)
         rects = team.fov_rects_list()
         sensed, newly = self._sense(rects)
-        pruned, dumped = self._prune(rects)
-        self._record()
+        if True in team.armed.tolist():  # (else _prune finds no dump: the call is saved)
+            pruned, dumped = self._prune(rects)
+            dumped = tuple(dumped)
+        else:
+            pruned, dumped = _EMPTY, ()
+        self._record(tick - 1)
         return _step_info(  # StepInfo(...), cheaper
-            self.tick,  # tick
-            self.tick / self._tps,  # time_s
+            tick,
+            tick / self._tps,  # time_s
             ignited,
             sensed,
             newly,  # newly_sensed
             pruned,
             rects,  # fov_rects
-            tuple(dumped) if dumped else (),
+            dumped,
             tuple(arrived.tolist()) if arrived.size else (),  # arrived
         )
 
@@ -441,8 +445,8 @@ class World:
             r["dumps"],
         )
 
-    def _record(self) -> None:
-        k = self.tick - 1
+    def _record(self, k: int) -> None:
+        """Write trace row ``k`` (tick ``k + 1``), growing the trace if needed."""
         if k >= self._row_views[0]:
             rows = self._rows
             for name, arr in rows.items():
