@@ -157,7 +157,8 @@ class World:
         Cells sensed at least once.
     facility_burning, facility_pruned : ndarray, (F,) int64
         Per scored facility (houses, hospitals, power stations, depot last): burning cells inside
-        its footprint, and cumulative pruned cells inside it.
+        its footprint, and cumulative pruned cells inside it. Read only: the world changes them
+        (the trace copies them lazily, from the last change on).
     """
 
     def __init__(self, scenario=None, seed=None) -> None:
@@ -221,6 +222,8 @@ class World:
             "mode": np.zeros((rows, n), np.int8),
             "dumps": np.zeros((rows, n), np.int16),
         }
+        self._n_recorded = 0  # trace rows recorded (ticks stepped since the reset)
+        self._fac_rows = 0  # facility trace rows written so far (see _sync_facility_rows)
         self._record_views()
 
     # ------------------------------------------------------------------ queries
@@ -236,6 +239,7 @@ class World:
 
     def trace(self) -> Trace:
         """The per-tick record so far (copies), ready for :func:`fcplan.metrics.compute_metrics`."""
+        self._sync_facility_rows()
         rows = {k: v[: self.tick].copy() for k, v in self._rows.items()}
         return Trace.from_rows(self.scenario, rows, self.team.ids)
 
@@ -249,6 +253,7 @@ class World:
         ndarray
             The array's row dtype and shape without the tick axis (zeros for an empty range).
         """
+        self._sync_facility_rows()
         return self._rows[name][start:stop].sum(axis=0)
 
     def ignite(self, xy) -> np.ndarray:
@@ -310,6 +315,7 @@ class World:
             return _EMPTY16
         lab = lab[inside]
         counts = np.bincount(lab, minlength=self.n_facilities)
+        self._sync_facility_rows()  # (the rows so far hold the counts before this change)
         self.facility_burning += sign * counts
         return counts
 
@@ -415,7 +421,7 @@ class World:
             flat = flat[keep]
             hit = self.fire.prune(flat)
             if hit.size:
-                counts = self._count_facilities(hit, -1)
+                counts = self._count_facilities(hit, -1)  # (syncs the facility rows first)
                 if counts.size:
                     self.facility_pruned += counts
                 self.n_sensed_active -= int(np.count_nonzero(self._sensed_flat[hit]))
@@ -435,8 +441,6 @@ class World:
             r["pruned"],
             r["sensed_active"],
             r["sensed_ever"],
-            r["facility_burning"],
-            r["facility_pruned"],
             r["xyz"][:, :, :2],
             r["xyz"][:, :, 2],
             r["battery"],
@@ -445,29 +449,43 @@ class World:
             r["dumps"],
         )
 
+    def _sync_facility_rows(self) -> None:
+        """Write the facility trace rows left unwritten by :meth:`_record`.
+
+        The facility counts change rarely (fire inside a footprint), so :meth:`_record` does not
+        copy them every tick: the recorded rows from ``_fac_rows`` on all hold the current
+        ``facility_burning`` and ``facility_pruned``. This fills them, and must run before those
+        arrays change (:meth:`_count_facilities`, which every change goes through first) and
+        before the trace rows are read (:meth:`trace`, :meth:`trace_sum`).
+        """
+        k0, k1 = self._fac_rows, self._n_recorded
+        if k1 > k0:
+            rows = self._rows
+            rows["facility_burning"][k0:k1] = self.facility_burning
+            rows["facility_pruned"][k0:k1] = self.facility_pruned
+            self._fac_rows = k1
+
     def _record(self, k: int) -> None:
-        """Write trace row ``k`` (tick ``k + 1``), growing the trace if needed."""
+        """Write trace row ``k`` (tick ``k + 1``), growing the trace if needed (the facility
+        rows are written later, by :meth:`_sync_facility_rows`)."""
         if k >= self._row_views[0]:
             rows = self._rows
             for name, arr in rows.items():
                 rows[name] = np.concatenate([arr, np.zeros_like(arr)])
             self._record_views()
-        _, active, pruned, s_active, s_ever, f_burning, f_pruned, xy, z, bat, tank, mode, dumps = (
-            self._row_views
-        )
+        _, active, pruned, s_active, s_ever, xy, z, bat, tank, mode, dumps = self._row_views
         team, fire = self.team, self.fire
         active[k] = fire.n_burning
         pruned[k] = fire.n_pruned
         s_active[k] = self.n_sensed_active
         s_ever[k] = self.n_sensed_ever
-        f_burning[k] = self.facility_burning
-        f_pruned[k] = self.facility_pruned
         xy[k] = team.pos
         z[k] = team.z
         bat[k] = team.battery
         tank[k] = team.tank
         mode[k] = team.mode
         dumps[k] = team.dumps
+        self._n_recorded = k + 1
 
 
 def _spawn(seed, n: int) -> list[np.random.Generator]:
