@@ -433,7 +433,8 @@ class World:
         return (parts[0] if len(parts) == 1 else np.concatenate(parts)), dumped
 
     def _record_views(self) -> None:
-        """Cache the trace arrays (and the xy and z parts of ``xyz``) for :meth:`_record`."""
+        """Cache the trace arrays :meth:`_record` writes every tick (the xy and z parts of ``xyz``
+        apart; not the facility rows, see :meth:`_sync_facility_rows`)."""
         r = self._rows
         self._row_views = (
             len(r["active"]),
