@@ -33,6 +33,7 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -48,6 +49,7 @@ __all__ = ["World", "StepInfo"]
 _EMPTY = np.zeros(0, dtype=np.int64)
 _EMPTY16 = np.zeros(0, dtype=np.int16)
 _ZERO16 = np.int16(0)
+_NO_OFFSETS = np.zeros((0, 0), dtype=np.int64)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -71,39 +73,70 @@ class StepInfo:
         return np.array(self.fov_rects, dtype=np.float64).reshape(-1, 4)
 
 
-def _cell_range(rect: list[float], w: int) -> tuple[int, int, int, int] | None:
-    """Cell range ``(x0, x1, y0, y1)`` (end-exclusive) covered by an inclusive rectangle
-    ``[x0, x1, y0, y1]`` of Python floats, clipped to the map, or None."""
-    x0 = max(math.ceil(rect[0]), 0)
-    x1 = min(math.floor(rect[1]), w - 1)
-    y0 = max(math.ceil(rect[2]), 0)
-    y1 = min(math.floor(rect[3]), w - 1)
+def _info_builder():
+    """A function building a :class:`StepInfo` from its fields in order, like ``StepInfo(...)``
+    at half the cost: the frozen dataclass's ``__init__`` goes through ``object.__setattr__`` per
+    field, this sets the slots through their descriptors (no ``__post_init__`` to run)."""
+    new = object.__new__
+    (s_tick, s_time, s_ign, s_sensed, s_newly, s_pruned, s_fov, s_dumped, s_arrived) = (
+        getattr(StepInfo, f.name).__set__ for f in dataclasses.fields(StepInfo)
+    )
+
+    def build(tick, time_s, ignited, sensed, newly, pruned, fov_rects, dumped, arrived):
+        info = new(StepInfo)
+        s_tick(info, tick)
+        s_time(info, time_s)
+        s_ign(info, ignited)
+        s_sensed(info, sensed)
+        s_newly(info, newly)
+        s_pruned(info, pruned)
+        s_fov(info, fov_rects)
+        s_dumped(info, dumped)
+        s_arrived(info, arrived)
+        return info
+
+    return build
+
+
+_step_info = _info_builder()
+
+
+def _scan_box(rect: list[float], blocks: np.ndarray, w: int) -> tuple[int, int, int, int] | None:
+    """The part of the field of view ``rect`` (inclusive ``[x0, x1, y0, y1]`` of Python floats)
+    that can hold burning cells, as an end-exclusive cell range ``(x0, x1, y0, y1)``, or None.
+
+    The range is that of the cells covered by ``rect``, clipped to the ``w x w`` map, then shrunk
+    to the bounding box of its ``BLOCK``-sized blocks that hold a burning cell (``blocks``: the
+    fire's per-block counts). Every burning cell of the covered range lies in the box, so scanning
+    the box row-major finds the same cells in the same order as scanning the whole range. None
+    when the range is empty or holds no burning block.
+    """
+    # (conditional expressions: cheaper than max()/min() calls on this per-tick path)
+    a = math.ceil(rect[0])
+    x0 = a if a > 0 else 0
+    a = math.floor(rect[1])
+    x1 = a if a < w - 1 else w - 1
+    a = math.ceil(rect[2])
+    y0 = a if a > 0 else 0
+    a = math.floor(rect[3])
+    y1 = a if a < w - 1 else w - 1
     if x1 < x0 or y1 < y0:
         return None
-    return x0, x1 + 1, y0, y1 + 1
-
-
-def _burning_box(
-    blocks: np.ndarray, x0: int, x1: int, y0: int, y1: int
-) -> tuple[int, int, int, int] | None:
-    """The part of the cell range ``[x0, x1) x [y0, y1)`` that can hold burning cells (the
-    bounding box of its ``BLOCK``-sized blocks that hold one), or None if none does.
-
-    Every burning cell of the range lies in the box, so scanning the box row-major finds the same
-    cells in the same order as scanning the whole range.
-    """
     i0, j0 = x0 // BLOCK, y0 // BLOCK
-    b = blocks[i0 : (x1 - 1) // BLOCK + 1, j0 : (y1 - 1) // BLOCK + 1]
+    b = blocks[i0 : x1 // BLOCK + 1, j0 : y1 // BLOCK + 1]
     if not np.count_nonzero(b):
         return None
-    bi, bj = np.nonzero(b)
+    bi, bj = b.nonzero()  # (the method: cheaper than np.nonzero's dispatch)
     bj = bj.tolist()
-    return (
-        max(x0, (i0 + int(bi[0])) * BLOCK),
-        min(x1, (i0 + int(bi[-1]) + 1) * BLOCK),
-        max(y0, (j0 + min(bj)) * BLOCK),
-        min(y1, (j0 + max(bj) + 1) * BLOCK),
-    )
+    a = (i0 + int(bi[0])) * BLOCK
+    x0 = a if a > x0 else x0
+    a = (i0 + int(bi[-1]) + 1) * BLOCK
+    x1 = a if a <= x1 else x1 + 1
+    a = (j0 + min(bj)) * BLOCK
+    y0 = a if a > y0 else y0
+    a = (j0 + max(bj) + 1) * BLOCK
+    y1 = a if a <= y1 else y1 + 1
+    return x0, x1, y0, y1
 
 
 class World:
@@ -124,7 +157,8 @@ class World:
         Cells sensed at least once.
     facility_burning, facility_pruned : ndarray, (F,) int64
         Per scored facility (houses, hospitals, power stations, depot last): burning cells inside
-        its footprint, and cumulative pruned cells inside it.
+        its footprint, and cumulative pruned cells inside it. Read only: the world changes them
+        (the trace copies them lazily, from the last change on).
     """
 
     def __init__(self, scenario=None, seed=None) -> None:
@@ -152,6 +186,7 @@ class World:
         self._can_act = self.team.can_act.tolist()
         self.sensed = np.zeros((w, w), dtype=bool)
         self._sensed_flat = self.sensed.reshape(-1)
+        self._box_offsets = _NO_OFFSETS  # (see _cells)
         facilities = scenario.scored_facilities
         self.facility_labels = np.full((w, w), -1, dtype=np.int16)
         for f, fac in enumerate(facilities):
@@ -187,6 +222,8 @@ class World:
             "mode": np.zeros((rows, n), np.int8),
             "dumps": np.zeros((rows, n), np.int16),
         }
+        self._n_recorded = 0  # trace rows recorded (ticks stepped since the reset)
+        self._fac_rows = 0  # facility trace rows written so far (see _sync_facility_rows)
         self._record_views()
 
     # ------------------------------------------------------------------ queries
@@ -202,8 +239,22 @@ class World:
 
     def trace(self) -> Trace:
         """The per-tick record so far (copies), ready for :func:`fcplan.metrics.compute_metrics`."""
+        self._sync_facility_rows()
         rows = {k: v[: self.tick].copy() for k, v in self._rows.items()}
         return Trace.from_rows(self.scenario, rows, self.team.ids)
+
+    def trace_sum(self, name: str, start: int, stop: int) -> np.ndarray:
+        """Sum over ticks ``start + 1 .. stop`` (trace rows ``start:stop``) of one trace array
+        (a name of :meth:`trace`'s rows, e.g. ``"active"``, ``"facility_burning"``), read in
+        place without copying the trace.
+
+        Returns
+        -------
+        ndarray
+            The array's row dtype and shape without the tick axis (zeros for an empty range).
+        """
+        self._sync_facility_rows()
+        return self._rows[name][start:stop].sum(axis=0)
 
     def ignite(self, xy) -> np.ndarray:
         """Set cells burning by hand (spot fires, tests); return the flat indices that ignited.
@@ -228,26 +279,31 @@ class World:
         if self.scenario is None:
             raise ValueError("World.step before World.reset")
         team, fire = self.team, self.fire
-        team.apply(commands)
+        if commands:  # (Team.apply does nothing without commands: the call is saved)
+            team.apply(commands)
         arrived = team.move()
-        self.tick += 1
+        self.tick = tick = self.tick + 1
         ignited = fire.step()
         if ignited.size:
             self._count_facilities(ignited, +1)
         rects = team.fov_rects_list()
         sensed, newly = self._sense(rects)
-        pruned, dumped = self._prune(rects)
-        self._record()
-        return StepInfo(  # (positional: cheaper than keywords on this per-tick path)
-            self.tick,  # tick
-            self.tick / self._tps,  # time_s
+        if True in team.armed.tolist():  # (else _prune finds no dump: the call is saved)
+            pruned, dumped = self._prune(rects)
+            dumped = tuple(dumped)
+        else:
+            pruned, dumped = _EMPTY, ()
+        self._record(tick - 1)
+        return _step_info(  # StepInfo(...), cheaper
+            tick,
+            tick / self._tps,  # time_s
             ignited,
             sensed,
             newly,  # newly_sensed
             pruned,
             rects,  # fov_rects
-            tuple(dumped),
-            tuple(arrived.tolist()),  # arrived
+            dumped,
+            tuple(arrived.tolist()) if arrived.size else (),  # arrived
         )
 
     def _count_facilities(self, flat: np.ndarray, sign: int) -> np.ndarray:
@@ -259,6 +315,7 @@ class World:
             return _EMPTY16
         lab = lab[inside]
         counts = np.bincount(lab, minlength=self.n_facilities)
+        self._sync_facility_rows()  # (the rows so far hold the counts before this change)
         self.facility_burning += sign * counts
         return counts
 
@@ -276,28 +333,48 @@ class World:
             # scan below would find none and draw nothing
             if r[1] < bx0 or r[0] > bx1 or r[3] < by0 or r[2] > by1:
                 continue
-            sl = _cell_range(r, w)
-            if sl is None:
-                continue
-            box = _burning_box(blocks, *sl)
+            box = _scan_box(r, blocks, w)
             if box is None:
                 continue
             x0, x1, y0, y1 = box
-            bx, by = np.nonzero(state[x0:x1, y0:y1] == _BURNING8)
-            if bx.size == 0:
+            flat = self._cells(state[x0:x1, y0:y1] == _BURNING8, x0, y0)
+            if flat.size == 0:
                 continue
-            keep = self.rng_sense.random(bx.size) < team._sensing_confidence_of(i)
+            keep = self.rng_sense.random(flat.size) < team._sensing_confidence_of(i)
             if np.count_nonzero(keep):
-                parts.append(((bx + x0) * w + (by + y0))[keep])
+                parts.append(flat[keep])
         if not parts:
             return _EMPTY, _EMPTY
         sensed = parts[0] if len(parts) == 1 else _unique(np.concatenate(parts))
-        newly = sensed[~self._sensed_flat[sensed]]
-        if newly.size:
-            self._sensed_flat[newly] = True
-            self.n_sensed_active += int(newly.size)
-            self.n_sensed_ever += int(newly.size)
+        seen = self._sensed_flat[sensed]
+        if np.count_nonzero(seen) == seen.size:  # (usual: every cell sensed before)
+            return sensed, _EMPTY
+        newly = sensed[~seen]
+        self._sensed_flat[newly] = True
+        self.n_sensed_active += int(newly.size)
+        self.n_sensed_ever += int(newly.size)
         return sensed, newly
+
+    def _cells(self, mask: np.ndarray, x0: int, y0: int) -> np.ndarray:
+        """(k,) int64 flat indices ``(x0 + i) W + y0 + j`` of the true cells ``(i, j)`` of a 2-D
+        bool ``mask`` over the cell box starting at ``(x0, y0)``, row-major (the order of
+        ``mask.nonzero()``).
+
+        One boolean selection from a cached grid of in-box offsets ``i W + j`` (grown on demand
+        to the largest box seen), then one add: far cheaper than the 2-D ``nonzero`` and the
+        arithmetic on its two index arrays.
+        """
+        h, bw = mask.shape
+        off = self._box_offsets
+        if h > off.shape[0] or bw > off.shape[1]:
+            h_max, bw_max = max(h, off.shape[0]), max(bw, off.shape[1])
+            off = np.arange(h_max, dtype=np.int64)[:, None] * self.world_size
+            off = off + np.arange(bw_max, dtype=np.int64)
+            off.flags.writeable = False
+            self._box_offsets = off
+        flat = off[:h, :bw][mask]
+        flat += x0 * self.world_size + y0
+        return flat
 
     def _prune(self, rects: list) -> tuple[np.ndarray, list[int]]:
         team, w = self.team, self.world_size
@@ -323,32 +400,31 @@ class World:
         state, sensed, blocks = fire.state, self.sensed, fire.block_burning
         parts, dumped = [], []
         for i in rows:
-            sl = _cell_range(rects[i], w)
-            if sl is None:
-                continue
-            box = _burning_box(blocks, *sl)
+            box = _scan_box(rects[i], blocks, w)
             if box is None:
                 continue
             x0, x1, y0, y1 = box
             burning = state[x0:x1, y0:y1] == _BURNING8
             seen = burning & sensed[x0:x1, y0:y1]
+            # (np.count_nonzero: the cheapest "any" on these small masks)
             if reference_gate:
-                if not (seen.any() or self.n_sensed_active == 0) or not burning.any():
+                some_seen = self.n_sensed_active == 0 or np.count_nonzero(seen)
+                if not some_seen or not np.count_nonzero(burning):
                     continue
                 cand = burning
             else:
-                if not seen.any():
+                if not np.count_nonzero(seen):
                     continue
                 cand = seen
-            bx, by = np.nonzero(cand)
-            keep = self.rng_prune.random(bx.size) < team.prune_confidence[i]
-            flat = (bx[keep] + x0) * w + (by[keep] + y0)
+            flat = self._cells(cand, x0, y0)
+            keep = self.rng_prune.random(flat.size) < team.prune_confidence[i]
+            flat = flat[keep]
             hit = self.fire.prune(flat)
             if hit.size:
-                counts = self._count_facilities(hit, -1)
+                counts = self._count_facilities(hit, -1)  # (syncs the facility rows first)
                 if counts.size:
                     self.facility_pruned += counts
-                self.n_sensed_active -= int(self._sensed_flat[hit].sum())
+                self.n_sensed_active -= int(np.count_nonzero(self._sensed_flat[hit]))
                 parts.append(hit)
             team.record_dump(i)
             dumped.append(i)
@@ -357,7 +433,8 @@ class World:
         return (parts[0] if len(parts) == 1 else np.concatenate(parts)), dumped
 
     def _record_views(self) -> None:
-        """Cache the trace arrays (and the xy and z parts of ``xyz``) for :meth:`_record`."""
+        """Cache the trace arrays :meth:`_record` writes every tick (the xy and z parts of ``xyz``
+        apart; not the facility rows, see :meth:`_sync_facility_rows`)."""
         r = self._rows
         self._row_views = (
             len(r["active"]),
@@ -365,8 +442,6 @@ class World:
             r["pruned"],
             r["sensed_active"],
             r["sensed_ever"],
-            r["facility_burning"],
-            r["facility_pruned"],
             r["xyz"][:, :, :2],
             r["xyz"][:, :, 2],
             r["battery"],
@@ -375,29 +450,43 @@ class World:
             r["dumps"],
         )
 
-    def _record(self) -> None:
-        k = self.tick - 1
+    def _sync_facility_rows(self) -> None:
+        """Write the facility trace rows left unwritten by :meth:`_record`.
+
+        The facility counts change rarely (fire inside a footprint), so :meth:`_record` does not
+        copy them every tick: the recorded rows from ``_fac_rows`` on all hold the current
+        ``facility_burning`` and ``facility_pruned``. This fills them, and must run before those
+        arrays change (:meth:`_count_facilities`, which every change goes through first) and
+        before the trace rows are read (:meth:`trace`, :meth:`trace_sum`).
+        """
+        k0, k1 = self._fac_rows, self._n_recorded
+        if k1 > k0:
+            rows = self._rows
+            rows["facility_burning"][k0:k1] = self.facility_burning
+            rows["facility_pruned"][k0:k1] = self.facility_pruned
+            self._fac_rows = k1
+
+    def _record(self, k: int) -> None:
+        """Write trace row ``k`` (tick ``k + 1``), growing the trace if needed (the facility
+        rows are written later, by :meth:`_sync_facility_rows`)."""
         if k >= self._row_views[0]:
             rows = self._rows
             for name, arr in rows.items():
                 rows[name] = np.concatenate([arr, np.zeros_like(arr)])
             self._record_views()
-        _, active, pruned, s_active, s_ever, f_burning, f_pruned, xy, z, bat, tank, mode, dumps = (
-            self._row_views
-        )
+        _, active, pruned, s_active, s_ever, xy, z, bat, tank, mode, dumps = self._row_views
         team, fire = self.team, self.fire
         active[k] = fire.n_burning
         pruned[k] = fire.n_pruned
         s_active[k] = self.n_sensed_active
         s_ever[k] = self.n_sensed_ever
-        f_burning[k] = self.facility_burning
-        f_pruned[k] = self.facility_pruned
         xy[k] = team.pos
         z[k] = team.z
         bat[k] = team.battery
         tank[k] = team.tank
         mode[k] = team.mode
         dumps[k] = team.dumps
+        self._n_recorded = k + 1
 
 
 def _spawn(seed, n: int) -> list[np.random.Generator]:

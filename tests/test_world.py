@@ -128,6 +128,62 @@ def test_facility_counts_follow_ignition_and_pruning():
     assert world2.facility_pruned[0] == info.pruned.size > 0
 
 
+@settings(max_examples=10, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    events=st.lists(
+        st.tuples(st.integers(0, 59), st.sampled_from(["ignite", "dump", "trace", "sum"])),
+        max_size=12,
+    ),
+)
+def test_facility_trace_rows_are_the_counts_after_every_tick(seed, events):
+    """The trace's facility rows (written lazily, from the last change of the counts on) hold,
+    for every tick, facility_burning and facility_pruned as they were after that tick: through
+    hand ignitions inside footprints between ticks, dumps over a facility during ticks, and the
+    trace read (trace(), trace_sum) at any tick in between."""
+    sc = scenario_with(1, **QUIET)
+    world = World().reset(sc, seed=seed)
+    rng = np.random.default_rng(seed)
+    fac = [f.footprint for f in sc.scored_facilities[:3]]
+    burning, pruned = [], []
+    for t in range(60):
+        for when, what in events:
+            if when != t:
+                continue
+            x0, x1, y0, y1 = fac[int(rng.integers(len(fac)))]
+            cx, cy = (
+                int(rng.integers(int(x0) + 1, int(x1))),
+                int(rng.integers(int(y0) + 1, int(y1))),
+            )
+            if what == "ignite":
+                world.ignite(block(cx, cy, 3, 2))
+            elif what == "dump" and world.fire.n_burning:
+                cells = np.flatnonzero(world.fire.state.reshape(-1) == BURNING)
+                world.sensed.reshape(-1)[cells] = True
+                world.n_sensed_active = world.n_sensed_ever = int(cells.size)
+                c = int(cells[rng.integers(cells.size)])
+                park(world, "A1", float(c // 1200), float(c % 1200))
+                world.team.armed[world.team.index("A1")] = True
+            elif what == "trace" and world.tick:
+                tr = world.trace()
+                np.testing.assert_array_equal(tr.facility_burning, np.array(burning))
+                np.testing.assert_array_equal(tr.facility_pruned, np.array(pruned))
+            elif what == "sum" and world.tick:
+                np.testing.assert_array_equal(
+                    world.trace_sum("facility_burning", 0, world.tick), np.sum(burning, axis=0)
+                )
+        world.step()
+        burning.append(world.facility_burning.copy())
+        pruned.append(world.facility_pruned.copy())
+    tr = world.trace()
+    np.testing.assert_array_equal(tr.facility_burning, np.array(burning))
+    np.testing.assert_array_equal(tr.facility_pruned, np.array(pruned))
+    k = int(rng.integers(0, 60))
+    np.testing.assert_array_equal(
+        world.trace_sum("facility_pruned", k, 60), np.sum(pruned[k:], axis=0)
+    )
+
+
 @settings(max_examples=15, deadline=None)
 @given(
     seed=st.integers(0, 2**32 - 1),

@@ -308,18 +308,20 @@ class TaskEnv(_Base):
         """Run one period of ticks; return the step's reward."""
         world, belief = self.world, self.belief
         fire = world.fire
+        start = world.tick
+        pruned = fire.n_pruned
         active = 0  # sum over the ticks of the burning cells
-        in_fac = np.zeros_like(world.facility_burning)  # sum of burning cells per facility
-        pruned = 0
-        for _ in range(self.period):
-            if world.done:
-                break
-            info = world.step(commands)
+        step, update = world.step, belief.update
+        # (the period, cut at the scenario's end: world.done once tick >= n_ticks)
+        for _ in range(min(self.period, self.scenario.n_ticks - start)):
+            update(step(commands))
             commands = None
-            belief.update(info)
             active += fire.n_burning
-            in_fac += world.facility_burning
-            pruned += info.pruned.size
+        # burning cells per facility summed over the ticks, from the trace rows the ticks wrote
+        # (the same integers as adding world.facility_burning after every tick); cells put out
+        # during the step: the change of the fire's count (the sum of every tick's info.pruned)
+        in_fac = world.trace_sum("facility_burning", start, world.tick)
+        pruned = fire.n_pruned - pruned
         rate = self.scenario.scoring.propagation_weight * active + float(
             in_fac @ world.facility_penalties
         )
