@@ -212,3 +212,26 @@ def test_box_cells_are_the_flat_indices_of_the_masks_nonzero(scenario, shapes, s
         np.testing.assert_array_equal(
             off, np.add.outer(np.arange(off.shape[0]) * w, np.arange(off.shape[1]))
         )
+
+
+@pytest.mark.parametrize("zero", [0.0, -0.0])
+@pytest.mark.parametrize("goal", [(-3.0, 5.0), (0.0, -0.0), (7.0, -2.0)])
+@pytest.mark.parametrize("mode", ["idle", "hover", "fly"])
+def test_small_team_path_keeps_the_vector_paths_signed_zeros(scenario, zero, goal, mode):
+    """Agents that do not fly are skipped by the small path except for zero coordinates: a
+    ``-0.0`` or ``+0.0`` coordinate of an idle, hovering or flying agent (goal signs either way)
+    ends the tick with the vector path's exact bits, positions, batteries, distances and clocks."""
+    small, vector = Team(scenario), Team(scenario)
+    vector._small = False
+    for team in (small, vector):
+        team.pos[0] = (zero, 40.0)
+        team.pos[1] = (40.0, zero)
+        team.goal[0] = team.goal[1] = goal
+        if mode != "idle":
+            team.mode[:2] = 1  # ACTIVE
+            team.has_goal[:2] = mode == "fly"
+    for _ in range(3):
+        a, b = small.move(), vector.move()
+        assert a.tolist() == b.tolist()
+        for name in _STATE:
+            assert _bits(getattr(small, name)) == _bits(getattr(vector, name)), name
