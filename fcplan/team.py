@@ -465,11 +465,12 @@ class Team:
         # altitude
         z, zt = self.z.tolist(), self.z_target.tolist()
         if z != zt:  # (NaN targets compare unequal, as in the vector path)
-            climb, lo = self._climb, -self._climb
-            self.z[:] = [
-                zi + min(max(t - zi, lo), climb) * s
-                for zi, t, s in zip(z, zt, self._can_sense_list, strict=True)
-            ]
+            # an agent at its target altitude moves by +0.0, which changes only a -0.0
+            climb, lo, sense = self._climb, -self._climb, self._can_sense_list
+            for i, (zi, t) in enumerate(zip(z, zt, strict=True)):
+                if zi != t or zi == 0.0:
+                    z[i] = zi + min(max(t - zi, lo), climb) * sense[i]
+            self.z[:] = z
         if arrived is not None:
             # docking first, then the next goals, as the vector path
             for i in arrived:
