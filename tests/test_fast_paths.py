@@ -235,3 +235,20 @@ def test_small_team_path_keeps_the_vector_paths_signed_zeros(scenario, zero, goa
         assert a.tolist() == b.tolist()
         for name in _STATE:
             assert _bits(getattr(small, name)) == _bits(getattr(vector, name)), name
+
+
+@pytest.mark.parametrize("z", [0.0, -0.0, 30.0])
+@pytest.mark.parametrize("target", [0.0, -0.0, 30.0, math.nan])
+def test_small_team_path_steps_altitudes_as_the_vector_path(scenario, z, target):
+    """The small path steps only the altitudes off their target (and zero ones): while one agent
+    climbs, any altitude of the others (zeros of either sign) and target (equal, zero, NaN) ends
+    the tick with the vector path's exact bits, for agents that can sense and those that cannot."""
+    small, vector = Team(scenario), Team(scenario)
+    vector._small = False
+    for team in (small, vector):
+        team.z[:] = z
+        team.z_target[:] = target
+        team.z_target[0] = 50.0  # (one agent climbs, so the others take the altitude step too)
+    for _ in range(2):
+        small.move(), vector.move()
+        assert _bits(small.z) == _bits(vector.z)
