@@ -244,12 +244,13 @@ class Team:
         """:meth:`fov_rects` as nested Python lists (the same values)."""
         if not self._small:
             return self.fov_rects().tolist()
-        # the same operations as fov_rects on Python floats: x + z (-t) per bound
+        # the same operations as fov_rects on Python floats: x + z (-t) per bound (a plain loop:
+        # cheaper than a comprehension's own frame on Python 3.11 for a handful of agents)
         ax, bx, ay, by = _FOV_SCALE_LIST
-        return [
-            [x + z * ax, x + z * bx, y + z * ay, y + z * by]
-            for (x, y), z in zip(self.pos.tolist(), self.z.tolist(), strict=True)
-        ]
+        rects = []
+        for (x, y), z in zip(self.pos.tolist(), self.z.tolist(), strict=True):
+            rects.append([x + z * ax, x + z * bx, y + z * ay, y + z * by])
+        return rects
 
     def sensing_confidence(self) -> np.ndarray:
         """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""
