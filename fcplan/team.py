@@ -380,13 +380,13 @@ class Team:
         has_goal = self.has_goal.tolist()
         home = self._home_list
         goal = None
-        any_active = False
+        act = []  # ACTIVE rows
         hover = []  # ACTIVE rows without a goal
         legs = []  # flyers: [row, target x, target y, dx, dy, |d|]
         hyp_k, hyp_x, hyp_y = [], [], []  # legs that need numpy's hypot
         for i, m in enumerate(mode):
             if m == _ACTIVE:
-                any_active = True
+                act.append(i)
                 if not has_goal[i]:
                     hover.append(i)
                     continue
@@ -482,36 +482,37 @@ class Team:
                 self._next_goal(i)
             self._rules()  # docking changed modes
             return np.array(rows, dtype=np.intp) if rows else _NO_ROWS
-        if any_active:
-            self._rules_lists(mode, pos, battery, hover_s)
+        if act:
+            self._rules_lists(act, mode, pos, battery, hover_s)
         return _NO_ROWS
 
-    def _rules_lists(self, mode: list, pos: list, battery: list, hover_s: list | None) -> None:
-        """:meth:`_rules` of a small team on Python numbers (the current modes, flat positions
-        ``[x0, y0, x1, y1, ...]``, batteries and hover clocks as lists; ``hover_s`` None when
-        every clock is 0).
+    def _rules_lists(
+        self, rows: list, mode: list, pos: list, battery: list, hover_s: list | None
+    ) -> None:
+        """:meth:`_rules` of a small team on Python numbers (``rows``: the ACTIVE rows, in
+        order; the current modes, flat positions ``[x0, y0, x1, y1, ...]``, batteries and hover
+        clocks as lists; ``hover_s`` None when every clock is 0).
 
         An agent whose battery is above an upper bound of its reserve (``hypot(d) <= |dx| +
         |dy|``, with a margin covering every rounding) is certainly not low; only the others
         need the exact reserve, with numpy's ``hypot`` and the vector rule's operations."""
         hm, home, margins = self._hover_margin, self._home_list, self._speed_margin_list
         near = None
-        for i, m in enumerate(mode):
-            if m == _ACTIVE:
-                hx, hy = home[i]
-                if (
-                    not battery[i]
-                    > (
-                        DRAIN_PER_PX * (abs(hx - pos[2 * i]) + abs(hy - pos[2 * i + 1]))
-                        + margins[i]
-                        + hm
-                    )
-                    * _BOUND
-                ):
-                    if near is None:
-                        near = [i]
-                    else:
-                        near.append(i)
+        for i in rows:
+            hx, hy = home[i]
+            if (
+                not battery[i]
+                > (
+                    DRAIN_PER_PX * (abs(hx - pos[2 * i]) + abs(hy - pos[2 * i + 1]))
+                    + margins[i]
+                    + hm
+                )
+                * _BOUND
+            ):
+                if near is None:
+                    near = [i]
+                else:
+                    near.append(i)
         if near is not None:
             dx = [home[i][0] - pos[2 * i] for i in near]
             dy = [home[i][1] - pos[2 * i + 1] for i in near]
@@ -593,12 +594,16 @@ class Team:
         """Battery reserve, and the 3-second rule for action agents (``active``: the rows in
         ACTIVE mode, if the caller has them)."""
         if self._small:
-            self._rules_lists(
-                self.mode.tolist(),
-                self.pos.ravel().tolist(),
-                self.battery.tolist(),
-                self.hover_s.tolist(),
-            )
+            mode = self.mode.tolist()
+            rows = [i for i, m in enumerate(mode) if m == _ACTIVE]
+            if rows:  # (without ACTIVE agents neither rule applies)
+                self._rules_lists(
+                    rows,
+                    mode,
+                    self.pos.ravel().tolist(),
+                    self.battery.tolist(),
+                    self.hover_s.tolist(),
+                )
             return
         if active is None:
             active = self.mode == _ACTIVE8
