@@ -440,7 +440,8 @@ class Team:
                     else:
                         arrived.append(i)
                 else:
-                    den = max(d, _TINY_F)  # (a NaN distance stays NaN, as np.maximum)
+                    # max(d, _TINY_F) without the call (a NaN distance stays NaN, as np.maximum)
+                    den = d if not d < _TINY_F else _TINY_F
                     pos[2 * i] += dx / den * sp
                     pos[2 * i + 1] += dy / den * sp
                     step = sp
