@@ -244,12 +244,13 @@ class Team:
         """:meth:`fov_rects` as nested Python lists (the same values)."""
         if not self._small:
             return self.fov_rects().tolist()
-        # the same operations as fov_rects on Python floats: x + z (-t) per bound
+        # the same operations as fov_rects on Python floats: x + z (-t) per bound (a plain loop:
+        # cheaper than a comprehension's own frame on Python 3.11 for a handful of agents)
         ax, bx, ay, by = _FOV_SCALE_LIST
-        return [
-            [x + z * ax, x + z * bx, y + z * ay, y + z * by]
-            for (x, y), z in zip(self.pos.tolist(), self.z.tolist(), strict=True)
-        ]
+        rects = []
+        for (x, y), z in zip(self.pos.tolist(), self.z.tolist(), strict=True):
+            rects.append([x + z * ax, x + z * bx, y + z * ay, y + z * by])
+        return rects
 
     def sensing_confidence(self) -> np.ndarray:
         """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""
@@ -367,141 +368,155 @@ class Team:
     def _move_small(self) -> np.ndarray:
         """:meth:`_move_vector` agent by agent on Python floats (same operations, same order, so
         the same rounding; ``hypot`` is numpy's, or ``|d|`` when one component is zero, which
-        C's Annex F makes exact). An agent that does not fly moves by ``(d / |d|) 0.0``, which is
-        the zero of ``d``'s sign: its position is ``x + 0.0 dx`` and no ``hypot`` is needed."""
+        C's Annex F makes exact).
+
+        Only the agents that fly or hover are touched. Every other one would move by
+        ``(d / |d|) 0.0``, the zero of ``d``'s sign: ``x + (+-0.0)`` is ``x`` unless ``x`` is a
+        zero (whose sign it may change, so zero coordinates take that operation), and its
+        battery and distance would change by ``+-0.0``, which leaves them as they are (a distance
+        is never ``-0.0``)."""
         mode = self.mode.tolist()
-        pos = self.pos.tolist()
-        battery = self.battery.tolist()
-        active = [m == _ACTIVE for m in mode]
-        # flying: going home (RETURNING, HOMING) or ACTIVE with a goal
-        flying = [
-            m >= _RETURNING or (a and h)
-            for m, a, h in zip(mode, active, self.has_goal.tolist(), strict=True)
-        ]
-        any_active = True in active
-        arrive = None
-        flat = None  # new positions, flat [x0, y0, x1, y1, ...]
-        hover_s = None  # None: every hover clock is 0
-        if True in flying or any(x == 0.0 or y == 0.0 for x, y in pos):
-            goal, home, speed = self.goal.tolist(), self._home_list, self._speed_list
+        pos = self.pos.ravel().tolist()  # flat [x0, y0, x1, y1, ...], updated in place below
+        has_goal = self.has_goal.tolist()
+        home = self._home_list
+        goal = None
+        act = []  # ACTIVE rows
+        hover = []  # ACTIVE rows without a goal
+        legs = []  # flyers: [row, target x, target y, dx, dy, |d|]
+        hyp_k, hyp_x, hyp_y = [], [], []  # legs that need numpy's hypot
+        for i, m in enumerate(mode):
+            if m == _ACTIVE:
+                act.append(i)
+                if not has_goal[i]:
+                    hover.append(i)
+                    continue
+                if goal is None:
+                    goal = self.goal.tolist()
+                tx, ty = goal[i]
+            elif m >= _RETURNING:  # RETURNING or HOMING: flies home
+                tx, ty = home[i]
+            else:
+                continue
+            dx, dy = tx - pos[2 * i], ty - pos[2 * i + 1]
+            if dy == 0.0:  # hypot(x, +-0) is |x| exactly (C99 Annex F)
+                legs.append([i, tx, ty, dx, dy, abs(dx)])
+            elif dx == 0.0:
+                legs.append([i, tx, ty, dx, dy, abs(dy)])
+            else:
+                hyp_k.append(len(legs))
+                hyp_x.append(dx)
+                hyp_y.append(dy)
+                legs.append([i, tx, ty, dx, dy, 0.0])
+        # zero coordinates of agents that do not fly (x + 0.0 (t - x) may flip a -0.0)
+        moved = bool(legs)
+        if 0.0 in pos:
+            for i, m in enumerate(mode):
+                if m < _RETURNING and not (m == _ACTIVE and has_goal[i]):
+                    x, y = pos[2 * i], pos[2 * i + 1]
+                    if x == 0.0 or y == 0.0:
+                        if goal is None:
+                            goal = self.goal.tolist()
+                        tx, ty = goal[i]
+                        pos[2 * i] = x + 0.0 * (tx - x)
+                        pos[2 * i + 1] = y + 0.0 * (ty - y)
+                        moved = True
+        battery = None
+        arrived = None  # rows that reached their target
+        if legs:
+            if hyp_k:
+                for k, d in zip(hyp_k, np.hypot(hyp_x, hyp_y).tolist(), strict=True):
+                    legs[k][5] = d
+            speed = self._speed_list
             dist = self.distance.tolist()
-            # the flyers' distances to their targets: one hypot call for those that need it
-            legs = {}
-            hyp_i, hyp_x, hyp_y = [], [], []
-            for i, f in enumerate(flying):
-                if f:
-                    t = home[i] if mode[i] >= _RETURNING else goal[i]
-                    x, y = pos[i]
-                    dx, dy = t[0] - x, t[1] - y
-                    if dy == 0.0:  # hypot(x, +-0) is |x| exactly (C99 Annex F)
-                        legs[i] = (t, dx, dy, abs(dx))
-                    elif dx == 0.0:
-                        legs[i] = (t, dx, dy, abs(dy))
+            battery = self.battery.tolist()
+            for i, tx, ty, dx, dy, d in legs:
+                sp = speed[i]
+                if d <= sp:
+                    pos[2 * i] = tx
+                    pos[2 * i + 1] = ty
+                    step = d
+                    if arrived is None:
+                        arrived = [i]
                     else:
-                        legs[i] = (t, dx, dy, 0.0)
-                        hyp_i.append(i)
-                        hyp_x.append(dx)
-                        hyp_y.append(dy)
-            if hyp_i:
-                for i, d in zip(hyp_i, np.hypot(hyp_x, hyp_y).tolist(), strict=True):
-                    t, dx, dy, _ = legs[i]
-                    legs[i] = (t, dx, dy, d)
-            hd, dt, flat, arrive = self._hover_drain, self.dt_s, [], []
-            any_hover = any_active and True in [
-                a and not f for a, f in zip(active, flying, strict=True)
-            ]
-            if any_hover:
-                hover_s = self.hover_s.tolist()
-            for i, (x, y) in enumerate(pos):
-                if flying[i]:
-                    t, dx, dy, d = legs[i]
-                    sp = speed[i]
-                    if d <= sp:
-                        arrive.append(True)
-                        flat += t
-                        step = d
-                    else:
-                        arrive.append(False)
-                        den = max(d, _TINY_F)  # (a NaN distance stays NaN, as np.maximum)
-                        flat += (x + dx / den * sp, y + dy / den * sp)
-                        step = sp
-                    dist[i] += step
-                    battery[i] -= DRAIN_PER_PX * step
-                    if any_hover:
-                        hover_s[i] = 0.0
+                        arrived.append(i)
                 else:
-                    arrive.append(False)
-                    t = home[i] if mode[i] >= _RETURNING else goal[i]
-                    flat += (x + 0.0 * (t[0] - x), y + 0.0 * (t[1] - y))
-                    dist[i] += 0.0
-                    if active[i]:  # hovering
-                        battery[i] -= 0.0 + hd
-                        hover_s[i] = hover_s[i] + dt
-                    else:
-                        battery[i] -= 0.0
-                        if any_hover:
-                            hover_s[i] = 0.0
-            self.pos = np.array(flat, dtype=np.float64).reshape(self.n, 2)
+                    # max(d, _TINY_F) without the call (a NaN distance stays NaN, as np.maximum)
+                    den = d if not d < _TINY_F else _TINY_F
+                    pos[2 * i] += dx / den * sp
+                    pos[2 * i + 1] += dy / den * sp
+                    step = sp
+                dist[i] += step
+                battery[i] -= DRAIN_PER_PX * step
             self.distance[:] = dist
+        if moved:
+            self.pos = np.array(pos, dtype=np.float64).reshape(self.n, 2)
+        hover_s = None  # None: every hover clock is 0
+        if hover:
+            if battery is None:
+                battery = self.battery.tolist()
+            hd, dt, old = self._hover_drain, self.dt_s, self.hover_s.tolist()
+            hover_s = [0.0] * self.n
+            for i in hover:
+                battery[i] -= hd
+                hover_s[i] = old[i] + dt
+            self.hover_s = np.array(hover_s, dtype=np.float64)
+        else:
+            self.hover_s = np.zeros(self.n)
+        if battery is not None:
             self.battery[:] = battery
-        elif any_active:
-            hd = self._hover_drain
-            battery = [b - hd * a for b, a in zip(battery, active, strict=True)]
-            hover_s = [
-                h + self.dt_s if a else 0.0
-                for h, a in zip(self.hover_s.tolist(), active, strict=True)
-            ]
-            self.battery[:] = battery
-        self.hover_s = np.zeros(self.n) if hover_s is None else np.array(hover_s, np.float64)
         # altitude
         z, zt = self.z.tolist(), self.z_target.tolist()
         if z != zt:  # (NaN targets compare unequal, as in the vector path)
-            climb, lo = self._climb, -self._climb
-            self.z[:] = [
-                zi + min(max(t - zi, lo), climb) * s
-                for zi, t, s in zip(z, zt, self._can_sense_list, strict=True)
-            ]
-        if arrive is not None and True in arrive:
-            arrive_a = np.array(arrive)
-            going_home = np.array(mode) >= _RETURNING
-            for i in (arrive_a & going_home).nonzero()[0].tolist():
-                self._dock(i)
-            arrived_goal = (arrive_a & np.array(active)).nonzero()[0]
-            for i in arrived_goal.tolist():
+            # an agent at its target altitude moves by +0.0, which changes only a -0.0
+            climb, lo, sense = self._climb, -self._climb, self._can_sense_list
+            for i, (zi, t) in enumerate(zip(z, zt, strict=True)):
+                if zi != t or zi == 0.0:
+                    z[i] = zi + min(max(t - zi, lo), climb) * sense[i]
+            self.z[:] = z
+        if arrived is not None:
+            # docking first, then the next goals, as the vector path
+            for i in arrived:
+                if mode[i] >= _RETURNING:
+                    self._dock(i)
+            rows = [i for i in arrived if mode[i] == _ACTIVE]
+            for i in rows:
                 self._next_goal(i)
             self._rules()  # docking changed modes
-            return arrived_goal
-        if any_active:
-            if flat is None:
-                xs, ys = [p[0] for p in pos], [p[1] for p in pos]
-            else:
-                xs, ys = flat[0::2], flat[1::2]
-            self._rules_lists(mode, xs, ys, battery, hover_s)
+            return np.array(rows, dtype=np.intp) if rows else _NO_ROWS
+        if act:
+            self._rules_lists(act, mode, pos, battery, hover_s)
         return _NO_ROWS
 
     def _rules_lists(
-        self, mode: list, xs: list, ys: list, battery: list, hover_s: list | None
+        self, rows: list, mode: list, pos: list, battery: list, hover_s: list | None
     ) -> None:
-        """:meth:`_rules` of a small team on Python numbers (the current modes, positions,
-        batteries and hover clocks as lists; ``hover_s`` None when every clock is 0).
+        """:meth:`_rules` of a small team on Python numbers (``rows``: the ACTIVE rows, in
+        order; the current modes, flat positions ``[x0, y0, x1, y1, ...]``, batteries and hover
+        clocks as lists; ``hover_s`` None when every clock is 0).
 
         An agent whose battery is above an upper bound of its reserve (``hypot(d) <= |dx| +
         |dy|``, with a margin covering every rounding) is certainly not low; only the others
         need the exact reserve, with numpy's ``hypot`` and the vector rule's operations."""
         hm, home, margins = self._hover_margin, self._home_list, self._speed_margin_list
-        near = []
-        for i, m in enumerate(mode):
-            if m == _ACTIVE:
-                hx, hy = home[i]
-                x, y = xs[i], ys[i]
-                if (
-                    not battery[i]
-                    > (DRAIN_PER_PX * (abs(hx - x) + abs(hy - y)) + margins[i] + hm) * _BOUND
-                ):
+        near = None
+        for i in rows:
+            hx, hy = home[i]
+            if (
+                not battery[i]
+                > (
+                    DRAIN_PER_PX * (abs(hx - pos[2 * i]) + abs(hy - pos[2 * i + 1]))
+                    + margins[i]
+                    + hm
+                )
+                * _BOUND
+            ):
+                if near is None:
+                    near = [i]
+                else:
                     near.append(i)
-        if near:
-            dx = [home[i][0] - xs[i] for i in near]
-            dy = [home[i][1] - ys[i] for i in near]
+        if near is not None:
+            dx = [home[i][0] - pos[2 * i] for i in near]
+            dy = [home[i][1] - pos[2 * i + 1] for i in near]
             for i, h in zip(near, np.hypot(dx, dy).tolist(), strict=True):
                 if battery[i] <= DRAIN_PER_PX * h + margins[i] + hm:
                     self.mode[i] = _RETURNING
@@ -580,14 +595,16 @@ class Team:
         """Battery reserve, and the 3-second rule for action agents (``active``: the rows in
         ACTIVE mode, if the caller has them)."""
         if self._small:
-            pos = self.pos.tolist()
-            self._rules_lists(
-                self.mode.tolist(),
-                [p[0] for p in pos],
-                [p[1] for p in pos],
-                self.battery.tolist(),
-                self.hover_s.tolist(),
-            )
+            mode = self.mode.tolist()
+            rows = [i for i, m in enumerate(mode) if m == _ACTIVE]
+            if rows:  # (without ACTIVE agents neither rule applies)
+                self._rules_lists(
+                    rows,
+                    mode,
+                    self.pos.ravel().tolist(),
+                    self.battery.tolist(),
+                    self.hover_s.tolist(),
+                )
             return
         if active is None:
             active = self.mode == _ACTIVE8

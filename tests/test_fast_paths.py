@@ -212,3 +212,43 @@ def test_box_cells_are_the_flat_indices_of_the_masks_nonzero(scenario, shapes, s
         np.testing.assert_array_equal(
             off, np.add.outer(np.arange(off.shape[0]) * w, np.arange(off.shape[1]))
         )
+
+
+@pytest.mark.parametrize("zero", [0.0, -0.0])
+@pytest.mark.parametrize("goal", [(-3.0, 5.0), (0.0, -0.0), (7.0, -2.0)])
+@pytest.mark.parametrize("mode", ["idle", "hover", "fly"])
+def test_small_team_path_keeps_the_vector_paths_signed_zeros(scenario, zero, goal, mode):
+    """Agents that do not fly are skipped by the small path except for zero coordinates: a
+    ``-0.0`` or ``+0.0`` coordinate of an idle, hovering or flying agent (goal signs either way)
+    ends the tick with the vector path's exact bits, positions, batteries, distances and clocks."""
+    small, vector = Team(scenario), Team(scenario)
+    vector._small = False
+    for team in (small, vector):
+        team.pos[0] = (zero, 40.0)
+        team.pos[1] = (40.0, zero)
+        team.goal[0] = team.goal[1] = goal
+        if mode != "idle":
+            team.mode[:2] = 1  # ACTIVE
+            team.has_goal[:2] = mode == "fly"
+    for _ in range(3):
+        a, b = small.move(), vector.move()
+        assert a.tolist() == b.tolist()
+        for name in _STATE:
+            assert _bits(getattr(small, name)) == _bits(getattr(vector, name)), name
+
+
+@pytest.mark.parametrize("z", [0.0, -0.0, 30.0])
+@pytest.mark.parametrize("target", [0.0, -0.0, 30.0, math.nan])
+def test_small_team_path_steps_altitudes_as_the_vector_path(scenario, z, target):
+    """The small path steps only the altitudes off their target (and zero ones): while one agent
+    climbs, any altitude of the others (zeros of either sign) and target (equal, zero, NaN) ends
+    the tick with the vector path's exact bits, for agents that can sense and those that cannot."""
+    small, vector = Team(scenario), Team(scenario)
+    vector._small = False
+    for team in (small, vector):
+        team.z[:] = z
+        team.z_target[:] = target
+        team.z_target[0] = 50.0  # (one agent climbs, so the others take the altitude step too)
+    for _ in range(2):
+        small.move(), vector.move()
+        assert _bits(small.z) == _bits(vector.z)
