@@ -476,17 +476,22 @@ def test_graph_reports_team_state():
 
 
 @settings(max_examples=80, deadline=None)
-@given(seed=st.integers(0, 2**31 - 1), nx=st.integers(2, 12), ny=st.integers(2, 12))
-def test_small_fire_clusters_match_scipy_label_also_when_repeated(seed, nx, ny):
-    """Up to a few dozen tiles (the closure path), cluster labels equal scipy.ndimage.label
-    (8-connected, numbered by first tile in raster order), and asking again for the same tiles
-    (the memo) gives the same labels."""
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    nx=st.integers(2, 30),
+    ny=st.integers(2, 30),
+    most=st.sampled_from([40, 200]),
+)
+def test_small_fire_clusters_match_scipy_label_also_when_repeated(seed, nx, ny, most):
+    """Up to a few dozen tiles (the closure path) and up to 200 (the numpy labelling), cluster
+    labels equal scipy.ndimage.label (8-connected, numbered by first tile in raster order), and
+    asking again for the same tiles (the memo) gives the same labels."""
     from scipy.ndimage import label
 
     from fcplan.taskgraph import _EIGHT, _clusters
 
     rng = np.random.default_rng(seed)
-    n = int(rng.integers(1, min(nx * ny, 40) + 1))
+    n = int(rng.integers(1, min(nx * ny, most) + 1))
     flat = np.sort(rng.choice(nx * ny, size=n, replace=False))
     tx, ty = np.divmod(flat, ny)
     grid = np.zeros((nx + 1, ny + 1), dtype=bool)

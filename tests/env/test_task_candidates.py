@@ -174,25 +174,6 @@ def test_validate_plan_fast_path_matches_checks(seed, n_agents, n_tasks):
         assert fast == slow
 
 
-@settings(max_examples=60, deadline=None)
-@given(seed=st.integers(0, 2**31 - 1), nx=st.integers(2, 30), ny=st.integers(2, 30))
-def test_fire_clusters_match_scipy_label(seed, nx, ny):
-    """The task graph's small-fire cluster labelling equals scipy.ndimage.label (8-connected,
-    numbered by first tile in raster order)."""
-    from scipy.ndimage import label
-
-    from fcplan.taskgraph import _EIGHT, _clusters
-
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(1, min(nx * ny, 200) + 1))
-    flat = np.sort(rng.choice(nx * ny, size=n, replace=False))
-    tx, ty = np.divmod(flat, ny)
-    grid = np.zeros((nx + 1, ny + 1), dtype=bool)
-    grid[tx, ty] = True
-    labels, _ = label(grid, structure=_EIGHT)
-    assert np.array_equal(_clusters(tx, ty, nx, ny), labels[tx, ty].astype(np.int64) - 1)
-
-
 @settings(max_examples=30, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1), backwards=st.booleans())
 def test_deferred_coverage_equals_eager_writes(seed, backwards):
