@@ -80,13 +80,14 @@ def _run_pair(a: Fire, b: Fire, ticks: int, prune_every: int, small_b: int | Non
     assert bits(a.visits) == bits(b.visits)
 
 
+_SEED, _COORD = st.integers(0, 2**31 - 1), st.integers(0, 1199)
+_FRONTS = st.integers(1, 300)  # (over 256: C/R is not drawn ahead)
+# one region anywhere on the x axis (some fronts leave the map), pruned every few ticks
+_ONE_REGION_RUN = {"seed": _SEED, "fronts": _FRONTS, "cx": _COORD, "prune_every": st.integers(0, 7)}
+
+
 @settings(max_examples=25, deadline=None)
-@given(
-    seed=st.integers(0, 2**31 - 1),
-    fronts=st.integers(1, 300),
-    cx=st.integers(0, 1199),
-    prune_every=st.integers(0, 7),
-)
+@given(**_ONE_REGION_RUN)
 def test_draws_ahead_move_fronts_exactly_as_tick_by_tick_draws(seed, fronts, cx, prune_every):
     """Drawing and precomputing 64 ticks ahead gives bit-identical fronts, cells and visits to
     drawing every tick (also with more than 256 fronts, pruning and fronts leaving the map)."""
@@ -103,13 +104,7 @@ def test_draws_ahead_move_fronts_exactly_as_tick_by_tick_draws(seed, fronts, cx,
 
 
 @settings(max_examples=25, deadline=None)
-@given(
-    seed=st.integers(0, 2**31 - 1),
-    cx=st.integers(0, 1199),
-    cy=st.integers(0, 1199),
-    fuel=st.integers(1, 30),
-    prune_every=st.integers(0, 7),
-)
+@given(seed=_SEED, cx=_COORD, cy=_COORD, fuel=st.integers(1, 30), prune_every=st.integers(0, 7))
 def test_edge_margin_shortcut_agrees_with_the_full_map_check(seed, cx, cy, fuel, prune_every):
     """Skipping the per-front map check while the burn box keeps ``_edge_margin`` from the edges
     changes nothing: fronts die at exactly the same ticks as with the check on every tick (also
@@ -122,12 +117,7 @@ def test_edge_margin_shortcut_agrees_with_the_full_map_check(seed, cx, cy, fuel,
 
 
 @settings(max_examples=25, deadline=None)
-@given(
-    seed=st.integers(0, 2**31 - 1),
-    fronts=st.integers(1, 300),
-    cx=st.integers(0, 1199),
-    prune_every=st.integers(0, 7),
-)
+@given(**_ONE_REGION_RUN)
 def test_small_fire_kernels_move_fronts_exactly_as_the_vector_rule(seed, fronts, cx, prune_every):
     """With a few fresh cells per tick the fire ignites on Python ints (ignite_cells) and checks
     landings on lists; with ``_SMALL = 0`` every tick takes the numpy rule (``Fire._ignite``):
@@ -140,11 +130,7 @@ def test_small_fire_kernels_move_fronts_exactly_as_the_vector_rule(seed, fronts,
 
 
 @settings(max_examples=100, deadline=None)
-@given(
-    seed=st.integers(0, 2**31 - 1),
-    n=st.integers(1, 300),
-    ticks=st.integers(1, 70),
-)
+@given(seed=_SEED, n=_FRONTS, ticks=st.integers(1, 70))
 def test_wind_drawn_ahead_is_the_per_tick_rule(seed, n, ticks):
     """draw_ahead fills T ticks of U, sin(Theta), cos(Theta) and C/R that are, row by row, bit
     for bit what T successive calls of wind_draws (and the tabulated C/R of their U) give."""
@@ -168,9 +154,9 @@ def test_wind_drawn_ahead_is_the_per_tick_rule(seed, n, ticks):
 
 @settings(max_examples=50, deadline=None)
 @given(
-    seed=st.integers(0, 2**31 - 1),
-    fronts=st.integers(1, 300),
-    cx=st.integers(0, 1199),
+    seed=_SEED,
+    fronts=_FRONTS,
+    cx=_COORD,
     ticks=st.integers(1, 80),
     freeze_every=st.integers(0, 4),
     delayed=st.booleans(),
