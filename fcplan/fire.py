@@ -10,8 +10,12 @@ ignition box. Every tick every live front takes one FARSITE step (FIRECOMMANDER.
     C = 0.5 (R - R / HB)
     x += C sin(Theta) dt,   y += C cos(Theta) dt              (dt = 10 / ticks_per_second)
 
-so a front moves about ``0.24 * fuel`` px per tick at wind 5 on its first tick, drifting weakly
-along the wind azimuth (theta = 0 is +y, screen down; 90 degrees is +x).
+This is the manual's FARSITE model, ``dq/dt = C(R, U) D(Theta)`` with the spread rate
+``C = R (1 - LB / (LB + sqrt(LB^2 - 1)))`` (``eq:qdot1``, ``eq:C``), identical for ``LB >= 1``, with the reference code's
+exponents (the manual rounds them to 0.256 and 0.154). Units: px (1 px = 1 m), wind speed in the
+scenario's units, angles in radians; the step is per tick at 10 ticks per second, scaled by ``dt``
+at other rates. A front moves about ``0.24 * fuel`` px per tick at wind 5 on its first tick,
+drifting weakly along the wind azimuth (theta = 0 is +y, screen down; 90 degrees is +x).
 
 What fcplan keeps and fixes (ARCHITECTURE.md "Fire"):
 
@@ -24,9 +28,11 @@ What fcplan keeps and fixes (ARCHITECTURE.md "Fire"):
   by its fuel coefficient.
 * Random numbers: two normals are drawn for *every* front every tick, live or not, so the fire's
   random stream never depends on what the agents do (common random numbers across schedulers).
-  They are drawn up to 64 ticks ahead, together with everything of the step that does not depend
-  on the positions (wind speed, C/R, sin and cos of the direction), in a few calls over the whole
-  block; element by element the arithmetic is the per-tick one, so the trajectories are the same.
+  :func:`wind_draws` is that rule for one tick; :class:`Fire` computes it for blocks of ticks at
+  once (:func:`fcplan._fast.fire.draw_ahead`), bit for bit as tick by tick.
+* ``C/R`` is read from a table of :func:`spread_rate_ratio` (linear interpolation: error below
+  1e-5; below 1.5e-4 for steps of more than 256 moving fronts, except within 0.002 of the two
+  kinks of ``sqrt|LB^2 - 1|`` at ``U = 0`` and ``U = -6.219``, where it stays below 0.0065; a wind draw lands there with probability about 1e-5).
 * Intensity is not used by any rule. It is kept as a grid of front visits (``visits``); the
   Gaussian heat field of the manual is computed on demand by :meth:`Fire.intensity`.
 
@@ -50,22 +56,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
+
+from fcplan._fast.fire import advance_whole, draw_ahead, ignite_cells
+from fcplan._fast.fire import unique as _unique
 
 try:  # np.interp without its argument checks (same compiled routine, same results)
     from numpy._core.multiarray import interp as _interp
 except ImportError:  # numpy < 2
-    from numpy.core.multiarray import interp as _interp
+    from numpy.core.multiarray import interp as _interp  # type: ignore[no-redef]
 
-__all__ = [
-    "Fire",
-    "spread_rate_ratio",
-    "INTENSITY_COEFF",
-    "UNBURNT",
-    "BURNING",
-    "PRUNED",
-]
+__all__ = ["Fire", "spread_rate_ratio", "wind_draws", "INTENSITY_COEFF"]
+__all__ += ["UNBURNT", "BURNING", "PRUNED"]
 
 #: ``259.833 (h / cos(alpha))^2.174 / 1000`` with h = 3 m, alpha = pi/3 (manual Eq. intensity).
 INTENSITY_COEFF = 259.833 * (3.0 / math.cos(math.pi / 3)) ** 2.174 / 1000.0
@@ -78,7 +82,7 @@ UNBURNT, BURNING, PRUNED = 0, 1, 2
 BLOCK = 16
 
 
-def _lb(u):
+def _lb(u: np.ndarray | float) -> np.ndarray:
     """FARSITE length-to-breadth ratio LB(U) (reference exponents 0.2566 and 0.1548)."""
     return 0.936 * np.exp(0.2566 * u) + 0.461 * np.exp(-0.1548 * u) - 0.397
 
@@ -96,6 +100,37 @@ def spread_rate_ratio(wind_speed: np.ndarray | float) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         inv_hb = np.where(lb - s != 0.0, (lb - s) / (lb + s), 1.0)
     return 0.5 * (1.0 - inv_hb)
+
+
+def wind_draws(
+    rng: np.random.Generator, wind_avg: np.ndarray, theta_avg: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One tick's wind for every front: ``U ~ N(U_avg, 2)`` and ``Theta ~ N(theta_avg, 2 rad)``.
+
+    The two normals of every front are drawn as one ``(2, n)`` array (speeds, then directions).
+    :class:`Fire` computes this for blocks of ticks ahead, bit for bit as successive calls.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+    wind_avg, theta_avg : ndarray, (n,) float64
+        Mean wind speed and direction (rad) of each front.
+
+    Returns
+    -------
+    u, sin_theta, cos_theta : ndarray, (n,) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> u, s, c = wind_draws(np.random.default_rng(0), np.full(3, 5.0), np.zeros(3))
+    >>> u.shape, bool(np.allclose(s**2 + c**2, 1.0))
+    ((3,), True)
+    """
+    z = rng.standard_normal((2, wind_avg.size))
+    u = z[0] * WIND_SPEED_SD + wind_avg
+    theta = z[1] * WIND_DIR_SD_RAD + theta_avg
+    return u, np.sin(theta), np.cos(theta)
 
 
 class Fire:
@@ -128,9 +163,11 @@ class Fire:
         Front-ticks spent in each cell (the accumulation behind :meth:`intensity`).
     """
 
+    _block = BLOCK  # (read by the kernels of fcplan._fast.fire, which cannot import this module)
+
     def __init__(
         self,
-        regions: Sequence,
+        regions: Sequence[Any],
         world_size: int,
         ticks_per_second: int,
         rng: np.random.Generator,
@@ -186,7 +223,8 @@ class Fire:
         self._n_visits = 0
         self._move = np.empty((2, n))  # per-tick buffer: the moves of all fronts
         # The position-free part of the FARSITE step (draws, wind, C/R, sin and cos of Theta) for
-        # the next ``_pre_len`` ticks of every front, filled in one go by _refill.
+        # the next ``_pre_len`` ticks of every front, filled in one go by _refill (row t: tick t
+        # of the block, the result of wind_draws).
         self._pre_len = max(1, min(_PRE_TICKS, _PRE_VALUES // max(n, 1)))
         self._pre_t = self._pre_len  # next row to use (all used: refill first)
         self._pre_z = np.empty((self._pre_len, 2, n))
@@ -224,7 +262,7 @@ class Fire:
         return self._xy[0]
 
     @x.setter
-    def x(self, value) -> None:
+    def x(self, value: Any) -> None:
         self._xy[0] = value
 
     @property
@@ -233,7 +271,7 @@ class Fire:
         return self._xy[1]
 
     @y.setter
-    def y(self, value) -> None:
+    def y(self, value: Any) -> None:
         self._xy[1] = value
 
     @property
@@ -293,7 +331,7 @@ class Fire:
         b = self.block_burning[
             x0 // BLOCK : (x1 - 1) // BLOCK + 1, y0 // BLOCK : (y1 - 1) // BLOCK + 1
         ]
-        return np.count_nonzero(b) > 0
+        return bool(np.count_nonzero(b))
 
     # ------------------------------------------------------------------ dynamics
     def _ignite(self, flat: np.ndarray, state: np.ndarray | None = None) -> np.ndarray:
@@ -306,7 +344,7 @@ class Fire:
         if n == 0:
             return fresh
         if n <= _SMALL:  # a few cells (every tick of a normal fire): Python ints are cheaper
-            return self._ignite_cells(fresh.tolist())
+            return ignite_cells(self, fresh.tolist())
         fresh = _unique(fresh)
         np.add.at(self._block_flat, self._block_of(fresh), _ONE32)
         w = self.world_size
@@ -314,24 +352,6 @@ class Fire:
         return self._burn(
             fresh, int(fresh[0]) // w, int(fresh[-1]) // w, int(ys.min()), int(ys.max())
         )
-
-    def _ignite_cells(self, cells: list) -> np.ndarray:
-        """:meth:`_ignite` of a short list of unburnt flat cells (Python ints, repeats allowed)."""
-        if not cells:
-            return _EMPTY
-        w, nblk, blocks = self.world_size, self._nblk, self._block_flat
-        if len(cells) > 1:
-            cells = sorted(set(cells))
-        y0, y1 = w, -1
-        for c in cells:
-            cx, cy = divmod(c, w)
-            blocks[(cx // BLOCK) * nblk + cy // BLOCK] += 1
-            if cy < y0:
-                y0 = cy
-            if cy > y1:
-                y1 = cy
-        # (cells are sorted: x grows along the list)
-        return self._burn(np.array(cells, dtype=np.int64), cells[0] // w, cells[-1] // w, y0, y1)
 
     def _burn(self, fresh: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndarray:
         """Set the (unique, unburnt) cells ``fresh`` burning, spanning ``[x0, x1] x [y0, y1]``
@@ -353,155 +373,142 @@ class Fire:
     def step(self) -> np.ndarray:
         """Advance one tick; return the flat indices of the cells that started burning.
 
-        Regions whose delay has passed activate first (their ignition cells burn); then every
-        live, unfrozen front takes one FARSITE step.
+        1. Regions whose delay has passed activate: their ignition cells burn
+           (:meth:`_wake_regions`).
+        2. Every live, unfrozen front takes one FARSITE step with this tick's wind
+           (:meth:`_advance_moving`).
+        3. Fronts that left the map die.
+        4. Every other moved front lands in a cell: a pruned cell freezes it for good, an
+           unburnt cell starts burning.
         """
         self.tick += 1
-        new = _EMPTY
-        if self.tick >= self._next_wake:
-            waking = (~self.region_active) & (self.delay_ticks <= self.tick)
-            if waking.any():
-                self.region_active |= waking
-                self._moving = None
-                new = self._ignite(self.cell[self.alive & waking[self.region]])
-            self._set_next_wake()
-        t = self._pre_t
+        new = self._wake_regions() if self.tick >= self._next_wake else _EMPTY
+        t = self._pre_t  # this tick's row of the wind drawn ahead
         if t == self._pre_len:
             self._refill()
             t = 0
         self._pre_t = t + 1
-        if self._moving is None:
-            self._refresh_moving()
         idx = self._moving
+        if idx is None:
+            idx = self._refresh_moving()
         if idx.size == 0:
             return new
         all_moving = self._all_moving
         ratio = self._pre_ratio
+        # the visits of this tick: the cells the moving fronts stand in
         k = self._n_visits
         if k + self.n_fronts > self._visit_queue.size:
             self._flush_visits()
             k = 0
-        # No front can leave the map this tick while the burn box keeps _edge_margin from the
-        # edges (moving fronts stand in burning cells); the box does not change until the
-        # ignitions below.
-        (x0, x1, y0, y1), m, w = self.burn_box, self._edge_margin, self.world_size
-        far = m <= x0 <= x1 and x1 + m < w and m <= y0 and y1 + m < w
-        # Whole-array step: every front, the ones that do not move with a zero spread (C = 0,
-        # so x + (+-0.0) = x: positions are never -0.0). Not for fires over _INTERP_MAX fronts
-        # (C/R's method depends on how many fronts move).
-        masked = not all_moving and ratio is not None
-        if all_moving or masked:  # no gathers: update the positions in place
-            if all_moving:
-                self._visit_queue[k : k + self.n_fronts] = self.cell
-                self._n_visits = k + self.n_fronts
-                fuel_dt = self._m_fuel_dt
-            else:
-                self._visit_queue[k : k + idx.size] = self.cell[idx]
-                self._n_visits = k + idx.size
-                fuel_dt = self._fuel_dt_masked
-            xy, sc = self._xy, self._pre_sc[t]
-            ratio = _ratio(self._pre_u[t]) if ratio is None else ratio[t]
-            # (dead fronts stand just off the map: clipped terrain reads, multiplied by 0)
-            cells = self._t_stride @ np.rint(xy).astype(np.int64)
-            if all_moving:
-                fuel = self._terrain_flat[cells]
-            else:
-                fuel = self._terrain_flat.take(cells, mode="clip")
-            c = fuel * fuel_dt * ratio
-            # x += C sin(Theta), y += C cos(Theta)
-            xy += np.multiply(sc, c, out=self._move)
+        if all_moving:
+            self._visit_queue[k : k + self.n_fronts] = self.cell
+            self._n_visits = k + self.n_fronts
         else:
             self._visit_queue[k : k + idx.size] = self.cell[idx]
             self._n_visits = k + idx.size
-            # gathers through flat indices (1-D takes are much cheaper than 2-D fancy indexing)
-            idx2 = self._m_idx2
-            xy = self._xy.reshape(-1)[idx2].reshape(2, -1)
-            sc = self._pre_sc[t].reshape(-1)[idx2].reshape(2, -1)
-            ratio = _ratio(self._pre_u[t][idx]) if ratio is None else ratio[t][idx]
-            fuel = self._terrain_flat[self._t_stride @ np.rint(xy).astype(np.int64)]
-            c = fuel * self._m_fuel_dt * ratio
-            xy += np.multiply(sc, c)
-            self._xy.reshape(-1)[idx2] = xy.reshape(-1)
-        if far:
-            inside_all = True
+        # 2. The rule moves the moving fronts only. The whole-array kernel is bit-identical and
+        # cheaper when every front moves, or when C/R of every front was drawn ahead (fires up to
+        # _INTERP_MAX fronts: C/R's method depends on how many fronts move).
+        masked = not all_moving and ratio is not None
+        if all_moving or masked:
+            ratio_t = _ratio(self._pre_u[t]) if ratio is None else ratio[t]
+            xy = advance_whole(self, t, ratio_t, all_moving)
         else:
+            xy = self._advance_moving(idx, t)
+        # 3. No front can leave the map this tick while the burn box keeps _edge_margin from the
+        # edges (moving fronts stand in burning cells); the box does not change until step 4.
+        (x0, x1, y0, y1), m, w = self.burn_box, self._edge_margin, self.world_size
+        inside = None
+        if not (m <= x0 <= x1 and x1 + m < w and m <= y0 and y1 + m < w):
             # As unsigned integers the bits of non-negative doubles keep their order and every
             # negative double (and NaN) is larger: all below W's bits means all in [+0, W). In
             # the whole-array step the idle fronts add the same count as when they stopped.
-            inside_all = np.count_nonzero(xy.view(np.uint64) < self._w_bits) == (
-                self._idle_inside + 2 * idx.size if masked else xy.size
-            )
-            if not inside_all:
-                ge, lt = xy >= _ZERO, xy < self._w_float
-                inside = (ge & lt).all(axis=0)
+            n_in = np.count_nonzero(xy.view(np.uint64) < self._w_bits)
+            if n_in != (self._idle_inside + 2 * idx.size if masked else xy.size):
+                on_map: np.ndarray = (xy >= _ZERO) & (xy < self._w_float)
+                inside = on_map[0] & on_map[1]
                 if masked:
                     inside = inside[idx]
-                inside_all = np.count_nonzero(inside) == inside.size
-        if inside_all:
-            if all_moving:
-                idx = slice(None)
+                if np.count_nonzero(inside) == inside.size:
+                    inside = None
+        rows: np.ndarray | slice
+        if inside is None:
+            rows = slice(None) if all_moving else idx
         else:
             self.alive[idx[~inside]] = False
             self._moving = None
-            if masked:
-                idx = idx[inside]
-            else:
-                idx, xy = idx[inside], xy[:, inside]
-        flat = self._stride @ xy.astype(np.int64)  # x w + y, exact on int64 (one call)
+            rows = idx[inside]
+            if not masked:
+                xy = xy[:, inside]
+        # 4. land: x w + y, exact on int64 (one call)
+        flat = self._stride @ xy.astype(np.int64)
         if masked:
-            flat = flat[idx]
-        self.cell[idx] = flat
-        # A front that stepped into a pruned cell freezes there (and does not burn it).
+            flat = flat[rows]
+        self.cell[rows] = flat
         st = self._state_flat[flat]
         if flat.size <= _SMALL:  # a few fronts: the checks below on Python ints
             st_list = st.tolist()
             if PRUNED in st_list:
-                self._freeze(st, idx)
-            fresh = self._ignite_cells(
-                [c for c, v in zip(flat.tolist(), st_list, strict=True) if v == UNBURNT]
+                self._freeze(st, idx if isinstance(rows, slice) else rows)
+            fresh = ignite_cells(
+                self, [c for c, v in zip(flat.tolist(), st_list, strict=True) if v == UNBURNT]
             )
         else:
             if np.count_nonzero(st == _PRUNED8):
-                self._freeze(st, idx)
+                self._freeze(st, idx if isinstance(rows, slice) else rows)
             fresh = self._ignite(flat, st)
         return fresh if new.size == 0 else np.concatenate([new, fresh])
 
-    def _freeze(self, st: np.ndarray, idx) -> None:
-        """Freeze the moving fronts (rows ``idx``, or all moving ones) whose new cell, of state
-        ``st``, is pruned."""
-        into_pruned = st == _PRUNED8
-        self.frozen[self._moving[into_pruned] if isinstance(idx, slice) else idx[into_pruned]] = (
-            True
-        )
+    def _wake_regions(self) -> np.ndarray:
+        """Activate the regions whose delay has passed; return their ignition cells that started
+        burning."""
+        new = _EMPTY
+        waking = (~self.region_active) & (self.delay_ticks <= self.tick)
+        if waking.any():
+            self.region_active |= waking
+            self._moving = None
+            new = self._ignite(self.cell[self.alive & waking[self.region]])
+        self._set_next_wake()
+        return new
+
+    def _advance_moving(self, idx: np.ndarray, t: int) -> np.ndarray:
+        """One FARSITE step of the moving fronts ``idx`` with row ``t`` of the wind drawn ahead;
+        return their new positions, ``(2, k)``, also written back into the fronts.
+
+        ``R = fuel terrain[round(x), round(y)]``, ``C = R dt (C/R)(U)``, then
+        ``x += C sin(Theta)`` and ``y += C cos(Theta)``.
+        """
+        idx2 = self._m_idx2  # idx in the flat (2 n) positions: 1-D takes, not 2-D fancy indexing
+        xy = self._xy.reshape(-1)[idx2].reshape(2, -1)
+        sin_cos = self._pre_sc[t].reshape(-1)[idx2].reshape(2, -1)
+        pre_ratio = self._pre_ratio
+        ratio = _ratio(self._pre_u[t][idx]) if pre_ratio is None else pre_ratio[t][idx]
+        terrain = self._terrain_flat[self._t_stride @ np.rint(xy).astype(np.int64)]
+        c = terrain * self._m_fuel_dt * ratio
+        xy += np.multiply(sin_cos, c)
+        self._xy.reshape(-1)[idx2] = xy.reshape(-1)
+        return xy
+
+    def _freeze(self, st: np.ndarray, idx: np.ndarray) -> None:
+        """Freeze the moved fronts ``idx`` whose new cell, of state ``st``, is pruned."""
+        self.frozen[idx[st == _PRUNED8]] = True
         self._moving = None
 
     def _refill(self) -> None:
-        """Draw the next ``_pre_len`` ticks of every front (two normals each, in the order
-        per-tick draws of shape ``(2, n)`` would take them) and compute what does not depend on
-        the positions: ``U = U_avg + 2 N``, C/R of ``U``, ``sin`` and ``cos`` of
-        ``Theta = theta_avg + 2 N``. Element by element these are the per-tick operations, so
-        the fronts move exactly as if everything were computed tick by tick."""
-        z = self.rng.standard_normal(out=self._pre_z)
-        theta = z[:, 1]
-        theta *= WIND_DIR_SD_RAD
-        theta += self._theta
-        np.sin(theta, out=self._pre_sc[:, 0])
-        np.cos(theta, out=self._pre_sc[:, 1])
-        u = self._pre_u  # the speed draws, overwritten
-        u *= WIND_SPEED_SD
-        u += self._wind
-        if self._pre_ratio is not None:
-            self._pre_ratio[:] = _interp(u.reshape(-1), _U_GRID, _RATIO_TABLE, None, None).reshape(
-                u.shape
-            )
+        """Compute the wind of the next ``_pre_len`` ticks of every front at once: row ``t`` is
+        what :func:`wind_draws` would give on tick ``t`` of the block, bit for bit."""
+        pre = (self._pre_z, self._pre_sc, self._pre_ratio)
+        sd = (WIND_SPEED_SD, WIND_DIR_SD_RAD)
+        draw_ahead(self.rng, *pre, self._wind, self._theta, *sd, _interp_ratio)
 
     def _set_next_wake(self) -> None:
         """Tick at which the next inactive region activates (never: a huge number)."""
         waiting = self.delay_ticks[~self.region_active]
         self._next_wake = int(waiting.min()) if waiting.size else _NEVER
 
-    def _refresh_moving(self) -> None:
-        """Cache the fronts that move (alive, region active, not frozen) and their parameters."""
+    def _refresh_moving(self) -> np.ndarray:
+        """Cache the fronts that move (alive, region active, not frozen) and their parameters;
+        return their rows."""
         idx = np.flatnonzero(self.alive & self.region_active[self.region] & ~self.frozen)
         self._moving = idx
         self._all_moving = idx.size == self.n_fronts
@@ -513,6 +520,7 @@ class Fire:
         self._fuel_dt_masked = fuel_dt  # (n,): 0 for the fronts that do not move
         # coordinates of the idle fronts inside the map, as the step's check counts them
         self._idle_inside = int(np.count_nonzero(self._xy[:, idle].view(np.uint64) < self._w_bits))
+        return idx
 
     def prune(self, flat: np.ndarray) -> np.ndarray:
         """Put out burning cells; return the flat indices actually pruned (they were burning).
@@ -539,15 +547,6 @@ class Fire:
 _EMPTY = np.zeros(0, dtype=np.int64)
 
 
-def _unique(a: np.ndarray) -> np.ndarray:
-    """``np.unique`` of a 1-D array (sorted distinct values), with less call overhead."""
-    s = np.sort(a)
-    keep = np.empty(s.size, dtype=bool)
-    keep[:1] = True
-    np.not_equal(s[1:], s[:-1], out=keep[1:])
-    return s[keep]
-
-
 def _ratio_grid() -> np.ndarray:
     """Wind speeds at which C/R is tabulated: uniform, plus log-spaced points around the kinks
     where LB(U) = 1 (there sqrt|LB^2 - 1| has an infinite slope)."""
@@ -563,15 +562,18 @@ def _ratio_grid() -> np.ndarray:
     return np.unique(np.concatenate(pieces))
 
 
-# C/R tabulated once. Small batches use np.interp on a grid refined around the kinks (error < 1e-5
-# everywhere); large batches index a uniform 0.001 grid directly (np.interp's search is slow on
-# unsorted input): error < 1.5e-4 except within 0.002 of the kinks at U = 0 and U = -6.219, where
-# it stays < 0.0065 (a front's wind draw lands there with probability about 1e-5 per tick).
+# C/R tabulated once (accuracy: module docstring): np.interp on a grid refined around the kinks,
+# and a uniform 0.001 grid indexed directly for large batches (np.interp's search is slow there).
 _U_GRID = _ratio_grid()
 _RATIO_TABLE = spread_rate_ratio(_U_GRID)
 _U_LO, _U_STEP, _U_N = -40.0, 1e-3, 100_001
 _UNI_TABLE = spread_rate_ratio(_U_LO + _U_STEP * np.arange(_U_N))
 _UNI_SLOPE = np.diff(_UNI_TABLE, append=_UNI_TABLE[-1])
+
+
+def _interp_ratio(u: np.ndarray) -> np.ndarray:
+    """Tabulated :func:`spread_rate_ratio` of a 1-D array by linear interpolation."""
+    return _interp(u, _U_GRID, _RATIO_TABLE, None, None)
 
 
 def _ratio(u: np.ndarray) -> np.ndarray:

@@ -2,23 +2,30 @@
 
 Agents are held as arrays (one row per agent, scenario order: perception, action, hybrid) so a tick
 moves the whole team with a few numpy operations. Only agents that *arrive* somewhere (a goal, the
-depot) are handled one by one, which happens a few times per second at most. Teams of up to
-:data:`SMALL_TEAM` agents are moved by a loop on Python floats instead (numpy's per-call cost
-dominates there); it performs the same IEEE operations and gives bit-identical states (tested).
+depot) are handled one by one, which happens a few times per second at most.
 
-Rules (ARCHITECTURE.md "Agents", FIRECOMMANDER.md section 4, rescaled to ``ticks_per_second``):
+The rules below are those of the FireCommander manual and the reference game (FIRECOMMANDER.md
+section 4), with the manual's per-frame quantities read per tick at 10 ticks per second and
+rescaled to ``ticks_per_second`` (``s = 10 / ticks_per_second``). Units: px (1 px = 1 m) on the
+map, m of altitude, battery units, simulated seconds.
 
-* **Motion.** An agent flies straight at its own speed (scenario px per tick at 10 Hz) to its
-  current goal; when closer than one step it snaps onto the goal and takes the next one. After the
-  last goal it hovers, unless its route is a patrol loop, which repeats.
+* **Motion.** An agent flies straight at its own speed ``v s`` px per tick (``v``: the scenario's
+  px per frame) to its current goal: ``p <- p + v s (g - p) / |g - p|``; when ``|g - p| <= v s`` it
+  snaps onto the goal and takes the next one. After the last goal it hovers, unless its route is
+  a patrol loop, which repeats.
 * **Altitude.** Perception and hybrid agents climb or descend toward their commanded altitude at
-  5 m per 0.1 s, within their altitude bounds; action agents fly at 30 m.
-* **Field of view.** A rectangle centred on the agent, ``2 z`` wide (x) and ``2 tan(pi/6) z``
-  (about ``1.1547 z``) high (y); cell ``(i, j)`` is inside when ``|i - x| <= z`` and
-  ``|j - y| <= 0.57735 z`` (inclusive, as the reference).
-* **Battery.** Flying drains 0.1 per px and hovering 0.05 per 0.1 s. An active agent heads home
-  (and later resumes its route) as soon as its remaining battery would no longer cover the flight
-  home after one more step, so the battery never goes negative.
+  ``5 s`` m per tick, within their altitude bounds; action agents fly at
+  :data:`~fcplan.scenario.model.ACTION_ALTITUDE` (30 m).
+* **Field of view.** A rectangle centred on the agent, ``2 tan(pi/4) z = 2 z`` wide (x) and
+  ``2 tan(pi/6) z`` (about ``1.1547 z``) high (y); cell ``(i, j)`` is inside when ``|i - x| <= z``
+  and ``|j - y| <= 0.57735 z`` (inclusive, as the reference).
+* **Sensing confidence.** ``c = 1 - 0.6 (z - lo) / (hi - lo)`` (1 when ``lo == hi``): 100% at the
+  lowest altitude, 40% at the highest (manual, sensing).
+* **Battery.** Flying drains 0.1 per px and hovering ``0.05 s`` per tick (the manual's "0.1 per
+  unit length, 0.05 per iteration"). An active agent heads home (and later resumes its route) as
+  soon as ``B <= 0.1 |home - p| + 0.2 v s + 0.1 s``: after one more step, which can also lengthen
+  the way home by one step, it must still afford the flight home plus a hover tick, so the
+  battery never goes negative.
 * **Tank and dumps.** Arriving at a goal arms one dump. An armed action or hybrid agent dumps as
   soon as a dump can do something (see :mod:`fcplan.world`): one tank unit per dump, so tank ``T``
   gives ``T`` dumps (the 2020 code gave ``T + 1``). An empty tank sends the agent home.
@@ -26,6 +33,9 @@ Rules (ARCHITECTURE.md "Agents", FIRECOMMANDER.md section 4, rescaled to ``ticks
   its route (or flies back to the last goal it was holding), after a commanded return (or the
   3-second rule) it stays idle.
 * **3-second rule.** An action agent hovering at its last goal for 3 s goes home and idles.
+
+Teams of up to :data:`SMALL_TEAM` agents run bit-identical kernels of these rules on Python numbers
+(:mod:`fcplan._fast.team`); the numpy methods here are the rules' specification.
 
 Examples
 --------
@@ -47,7 +57,12 @@ from enum import IntEnum
 
 import numpy as np
 
+from fcplan._fast.team import fov_rects_small, move_small, rules_small
 from fcplan.errors import PlanError
+from fcplan.scenario.model import (
+    ACTION_ALTITUDE as ACTION_ALTITUDE,
+)  # (re-exported: one definition)
+from fcplan.scenario.model import Role, Scenario
 
 __all__ = ["Mode", "Command", "Team", "fov_half_extent", "sensing_confidence"]
 
@@ -55,10 +70,9 @@ FOV_TAN_X = 1.0  # tan(pi/4): half-width per metre of altitude (exact, not 0.999
 FOV_TAN_Y = math.tan(math.pi / 6)  # half-height per metre of altitude
 DRAIN_PER_PX = 0.1
 DRAIN_PER_HOVER_TICK = 0.05  # at 10 ticks/s
-ACTION_ALTITUDE = 30.0
 CLIMB_PER_TICK = 5.0  # m per tick at 10 ticks/s
 ACTION_IDLE_LIMIT_S = 3.0
-#: teams up to this many agents move on Python floats (:meth:`Team.move`)
+#: teams up to this many agents move on Python floats (:mod:`fcplan._fast.team`)
 SMALL_TEAM = 16
 
 
@@ -126,7 +140,13 @@ def sensing_confidence(z: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndar
 
 
 _IDLE, _ACTIVE, _RETURNING, _HOMING = (int(m) for m in Mode)
-_ROLE_ACTION = 1
+_ROLE_ACTION = int(Role.ACTION)
+_NO_ROWS = np.zeros(0, dtype=np.int64)
+_ACTIVE8, _RETURNING8 = np.int8(_ACTIVE), np.int8(_RETURNING)
+_IDLE_LIMIT = np.float64(ACTION_IDLE_LIMIT_S - 1e-9)
+_ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
+_TINY = np.float64(5e-324)  # smallest positive double
+_FOV_SCALE = np.array([-FOV_TAN_X, FOV_TAN_X, -FOV_TAN_Y, FOV_TAN_Y])
 
 
 class Team:
@@ -157,9 +177,13 @@ class Team:
         :class:`Mode` values.
     """
 
-    def __init__(self, scenario) -> None:
-        from fcplan.scenario import Role
+    # rule constants read by the kernels of fcplan._fast.team (which cannot import this module)
+    _modes = (_IDLE, _ACTIVE, _RETURNING, _HOMING)
+    _drain_per_px = DRAIN_PER_PX
+    _idle_limit = float(_IDLE_LIMIT)
+    _fov_scale_list = _FOV_SCALE.tolist()
 
+    def __init__(self, scenario: Scenario) -> None:
         agents = scenario.agents
         self.ids = tuple(a.id for a in agents)
         self._index = {a: i for i, a in enumerate(self.ids)}
@@ -186,7 +210,7 @@ class Team:
         self._speed_margin = 2.0 * DRAIN_PER_PX * self.speed  # (speed is fixed per team)
         self._climb = CLIMB_PER_TICK * self.tick_scale
         self._is_action = self.role == _ROLE_ACTION
-        # the small-team path of move() reads these constants as Python numbers
+        # the small-team kernels (fcplan._fast.team) read these constants as Python numbers
         self._small = 0 < n <= SMALL_TEAM
         self._home_list = [tuple(h) for h in self.home.tolist()]
         self._speed_list = self.speed.tolist()
@@ -244,23 +268,12 @@ class Team:
         """:meth:`fov_rects` as nested Python lists (the same values)."""
         if not self._small:
             return self.fov_rects().tolist()
-        # the same operations as fov_rects on Python floats: x + z (-t) per bound (a plain loop:
-        # cheaper than a comprehension's own frame on Python 3.11 for a handful of agents)
-        ax, bx, ay, by = _FOV_SCALE_LIST
-        rects = []
-        for (x, y), z in zip(self.pos.tolist(), self.z.tolist(), strict=True):
-            rects.append([x + z * ax, x + z * bx, y + z * ay, y + z * by])
-        return rects
+        return fov_rects_small(self)
 
     def sensing_confidence(self) -> np.ndarray:
         """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""
         c = 1.0 - 0.6 * (self.z - self.alt_lo) * self._inv_span
         return np.minimum(np.maximum(c, 0.4), 1.0) * self.can_sense
-
-    def _sensing_confidence_of(self, i: int) -> float:
-        """:meth:`sensing_confidence` of row ``i`` (same IEEE operations, on Python floats)."""
-        c = 1.0 - 0.6 * (float(self.z[i]) - float(self.alt_lo[i])) * float(self._inv_span[i])
-        return min(max(c, 0.4), 1.0) * bool(self.can_sense[i])
 
     def return_cost(self) -> np.ndarray:
         """(N,) battery needed to fly straight home from where each agent is."""
@@ -321,16 +334,17 @@ class Team:
     def move(self) -> np.ndarray:
         """Move every agent one tick; return the rows that arrived at a route goal this tick.
 
-        Teams of up to :data:`SMALL_TEAM` agents take :meth:`_move_small` (the same IEEE
-        operations on Python floats: a few numpy calls cost more than the whole loop there),
-        larger ones :meth:`_move_vector`; both give bit-identical states.
+        Teams of up to :data:`SMALL_TEAM` agents take :func:`fcplan._fast.team.move_small` (the
+        same IEEE operations on Python floats), larger ones :meth:`_move_vector`, the rule; both
+        give bit-identical states.
         """
         if self._small:
-            return self._move_small()
+            return move_small(self)
         return self._move_vector()
 
     def _move_vector(self) -> np.ndarray:
-        """:meth:`move` with numpy on the whole team."""
+        """:meth:`move` with numpy on the whole team: the motion, hover, altitude and arrival
+        rules of the module docstring, in that order, then the battery and 3-second rules."""
         # (np.count_nonzero is the cheapest "any" on these tiny arrays)
         mode = self.mode
         active = mode == _ACTIVE8
@@ -364,169 +378,6 @@ class Team:
             arrived_goal = _NO_ROWS
             self._rules(active)
         return arrived_goal
-
-    def _move_small(self) -> np.ndarray:
-        """:meth:`_move_vector` agent by agent on Python floats (same operations, same order, so
-        the same rounding; ``hypot`` is numpy's, or ``|d|`` when one component is zero, which
-        C's Annex F makes exact).
-
-        Only the agents that fly or hover are touched. Every other one would move by
-        ``(d / |d|) 0.0``, the zero of ``d``'s sign: ``x + (+-0.0)`` is ``x`` unless ``x`` is a
-        zero (whose sign it may change, so zero coordinates take that operation), and its
-        battery and distance would change by ``+-0.0``, which leaves them as they are (a distance
-        is never ``-0.0``)."""
-        mode = self.mode.tolist()
-        pos = self.pos.ravel().tolist()  # flat [x0, y0, x1, y1, ...], updated in place below
-        has_goal = self.has_goal.tolist()
-        home = self._home_list
-        goal = None
-        act = []  # ACTIVE rows
-        hover = []  # ACTIVE rows without a goal
-        legs = []  # flyers: [row, target x, target y, dx, dy, |d|]
-        hyp_k, hyp_x, hyp_y = [], [], []  # legs that need numpy's hypot
-        for i, m in enumerate(mode):
-            if m == _ACTIVE:
-                act.append(i)
-                if not has_goal[i]:
-                    hover.append(i)
-                    continue
-                if goal is None:
-                    goal = self.goal.tolist()
-                tx, ty = goal[i]
-            elif m >= _RETURNING:  # RETURNING or HOMING: flies home
-                tx, ty = home[i]
-            else:
-                continue
-            dx, dy = tx - pos[2 * i], ty - pos[2 * i + 1]
-            if dy == 0.0:  # hypot(x, +-0) is |x| exactly (C99 Annex F)
-                legs.append([i, tx, ty, dx, dy, abs(dx)])
-            elif dx == 0.0:
-                legs.append([i, tx, ty, dx, dy, abs(dy)])
-            else:
-                hyp_k.append(len(legs))
-                hyp_x.append(dx)
-                hyp_y.append(dy)
-                legs.append([i, tx, ty, dx, dy, 0.0])
-        # zero coordinates of agents that do not fly (x + 0.0 (t - x) may flip a -0.0)
-        moved = bool(legs)
-        if 0.0 in pos:
-            for i, m in enumerate(mode):
-                if m < _RETURNING and not (m == _ACTIVE and has_goal[i]):
-                    x, y = pos[2 * i], pos[2 * i + 1]
-                    if x == 0.0 or y == 0.0:
-                        if goal is None:
-                            goal = self.goal.tolist()
-                        tx, ty = goal[i]
-                        pos[2 * i] = x + 0.0 * (tx - x)
-                        pos[2 * i + 1] = y + 0.0 * (ty - y)
-                        moved = True
-        battery = None
-        arrived = None  # rows that reached their target
-        if legs:
-            if hyp_k:
-                for k, d in zip(hyp_k, np.hypot(hyp_x, hyp_y).tolist(), strict=True):
-                    legs[k][5] = d
-            speed = self._speed_list
-            dist = self.distance.tolist()
-            battery = self.battery.tolist()
-            for i, tx, ty, dx, dy, d in legs:
-                sp = speed[i]
-                if d <= sp:
-                    pos[2 * i] = tx
-                    pos[2 * i + 1] = ty
-                    step = d
-                    if arrived is None:
-                        arrived = [i]
-                    else:
-                        arrived.append(i)
-                else:
-                    # max(d, _TINY_F) without the call (a NaN distance stays NaN, as np.maximum)
-                    den = d if not d < _TINY_F else _TINY_F
-                    pos[2 * i] += dx / den * sp
-                    pos[2 * i + 1] += dy / den * sp
-                    step = sp
-                dist[i] += step
-                battery[i] -= DRAIN_PER_PX * step
-            self.distance[:] = dist
-        if moved:
-            self.pos = np.array(pos, dtype=np.float64).reshape(self.n, 2)
-        hover_s = None  # None: every hover clock is 0
-        if hover:
-            if battery is None:
-                battery = self.battery.tolist()
-            hd, dt, old = self._hover_drain, self.dt_s, self.hover_s.tolist()
-            hover_s = [0.0] * self.n
-            for i in hover:
-                battery[i] -= hd
-                hover_s[i] = old[i] + dt
-            self.hover_s = np.array(hover_s, dtype=np.float64)
-        else:
-            self.hover_s = np.zeros(self.n)
-        if battery is not None:
-            self.battery[:] = battery
-        # altitude
-        z, zt = self.z.tolist(), self.z_target.tolist()
-        if z != zt:  # (NaN targets compare unequal, as in the vector path)
-            # an agent at its target altitude moves by +0.0, which changes only a -0.0
-            climb, lo, sense = self._climb, -self._climb, self._can_sense_list
-            for i, (zi, t) in enumerate(zip(z, zt, strict=True)):
-                if zi != t or zi == 0.0:
-                    z[i] = zi + min(max(t - zi, lo), climb) * sense[i]
-            self.z[:] = z
-        if arrived is not None:
-            # docking first, then the next goals, as the vector path
-            for i in arrived:
-                if mode[i] >= _RETURNING:
-                    self._dock(i)
-            rows = [i for i in arrived if mode[i] == _ACTIVE]
-            for i in rows:
-                self._next_goal(i)
-            self._rules()  # docking changed modes
-            return np.array(rows, dtype=np.intp) if rows else _NO_ROWS
-        if act:
-            self._rules_lists(act, mode, pos, battery, hover_s)
-        return _NO_ROWS
-
-    def _rules_lists(
-        self, rows: list, mode: list, pos: list, battery: list, hover_s: list | None
-    ) -> None:
-        """:meth:`_rules` of a small team on Python numbers (``rows``: the ACTIVE rows, in
-        order; the current modes, flat positions ``[x0, y0, x1, y1, ...]``, batteries and hover
-        clocks as lists; ``hover_s`` None when every clock is 0).
-
-        An agent whose battery is above an upper bound of its reserve (``hypot(d) <= |dx| +
-        |dy|``, with a margin covering every rounding) is certainly not low; only the others
-        need the exact reserve, with numpy's ``hypot`` and the vector rule's operations."""
-        hm, home, margins = self._hover_margin, self._home_list, self._speed_margin_list
-        near = None
-        for i in rows:
-            hx, hy = home[i]
-            if (
-                not battery[i]
-                > (
-                    DRAIN_PER_PX * (abs(hx - pos[2 * i]) + abs(hy - pos[2 * i + 1]))
-                    + margins[i]
-                    + hm
-                )
-                * _BOUND
-            ):
-                if near is None:
-                    near = [i]
-                else:
-                    near.append(i)
-        if near is not None:
-            dx = [home[i][0] - pos[2 * i] for i in near]
-            dy = [home[i][1] - pos[2 * i + 1] for i in near]
-            for i, h in zip(near, np.hypot(dx, dy).tolist(), strict=True):
-                if battery[i] <= DRAIN_PER_PX * h + margins[i] + hm:
-                    self.mode[i] = _RETURNING
-                    mode[i] = _RETURNING
-        if hover_s is None or not max(hover_s) >= _IDLE_LIMIT_F:  # (the usual case)
-            return
-        for i, (m, h, act) in enumerate(zip(mode, hover_s, self._is_action_list, strict=True)):
-            if m == _ACTIVE and act and h >= _IDLE_LIMIT_F:
-                self.mode[i] = _HOMING
-                self.has_goal[i] = False
 
     def _fly(self, flying: np.ndarray, going_home: np.ndarray, active: np.ndarray) -> np.ndarray:
         """One step toward each flying agent's target; return the (N,) bool rows that arrived."""
@@ -593,12 +444,14 @@ class Team:
 
     def _rules(self, active: np.ndarray | None = None) -> None:
         """Battery reserve, and the 3-second rule for action agents (``active``: the rows in
-        ACTIVE mode, if the caller has them)."""
+        ACTIVE mode, if the caller has them). Small teams take
+        :func:`fcplan._fast.team.rules_small`."""
         if self._small:
             mode = self.mode.tolist()
             rows = [i for i, m in enumerate(mode) if m == _ACTIVE]
             if rows:  # (without ACTIVE agents neither rule applies)
-                self._rules_lists(
+                rules_small(
+                    self,
                     rows,
                     mode,
                     self.pos.ravel().tolist(),
@@ -638,15 +491,3 @@ class Team:
         current way home)."""
         d = self.home - self.pos
         return np.maximum(self.battery / DRAIN_PER_PX - np.hypot(d[:, 0], d[:, 1]), 0.0)
-
-
-_NO_ROWS = np.zeros(0, dtype=np.int64)
-_ACTIVE8, _RETURNING8 = np.int8(_ACTIVE), np.int8(_RETURNING)
-_IDLE_LIMIT = np.float64(ACTION_IDLE_LIMIT_S - 1e-9)
-_IDLE_LIMIT_F = float(_IDLE_LIMIT)
-_TINY_F = 5e-324
-_BOUND = 1.0 + 1e-9  # relative margin of _rules_lists's reserve bound
-_ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
-_TINY = np.float64(5e-324)  # smallest positive double
-_FOV_SCALE = np.array([-FOV_TAN_X, FOV_TAN_X, -FOV_TAN_Y, FOV_TAN_Y])
-_FOV_SCALE_LIST = _FOV_SCALE.tolist()

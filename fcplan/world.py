@@ -33,14 +33,16 @@ True
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
-from fcplan.fire import _BURNING8, BLOCK, Fire, _unique
+from fcplan._fast.team import sensing_confidence_of
+from fcplan._fast.world import scan_box as _scan_box
+from fcplan._fast.world import step_info_builder
+from fcplan.fire import _BURNING8, Fire, _unique
 from fcplan.team import Command, Team
 from fcplan.trace import Trace
 
@@ -73,70 +75,7 @@ class StepInfo:
         return np.array(self.fov_rects, dtype=np.float64).reshape(-1, 4)
 
 
-def _info_builder():
-    """A function building a :class:`StepInfo` from its fields in order, like ``StepInfo(...)``
-    at half the cost: the frozen dataclass's ``__init__`` goes through ``object.__setattr__`` per
-    field, this sets the slots through their descriptors (no ``__post_init__`` to run)."""
-    new = object.__new__
-    (s_tick, s_time, s_ign, s_sensed, s_newly, s_pruned, s_fov, s_dumped, s_arrived) = (
-        getattr(StepInfo, f.name).__set__ for f in dataclasses.fields(StepInfo)
-    )
-
-    def build(tick, time_s, ignited, sensed, newly, pruned, fov_rects, dumped, arrived):
-        info = new(StepInfo)
-        s_tick(info, tick)
-        s_time(info, time_s)
-        s_ign(info, ignited)
-        s_sensed(info, sensed)
-        s_newly(info, newly)
-        s_pruned(info, pruned)
-        s_fov(info, fov_rects)
-        s_dumped(info, dumped)
-        s_arrived(info, arrived)
-        return info
-
-    return build
-
-
-_step_info = _info_builder()
-
-
-def _scan_box(rect: list[float], blocks: np.ndarray, w: int) -> tuple[int, int, int, int] | None:
-    """The part of the field of view ``rect`` (inclusive ``[x0, x1, y0, y1]`` of Python floats)
-    that can hold burning cells, as an end-exclusive cell range ``(x0, x1, y0, y1)``, or None.
-
-    The range is that of the cells covered by ``rect``, clipped to the ``w x w`` map, then shrunk
-    to the bounding box of its ``BLOCK``-sized blocks that hold a burning cell (``blocks``: the
-    fire's per-block counts). Every burning cell of the covered range lies in the box, so scanning
-    the box row-major finds the same cells in the same order as scanning the whole range. None
-    when the range is empty or holds no burning block.
-    """
-    # (conditional expressions: cheaper than max()/min() calls on this per-tick path)
-    a = math.ceil(rect[0])
-    x0 = a if a > 0 else 0
-    a = math.floor(rect[1])
-    x1 = a if a < w - 1 else w - 1
-    a = math.ceil(rect[2])
-    y0 = a if a > 0 else 0
-    a = math.floor(rect[3])
-    y1 = a if a < w - 1 else w - 1
-    if x1 < x0 or y1 < y0:
-        return None
-    i0, j0 = x0 // BLOCK, y0 // BLOCK
-    b = blocks[i0 : x1 // BLOCK + 1, j0 : y1 // BLOCK + 1]
-    if not np.count_nonzero(b):
-        return None
-    bi, bj = b.nonzero()  # (the method: cheaper than np.nonzero's dispatch)
-    bj = bj.tolist()
-    a = (i0 + int(bi[0])) * BLOCK
-    x0 = a if a > x0 else x0
-    a = (i0 + int(bi[-1]) + 1) * BLOCK
-    x1 = a if a <= x1 else x1 + 1
-    a = (j0 + min(bj)) * BLOCK
-    y0 = a if a > y0 else y0
-    a = (j0 + max(bj) + 1) * BLOCK
-    y1 = a if a <= y1 else y1 + 1
-    return x0, x1, y0, y1
+_step_info = step_info_builder(StepInfo)  # StepInfo(...), cheaper
 
 
 class World:
@@ -340,7 +279,7 @@ class World:
             flat = self._cells(state[x0:x1, y0:y1] == _BURNING8, x0, y0)
             if flat.size == 0:
                 continue
-            keep = self.rng_sense.random(flat.size) < team._sensing_confidence_of(i)
+            keep = self.rng_sense.random(flat.size) < sensing_confidence_of(team, i)
             if np.count_nonzero(keep):
                 parts.append(flat[keep])
         if not parts:
