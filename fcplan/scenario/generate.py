@@ -321,7 +321,7 @@ def _layout(cfg: GeneratorConfig, rng: np.random.Generator, world: int, depot: D
     counts = {kind: _int(rng, getattr(cfg, f"n_{kind}s")) for kind in FACILITY_KINDS}
     n_lakes = _int(rng, cfg.n_lakes)
     penalties = {kind: getattr(cfg, f"{kind}_penalty") for kind in FACILITY_KINDS}
-    problem = PlacementError("n_regions", "")
+    problem = PlacementError("n_regions", "", "")
     for _ in range(_ATTEMPTS):
         lay = GridLayout(world, depot)
         try:
@@ -345,8 +345,7 @@ def _layout(cfg: GeneratorConfig, rng: np.random.Generator, world: int, depot: D
         return lay
     raise ScenarioError(
         problem.knob,
-        f"{problem.what} in {_ATTEMPTS} layouts of a {world} px map; ask for fewer objects, "
-        "a bigger map or a wider facility_fire_distance_px",
+        f"{problem.what} ({_ATTEMPTS} layouts of a {world} px map tried); {problem.hint}",
         got=getattr(cfg, problem.knob),
         source=_SOURCE,
     )

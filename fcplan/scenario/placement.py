@@ -52,11 +52,13 @@ class PlacementError(Exception):
         The generator setting that would have to change (e.g. ``"n_houses"``).
     what : str
         What could not be placed, and why.
+    hint : str
+        What to change.
     """
 
-    def __init__(self, knob: str, what: str):
-        super().__init__(f"{knob}: {what}")
-        self.knob, self.what = knob, what
+    def __init__(self, knob: str, what: str, hint: str):
+        super().__init__(f"{knob}: {what}; {hint}")
+        self.knob, self.what, self.hint = knob, what, hint
 
 
 def pick(rng: np.random.Generator, mask: np.ndarray) -> tuple[int, int]:
@@ -165,12 +167,13 @@ class GridLayout:
         dist = np.hypot(x - dx, y - dy)
         ok = free & (dist >= min_depot_distance)
         if not ok.any():
-            what = f"leaves no grid cell for a fire region on a {self.world} px map"
-            raise PlacementError("min_depot_distance_px", what)
+            what, hint = "leaves no grid cell for a fire region", "lower it or use a bigger map"
+            raise PlacementError("min_depot_distance_px", what, hint)
         self.far_px = far_fraction * float(dist.max())
         far = ok & (dist >= self.far_px)
         if (n_late or placement == "far") and not far.any():
-            raise PlacementError("far_fraction", "leaves no far grid cell for a fire region")
+            what = "leaves no far grid cell for a fire region"
+            raise PlacementError("far_fraction", what, "lower it or min_depot_distance_px")
         base = far if placement == "far" else ok
         clusters = []
         if placement == "clustered":
@@ -218,7 +221,8 @@ class GridLayout:
                     ok &= ~((x + x0 < bx1) & (bx0 < x + x1) & (y + y0 < by1) & (by0 < y + y1))
                 if not ok.any():
                     what = f"no free block {lo:g}..{hi:g} px from a fire region for {kind} {k + 1}"
-                    raise PlacementError(f"n_{kind}s", what)
+                    hint = "ask for fewer, a bigger map or a wider facility_fire_distance_px"
+                    raise PlacementError(f"n_{kind}s", what, hint)
                 cell = self._reserve(kind, *pick(rng, ok))
                 center = cell_center(cell, kind, self.world)
                 f = Facility.standard(kind, center, cell=cell, penalty=penalties[kind])
@@ -230,6 +234,10 @@ class GridLayout:
         for k in range(n):
             free, _, _ = self._blocks("lake")
             if not free.any():
-                raise PlacementError("n_lakes", f"no free 3 x 4 block for lake {k + 1}")
+                what, hint = (
+                    f"no free 3 x 4 block for lake {k + 1}",
+                    "ask for fewer or a bigger map",
+                )
+                raise PlacementError("n_lakes", what, hint)
             cell = self._reserve("lake", *pick(rng, free))
             self.lakes.append(Lake(cell_center(cell, "lake", self.world), cell))
