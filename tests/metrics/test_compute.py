@@ -1,4 +1,4 @@
-"""Tests of fcplan.metrics: both score definitions, hand-computed and as invariants.
+"""Tests of fcplan.metrics.compute: both score definitions, hand-computed and as invariants.
 
 Equation numbers follow fcplan.metrics: the manual's score section in order, (1) total negative
 reward ... (8) expected negative reward.
