@@ -32,8 +32,6 @@ Examples
 >>> from fcplan import World, load_scenario
 >>> from fcplan.render import render_frame, snapshot
 >>> world = World().reset(load_scenario("practice"), seed=0)
->>> for _ in range(30):
-...     _ = world.step()
 >>> img = render_frame(world.scenario, snapshot(world), size=256)
 >>> img.shape[0], img.dtype.name
 (256, 'uint8')
