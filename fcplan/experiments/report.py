@@ -57,8 +57,13 @@ from typing import Any
 import numpy as np
 
 from fcplan.errors import FcplanError
-from fcplan.experiments import plots as _plots
 from fcplan.experiments.optional import require
+from fcplan.experiments.plots import (
+    plot_distribution,
+    plot_grouped,
+    plot_solve_time,
+    scheduler_colors,
+)
 from fcplan.experiments.results import load_results
 from fcplan.experiments.stats import mean_ci
 from fcplan.experiments.tables import REPORT_COLUMNS, difficulty_key, higher_is_better
@@ -349,11 +354,11 @@ def _draw_plots(
     mpl = require("matplotlib", "plot")
     if "matplotlib.pyplot" not in sys.modules:
         mpl.use("Agg")  # files only; a notebook keeps its own backend
-    colors = _plots.scheduler_colors(names)
+    colors = scheduler_colors(names)
     label = _label(metric)
     ok = df[df["status"] == "ok"]
     p = out_dir / "score_distribution.png"
-    _plots.plot_distribution(ok, names, metric, label, p, colors)
+    plot_distribution(ok, names, metric, label, p, colors)
     images = [(f"{label} per episode", p)]
     for col, groups, name, title, caption in (
         ("difficulty", diffs, "score_by_difficulty", "by difficulty group", "by difficulty"),
@@ -361,10 +366,10 @@ def _draw_plots(
     ):
         p = out_dir / f"{name}.png"
         table = _group_table(df, [col, "scheduler"], [metric])
-        _plots.plot_grouped(table, col, groups, names, metric, label, p, colors, f"{label} {title}")
+        plot_grouped(table, col, groups, names, metric, label, p, colors, f"{label} {title}")
         images.append((f"{label} {caption}", p))
     p = out_dir / "solve_time_vs_size.png"
-    _plots.plot_solve_time(df, names, p, colors)
+    plot_solve_time(df, names, p, colors)
     images.append(("solve time vs problem size", p))
     return images
 

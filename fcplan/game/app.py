@@ -124,9 +124,9 @@ def run_app(
             f"cannot open a window ({exc}); to run headless set SDL_VIDEODRIVER=dummy"
         ) from None
     pygame.display.set_caption("fcplan play - FireCommander")
-    from fcplan.game import view
+    from fcplan.game.view import draw, reset_fonts
 
-    view.reset_fonts()
+    reset_fonts()
     app.set_script(script)
     shot_done = screenshot is None
     clock = pygame.time.Clock()
@@ -142,7 +142,7 @@ def run_app(
             app.advance(dt)
             if not app.running:
                 break
-            view.draw(surf, app)
+            draw(surf, app)
             pygame.display.flip()
             if screenshot is not None and not shot_done and app.screen == "game" and s is not None:
                 due = screenshot_at_s is None or s.world.time_s >= screenshot_at_s

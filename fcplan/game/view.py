@@ -28,7 +28,7 @@ from fcplan.game.screens import App
 from fcplan.game.session import GameSession
 from fcplan.game.tutorial import TUTORIAL
 from fcplan.metrics import METRICS
-from fcplan.render import COLORS, FrameData
+from fcplan.render import COLORS, FrameData, render_frame, snapshot
 
 Surface = Any  # a pygame.Surface (pygame is imported only when drawing)
 Color = tuple[int, int, int]
@@ -157,8 +157,7 @@ def draw(surf: Surface, app: App) -> None:
 @functools.cache
 def _backdrop() -> np.ndarray:
     """The welcome screen's dimmed backdrop: scenario #24 after 40 s, its fire all shown."""
-    from fcplan import load_scenario
-    from fcplan.render import render_frame, snapshot
+    from fcplan.scenario import load_scenario
 
     game = GameSession(load_scenario(24), seed=3)
     while game.tick < 400:
@@ -276,8 +275,6 @@ def _draw_preview(surf: Surface, app: App) -> None:
 
 # ------------------------------------------------------------------------------ game
 def _game_frame(app: App) -> FrameData:
-    from fcplan.render import snapshot
-
     s = app.game
     team, ctl = s.world.team, s.controller
     routes = []
@@ -292,8 +289,6 @@ def _game_frame(app: App) -> FrameData:
 
 def _draw_game(surf: Surface, app: App) -> None:
     import pygame
-
-    from fcplan.render import render_frame
 
     s = app.game
     mx, my, mw, mh = MAP_RECT
