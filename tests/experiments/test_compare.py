@@ -7,8 +7,6 @@ import importlib
 import json
 import math
 import multiprocessing
-import os
-from pathlib import Path
 
 import pytest
 
@@ -21,6 +19,7 @@ from fcplan.experiments.compare import (
     compare,
 )
 from fcplan.scenario import load_scenario
+from tests.experiments.schedulers import DiesOnce
 
 # the package exports the function `compare`, which shadows the module's name as an attribute
 compare_mod = importlib.import_module("fcplan.experiments.compare")
@@ -216,34 +215,17 @@ def test_failing_episode_is_recorded_and_others_complete(monkeypatch):
     assert "1 episode(s) failed" in res.format()
 
 
-class _DiesOnce:
-    """Greedy, except that the first plan() call anywhere kills its worker process (os._exit);
-    the marker file named by $FCPLAN_TEST_DIES_ONCE records that it happened."""
-
-    name = "dies-once"
-
-    def __init__(self):
-        self.marker = Path(os.environ.get("FCPLAN_TEST_DIES_ONCE", ""))
-        self._greedy = scheduling.make_scheduler("greedy")
-
-    def plan(self, graph, *, time_limit=None, rng=None):
-        if self.marker.name and not self.marker.exists():
-            self.marker.touch()
-            os._exit(3)
-        return self._greedy.plan(graph, time_limit=time_limit, rng=rng)
-
-
 def test_dead_worker_restarts_the_pool_and_every_episode_completes(tmp_path, monkeypatch):
     """A worker process that dies mid-episode breaks the pool; the pool restarts (as for sweeps),
     the episodes in flight run again, and every episode completes with greedy's scores."""
     marker = tmp_path / "died"
-    monkeypatch.setitem(scheduling._RUNTIME, "dies-once", _DiesOnce)
-    monkeypatch.setenv("FCPLAN_TEST_DIES_ONCE", str(marker))
-    res = compare([short(3, 10)], ["dies-once", "greedy"], [0, 1], jobs=2)
+    monkeypatch.setitem(scheduling._RUNTIME, "dies-once", DiesOnce)
+    dies = f"dies-once:marker={marker}"
+    res = compare([short(3, 10)], [dies, "greedy"], [0, 1], jobs=2)
     assert marker.exists()
     assert [e["error"] for e in res.episodes] == [""] * 4
     scores = {(e["scheduler"], e["seed"]): e["manual.final_score"] for e in res.episodes}
-    assert [scores["dies-once", k] for k in (0, 1)] == [scores["greedy", k] for k in (0, 1)]
+    assert [scores[dies, k] for k in (0, 1)] == [scores["greedy", k] for k in (0, 1)]
 
 
 def test_keyboard_interrupt_stops_workers():

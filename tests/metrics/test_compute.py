@@ -149,9 +149,10 @@ def test_manual_power_station_and_depot_penalty_5():
     assert compute_metrics(tr).total_negative_reward == pytest.approx(36.0)
 
 
-def test_manual_depot_counted_in_fps():
-    """FPS counts the depot as a facility: only the depot burning gives FPS = 100 * 1/2."""
-    tr = steady_trace(
+def burning_depot_trace() -> Trace:
+    """A steady trace at 1 tick/s: 5 active cells, nothing pruned or sensed, a house untouched and
+    2 cells of the depot burning."""
+    return steady_trace(
         tps=1,
         active=5,
         pruned=0,
@@ -162,6 +163,11 @@ def test_manual_depot_counted_in_fps():
         kinds=("house", "depot"),
         penalties=(1.0, 5.0),
     )
+
+
+def test_manual_depot_counted_in_fps():
+    """FPS counts the depot as a facility: only the depot burning gives FPS = 100 * 1/2."""
+    tr = burning_depot_trace()
     m = compute_metrics(tr)
     assert m.facility_protection == pytest.approx(50.0)
     # rate = 0.1*5 + 5*2 = 10.5 per s, 16 s -> 168; nothing pruned -> EXP = NEG, NRR = 100
@@ -267,17 +273,7 @@ def test_reference_every_equation_multi_facility():
 
 def test_reference_depot_counted_and_penalised():
     """reference2020 counts the depot in FPS and charges PC 5 per burning depot cell (not times T)."""
-    tr = steady_trace(
-        tps=1,
-        active=5,
-        pruned=0,
-        sensed_active=0,
-        sensed_ever=0,
-        burning=(0, 2),
-        fac_pruned=(0, 0),
-        kinds=("house", "depot"),
-        penalties=(1.0, 5.0),
-    )
+    tr = burning_depot_trace()
     m = compute_metrics(tr, "reference2020")
     # NEG = 5*2 + 5 * 0.1 * 16**1.25 = 10 + 16 = 26; EXP = 5 * 0.1 * 32 = 16
     assert m.total_negative_reward == pytest.approx(26.0)
