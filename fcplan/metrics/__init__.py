@@ -8,6 +8,8 @@ the burning fire cost over time. Every score here is a pure function of a :class
 Every metric is described once, in :data:`METRICS` (a :class:`MetricSpec` per field of
 :class:`Metrics`: name, labels, unit, decimals, whether higher is better, what it measures); the
 CLI's text table, the experiment tables and reports, and the game's score panels all iterate it.
+The scores are computed in :mod:`fcplan.metrics.compute` and the table lives in
+:mod:`fcplan.metrics.table`; everything is imported from ``fcplan.metrics``.
 
 Two definitions are computed from the same trace (:data:`DEFINITIONS`):
 
