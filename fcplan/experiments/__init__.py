@@ -5,11 +5,13 @@ experiment runs a grid of them (scenarios x schedulers x seeds), in parallel ove
 cores, and summarises the outcomes with confidence intervals.
 
 * :mod:`~fcplan.experiments.compare`: :func:`compare` runs the grid and returns a
-  :class:`ComparisonResult` (per-episode rows, a per-scheduler table, JSON/CSV output, a text
-  table); :func:`parse_range` reads the CLI's ``1-24``/``1,3,5-7``/``practice`` lists. The
-  ``fcplan compare`` command is a thin layer over them.
+  :class:`ComparisonResult` (:mod:`~fcplan.experiments.comparison`: per-episode rows, a
+  per-scheduler table, JSON/CSV output, a text table); :func:`parse_range`
+  (:mod:`~fcplan.experiments.ranges`) reads the CLI's ``1-24``/``1,3,5-7``/``practice`` lists.
+  The ``fcplan compare`` command is a thin layer over them.
 * :mod:`~fcplan.experiments.stats`: the mean and Student-t confidence interval of the mean, and
-  paired differences.
+  paired differences; :mod:`~fcplan.experiments.tables`: the columns every experiment table
+  summarises, taken from the metric table :data:`fcplan.metrics.METRICS`.
 
 * :mod:`~fcplan.experiments.sweep`: :func:`sweep` runs a TOML grid (scenarios x schedulers and
   their settings x seeds x scenario overrides, :mod:`~fcplan.experiments.config`) on a local
@@ -17,7 +19,12 @@ cores, and summarises the outcomes with confidence intervals.
   episode at once in a Parquet results folder (:mod:`~fcplan.experiments.results`);
   :func:`load_results` reads it back as a pandas DataFrame. Re-running resumes.
 * :mod:`~fcplan.experiments.report`: :func:`report` turns a results folder into Markdown, PNG and
-  HTML: tables with confidence intervals, paired Wilcoxon comparisons, plots.
+  HTML: tables with confidence intervals, paired Wilcoxon comparisons, plots
+  (:mod:`~fcplan.experiments.plots`).
+
+Sweeps and comparisons run their episodes on the same backends
+(:mod:`~fcplan.experiments.backends`: in-process, a local process pool restarted when a worker
+dies, or Dask).
 
 pandas/pyarrow (``fcplan[parquet]``), dask (``fcplan[dask]``) and matplotlib (``fcplan[plot]``)
 are imported only when needed.

@@ -17,6 +17,11 @@ died, the cluster lost it). Lost episodes are not stored, so a re-run plays them
   need no shared file system. An episode whose workers keep dying (``KilledWorker``) is lost.
 
 Episodes are pure functions of their spec, so every backend gives the same metrics.
+:func:`select_backend` picks one the way :func:`~fcplan.experiments.sweep` and
+:func:`~fcplan.experiments.compare` both do. By default a backend plays each spec with
+:func:`~fcplan.experiments.play.play_episode`; ``play`` substitutes another module-level function
+(picklable, so pool workers can run it) that takes a spec and returns its result, as
+:func:`~fcplan.experiments.compare` does. Specs need a unique ``key`` attribute.
 
 Examples
 --------
@@ -30,7 +35,7 @@ Examples
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
@@ -40,26 +45,33 @@ from fcplan.experiments.optional import require
 from fcplan.experiments.play import play_episode
 from fcplan.experiments.workers import init_worker, stop_workers
 
-__all__ = ["iter_dask", "iter_pool", "iter_serial"]
+__all__ = ["iter_dask", "iter_pool", "iter_serial", "select_backend"]
 
-Outcome = tuple[Any, dict | None, str | None]
+Outcome = tuple[Any, Any, str | None]
+"""``(spec, result, lost)``: the result of ``play(spec)``, or None and why it was lost."""
+
+Runtime = dict[str, Callable[..., Any]]
 
 
 def iter_serial(
-    specs: Sequence[Any], runtime: dict[str, Callable[..., Any]] | None = None
-) -> Iterator[Outcome]:
+    specs: Sequence[Any],
+    runtime: Runtime | None = None,
+    *,
+    play: Callable[..., Any] = play_episode,
+) -> Generator[Outcome, None, None]:
     """Play ``specs`` one after another in this process."""
     for spec in specs:
-        yield spec, play_episode(spec), None
+        yield spec, play(spec), None
 
 
 def iter_pool(
     specs: Sequence[Any],
     jobs: int,
-    runtime: dict[str, Callable[..., Any]] | None = None,
+    runtime: Runtime | None = None,
     *,
     max_restarts: int = 3,
-) -> Iterator[Outcome]:
+    play: Callable[..., Any] = play_episode,
+) -> Generator[Outcome, None, None]:
     """Play ``specs`` on a local process pool of ``jobs`` workers (see the module docstring)."""
     pending = list(specs)
     restarts = 0
@@ -73,7 +85,7 @@ def iter_pool(
         finished_keys: set[str] = set()
         broken = False
         try:
-            futures = {executor.submit(play_episode, s): s for s in pending}
+            futures = {executor.submit(play, s): s for s in pending}
             waiting = set(futures)
             while waiting and not broken:
                 done, waiting = wait(waiting, return_when=FIRST_COMPLETED)
@@ -109,8 +121,10 @@ def iter_dask(
     specs: Sequence[Any],
     address: str,
     jobs: int,
-    runtime: dict[str, Callable[..., Any]] | None = None,
-) -> Iterator[Outcome]:
+    runtime: Runtime | None = None,
+    *,
+    play: Callable[..., Any] = play_episode,
+) -> Generator[Outcome, None, None]:
     """Play ``specs`` on a Dask cluster (``address="local"``: a new LocalCluster of ``jobs``
     workers)."""
     distributed = require("distributed", "dask")
@@ -135,7 +149,7 @@ def iter_dask(
         ) from None
     futures: list[Any] = []
     try:
-        futures = client.map(play_episode, list(specs), runtime=runtime or None, pure=False)
+        futures = client.map(play, list(specs), runtime=runtime or None, pure=False)
         by_key = {f.key: s for f, s in zip(futures, specs, strict=True)}
         for fut in distributed.as_completed(futures):
             spec = by_key[fut.key]
@@ -154,3 +168,37 @@ def iter_dask(
         finally:
             if cluster is not None:
                 cluster.close()
+
+
+def select_backend(
+    specs: Sequence[Any],
+    jobs: int,
+    runtime: Runtime | None = None,
+    *,
+    dask: str | None = None,
+    play: Callable[..., Any] = play_episode,
+) -> tuple[str, Generator[Outcome, None, None]]:
+    """The backend for ``specs`` and its outcomes: Dask if ``dask`` is given, this process for
+    ``jobs=1`` or a single spec, else a pool of ``min(jobs, len(specs))`` workers.
+
+    Returns
+    -------
+    name : str
+        ``"serial"``, ``"pool:<workers>"`` or ``"dask:<address>"``.
+    outcomes : generator of Outcome
+        Close it when done early: that stops the workers.
+
+    Examples
+    --------
+    >>> name, outcomes = select_backend([], jobs=4)
+    >>> name, list(outcomes)
+    ('serial', [])
+    """
+    if dask is not None:
+        name = f"dask:{dask}"
+        if not specs:  # no cluster for nothing to do
+            return name, iter_serial(specs, runtime, play=play)
+        return name, iter_dask(specs, dask, jobs, runtime, play=play)
+    if jobs == 1 or len(specs) <= 1:
+        return "serial", iter_serial(specs, runtime, play=play)
+    return f"pool:{min(jobs, len(specs))}", iter_pool(specs, jobs, runtime, play=play)

@@ -245,7 +245,7 @@ def _set_path(node: Any, parts: list[str], value: Any, path: str) -> None:
         )
     slots: list[tuple[Any, Any]] = [(node, key)]  # (container, index) pairs to descend into
     for ix in indices:
-        nxt = []
+        nxt: list[tuple[Any, Any]] = []
         for parent, k in slots:
             t = parent[k]
             if not isinstance(t, list):
@@ -428,9 +428,10 @@ def _schedulers(source: str, value: Any) -> tuple[SchedulerVariant, ...]:
                     where,
                     f"unknown key(s) {sorted(extra)}; allowed: " + ", ".join(_SCHEDULER_KEYS),
                 )
-            name = item.get("name")
-            if not isinstance(name, str) or not name:
+            given = item.get("name")
+            if not isinstance(given, str) or not given:
                 raise _err(source, f"{where}.name", "is required (a registered scheduler name)")
+            name = given
             settings = item.get("settings", {})
             grid = item.get("grid", {})
             for k, v in (("settings", settings), ("grid", grid)):

@@ -88,14 +88,14 @@ def _base_row(spec: Any) -> dict[str, Any]:
     }
 
 
-def run_episode(*args: Any, **kwargs: Any):
+def run_episode(*args: Any, **kwargs: Any) -> Any:
     """:func:`fcplan.run_episode` (a module-level name, so tests can substitute a failing one)."""
     from fcplan.episode import run_episode as _run
 
     return _run(*args, **kwargs)
 
 
-def play_episode(spec: Any, runtime: dict[str, Callable[..., Any]] | None = None) -> dict:
+def play_episode(spec: Any, runtime: dict[str, Callable[..., Any]] | None = None) -> dict[str, Any]:
     """Play the episode ``spec`` (an :class:`~fcplan.experiments.config.EpisodeSpec`).
 
     Parameters

@@ -120,7 +120,7 @@ def _row_files(directory: str | os.PathLike[str]) -> Iterator[Path]:
         yield p
 
 
-def _read(path: Path, columns: list[str] | None = None):
+def _read(path: Path, columns: list[str] | None = None) -> Any:
     pq = require("pyarrow.parquet", "parquet")
     try:
         pf = pq.ParquetFile(path)
@@ -161,7 +161,7 @@ def stored_status(directory: str | os.PathLike[str]) -> dict[str, str]:
     return out
 
 
-def load_results(directory: str | os.PathLike[str]):
+def load_results(directory: str | os.PathLike[str]) -> Any:
     """All episodes in a results folder as a :class:`pandas.DataFrame` (one row per episode).
 
     Rows are sorted by ``finished_at`` when present (then by key). Columns are those of

@@ -44,6 +44,7 @@ from pathlib import Path
 from typing import Any
 
 from fcplan.errors import FcplanError
+from fcplan.experiments.backends import select_backend
 from fcplan.experiments.config import SweepConfig, load_sweep_config
 from fcplan.experiments.progress import make_progress
 from fcplan.experiments.results import (
@@ -96,7 +97,7 @@ class SweepSummary:
     errors: list[str] = field(default_factory=list)
     wall_time_s: float = 0.0
 
-    def load(self):
+    def load(self) -> Any:
         """:func:`~fcplan.experiments.load_results` of the results folder."""
         return load_results(self.results)
 
@@ -162,12 +163,40 @@ def sweep(
         On Ctrl-C, after stopping the workers; everything finished so far is stored.
     """
     cfg = load_sweep_config(config)
+    _check_backend_args(jobs, dask)
+    jobs = jobs or default_jobs()
+    specs = list({s.key: s for s in cfg.episodes()}.values())
+    out = _results_folder(results)
+    status = stored_status(out)
+    todo = [s for s in specs if s.key not in status or (retry_failed and status[s.key] != "ok")]
+    h = cfg.config_hash
+    write_manifest(out, h, {"config_hash": h, "source": cfg.source, **cfg.to_dict()})
+    runtime = runtime_factories([v.name for v in cfg.schedulers])
+    backend, outcomes = select_backend(todo, jobs, runtime, dask=dask)
+    report = make_progress(sys.stderr, label="sweep") if progress is True else progress or None
+    summary = SweepSummary(out, h, backend, total=len(specs), skipped=len(specs) - len(todo))
+    t0 = time.perf_counter()
+    try:
+        for done, (spec, row, lost) in enumerate(outcomes, 1):
+            row = _store(out, cfg, spec, row, lost, summary)
+            if report is not None:
+                report(done, len(todo), row)
+    finally:
+        outcomes.close()
+        summary.wall_time_s = time.perf_counter() - t0
+    return summary
+
+
+def _check_backend_args(jobs: Any, dask: Any) -> None:
+    """One-line errors for a bad ``jobs`` or ``dask`` argument."""
     if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1):
         raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
     if dask is not None and (not isinstance(dask, str) or not dask.strip()):
         raise FcplanError(f"dask must be 'local' or a scheduler address, got {dask!r}")
-    jobs = jobs or default_jobs()
-    specs = list({s.key: s for s in cfg.episodes()}.values())
+
+
+def _results_folder(results: str | os.PathLike[str]) -> Path:
+    """The results folder, created if needed, with stale temporary files removed."""
     out = Path(results)
     if out.exists() and not out.is_dir():
         raise ResultsError(f"{out}: exists and is not a folder")
@@ -176,49 +205,26 @@ def sweep(
     except OSError as exc:
         raise ResultsError(f"{out}: cannot create the results folder: {exc}") from None
     remove_stale_temporaries(out)
-    status = stored_status(out)
-    todo = [s for s in specs if s.key not in status or (retry_failed and status[s.key] != "ok")]
-    h = cfg.config_hash
-    write_manifest(out, h, {"config_hash": h, "source": cfg.source, **cfg.to_dict()})
-    runtime = runtime_factories([v.name for v in cfg.schedulers])
-    if dask is not None:
-        from fcplan.experiments.backends import iter_dask
+    return out
 
-        backend = f"dask:{dask}"
-        outcomes = iter_dask(todo, dask, jobs, runtime) if todo else iter([])
-    elif jobs == 1 or len(todo) <= 1:
-        from fcplan.experiments.backends import iter_serial
 
-        backend = "serial"
-        outcomes = iter_serial(todo, runtime)
-    else:
-        from fcplan.experiments.backends import iter_pool
-
-        backend = f"pool:{min(jobs, len(todo))}"
-        outcomes = iter_pool(todo, jobs, runtime)
-    report = make_progress(sys.stderr, label="sweep") if progress is True else progress or None
-    summary = SweepSummary(out, h, backend, total=len(specs), skipped=len(specs) - len(todo))
-    t0 = time.perf_counter()
-    done = 0
-    try:
-        for spec, row, lost in outcomes:
-            done += 1
-            if row is None:
-                summary.lost.append(f"{_describe(spec)}: {lost}")
-                row = {"error": lost}
-            else:
-                row["config_hash"] = h
-                row["sweep"] = cfg.name
-                write_row(out, row)
-                summary.ran += 1
-                if row.get("status") != "ok":
-                    summary.failed += 1
-                    summary.errors.append(f"{_describe(spec)}: {row.get('error')}")
-            if report is not None:
-                report(done, len(todo), row)
-    finally:
-        close = getattr(outcomes, "close", None)
-        if close is not None:
-            close()
-        summary.wall_time_s = time.perf_counter() - t0
-    return summary
+def _store(
+    out: Path,
+    cfg: SweepConfig,
+    spec: Any,
+    row: dict[str, Any] | None,
+    lost: str | None,
+    summary: SweepSummary,
+) -> dict[str, Any]:
+    """Write a finished episode's row (or count a lost one) and return the row for progress."""
+    if row is None:
+        summary.lost.append(f"{_describe(spec)}: {lost}")
+        return {"error": lost}
+    row["config_hash"] = cfg.config_hash
+    row["sweep"] = cfg.name
+    write_row(out, row)
+    summary.ran += 1
+    if row.get("status") != "ok":
+        summary.failed += 1
+        summary.errors.append(f"{_describe(spec)}: {row.get('error')}")
+    return row

@@ -12,10 +12,13 @@ demonstrations.
 Modules, from the bottom up (only the last two import pygame):
 
 * :mod:`~fcplan.game.controls`: the manual's controls as :class:`fcplan.team.Command` objects;
-* :mod:`~fcplan.game.scores`: the manual's metrics kept up to date tick by tick;
+* :mod:`~fcplan.game.scores`: the manual's metrics kept up to date tick by tick, shown as the
+  metric table (:data:`fcplan.metrics.METRICS`) describes them;
 * :mod:`~fcplan.game.session`: one game (world, controls, scores, recorder) and
   :func:`~fcplan.game.session.replay_inputs`;
 * :mod:`~fcplan.game.designer`: the open-world designer;
+* :mod:`~fcplan.game.layout`, :mod:`~fcplan.game.tutorial`, :mod:`~fcplan.game.storage`: where the
+  buttons sit, the tutorial's text, where games are recorded;
 * :mod:`~fcplan.game.screens`: the screens as a state machine (:class:`~fcplan.game.screens.App`);
 * :mod:`~fcplan.game.view` and :mod:`~fcplan.game.app`: pygame drawing and the event loop;
 * :mod:`~fcplan.game.cli`: the ``fcplan play`` command.

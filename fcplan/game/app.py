@@ -31,7 +31,7 @@ class GameError(FcplanError):
     """The game cannot start (no pygame, no display) or a script file is malformed."""
 
 
-def _import_pygame():
+def _import_pygame() -> Any:
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     try:
         import pygame
@@ -70,7 +70,7 @@ def load_script(path: str | os.PathLike) -> list[dict[str, Any]]:
     return data
 
 
-def _translate(pygame, ev) -> dict[str, Any] | None:
+def _translate(pygame: Any, ev: Any) -> dict[str, Any] | None:
     if ev.type == pygame.QUIT:
         return {"type": "quit"}
     if ev.type == pygame.MOUSEBUTTONDOWN and getattr(ev, "button", 1) == 1:
@@ -90,7 +90,7 @@ def run_app(
     *,
     fps: int = 30,
     script: Iterable[Mapping[str, Any]] = (),
-    screenshot: str | os.PathLike | None = None,
+    screenshot: str | os.PathLike[str] | None = None,
     screenshot_at_s: float | None = None,
     quit_after_screenshot: bool = False,
     on_frame: Callable[[App], None] | None = None,
@@ -124,9 +124,9 @@ def run_app(
             f"cannot open a window ({exc}); to run headless set SDL_VIDEODRIVER=dummy"
         ) from None
     pygame.display.set_caption("fcplan play - FireCommander")
-    from fcplan.game import view
+    from fcplan.game.view import draw, reset_fonts
 
-    view.reset_fonts()
+    reset_fonts()
     app.set_script(script)
     shot_done = screenshot is None
     clock = pygame.time.Clock()
@@ -142,9 +142,9 @@ def run_app(
             app.advance(dt)
             if not app.running:
                 break
-            view.draw(surf, app)
+            draw(surf, app)
             pygame.display.flip()
-            if not shot_done and app.screen == "game" and s is not None:
+            if screenshot is not None and not shot_done and app.screen == "game" and s is not None:
                 due = screenshot_at_s is None or s.world.time_s >= screenshot_at_s
                 if due:
                     Path(screenshot).parent.mkdir(parents=True, exist_ok=True)

@@ -76,7 +76,7 @@ class Controller:
         A short human message about the last input (shown by the game).
     """
 
-    def __init__(self, world) -> None:
+    def __init__(self, world: Any) -> None:
         self.world = world
         self.team = world.team
         sc = world.scenario
@@ -171,7 +171,7 @@ class Controller:
     # ------------------------------------------------------------------ commands
     def _put(self, aid: str, **fields: Any) -> None:
         old = self.pending.get(aid, Command())
-        new = {
+        new: dict[str, Any] = {
             "route": old.route,
             "patrol": old.patrol,
             "altitude": old.altitude,
@@ -186,7 +186,7 @@ class Controller:
         if cmd is not None and cmd.home:
             return [], False
         if cmd is not None and cmd.route is not None:
-            return [tuple(p) for p in cmd.route], cmd.patrol
+            return [(p[0], p[1]) for p in cmd.route], cmd.patrol
         team = self.team
         if team.mode[i] in (Mode.IDLE, Mode.HOMING):
             return [], False

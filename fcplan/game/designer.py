@@ -48,6 +48,7 @@ True
 from __future__ import annotations
 
 import math
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from typing import Any
 
@@ -379,7 +380,7 @@ class Design:
             self.values[key] = cell
 
     @staticmethod
-    def _fits(cell: str, cols: int, rows: int, n: int, taken: set) -> bool:
+    def _fits(cell: str, cols: int, rows: int, n: int, taken: AbstractSet[tuple[int, int]]) -> bool:
         try:
             c0, r0 = parse_cell(cell)
         except FcplanError:
@@ -387,7 +388,14 @@ class Design:
         block = {(c0 + i, r0 + j) for i in range(cols) for j in range(rows)}
         return c0 + cols <= n and r0 - 1 + rows <= n and not (block & taken)
 
-    def _first_free(self, cols, rows, n, taken, start=(0, 0)) -> str | None:
+    def _first_free(
+        self,
+        cols: int,
+        rows: int,
+        n: int,
+        taken: AbstractSet[tuple[int, int]],
+        start: tuple[int, int] = (0, 0),
+    ) -> str | None:
         sc, sr = start
         order = sorted(
             ((c, r) for c in range(n) for r in range(1, n + 1)),
@@ -445,7 +453,7 @@ class Design:
             doc["team"][role] = t
         return doc
 
-    def build(self):
+    def build(self) -> tuple[Any, list[str]]:
         """The designed scenario and the list of problems (empty when it can be played).
 
         Returns

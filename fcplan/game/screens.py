@@ -9,8 +9,9 @@
        |                          --> preview --> tutorial --> game
        \\--Tutorial--> tutorial (pages)          evaluation --Save playback--> playback
 
-:class:`App` holds the current screen and everything the screens show, lays out the buttons
-(:class:`Button`, window pixels) and reacts to abstract events: ``{"type": "click", "pos": (x, y)}``,
+:class:`App` holds the current screen and everything the screens show, gives the buttons of the
+current screen (:class:`~fcplan.game.layout.Button`, window pixels, laid out by
+:mod:`fcplan.game.layout`) and reacts to abstract events: ``{"type": "click", "pos": (x, y)}``,
 ``{"type": "move", "pos": (x, y)}`` and ``{"type": "key", "key": "up", "char": ""}`` (pygame key
 names, ``char`` the typed text). The pygame front end (:mod:`fcplan.game.app`) only translates
 events and draws what :class:`App` exposes, so every transition is testable without a display.
@@ -18,7 +19,8 @@ events and draws what :class:`App` exposes, so every transition is testable with
 In the game, clicks on the map and the keys 1-9 / Up / Down become input dicts for the
 :class:`~fcplan.game.session.GameSession` (see :mod:`fcplan.game.controls`); the session advances
 at the scenario's real-time pace (``ticks_per_second`` x ``speed`` ticks per wall second, see
-:meth:`App.advance`) or, in fast mode, a fixed number of ticks per frame.
+:meth:`App.advance`) or, in fast mode, a fixed number of ticks per frame. Every game is recorded
+(:mod:`fcplan.game.storage`); the tutorial's text is :data:`fcplan.game.tutorial.TUTORIAL`.
 
 Examples
 --------
@@ -38,8 +40,7 @@ Examples
 from __future__ import annotations
 
 import os
-import sys
-import time
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -48,128 +49,52 @@ import numpy as np
 
 from fcplan.errors import FcplanError
 from fcplan.game.designer import PAGES, Design
-from fcplan.game.session import GameSession
-
-__all__ = ["App", "Button", "SCREENS", "WINDOW", "MAP_RECT", "default_recording_path", "TUTORIAL"]
-
-SCREENS = ("welcome", "scenarios", "tutorial", "designer", "preview", "game", "evaluation",
-           "playback")  # fmt: skip
-"""Every screen of the game."""
-
-WINDOW = (1140, 760)
-"""Window size (width, height) in px."""
-
-MAP_RECT = (20, 20, 720, 720)
-"""Where the map is drawn in the game screen: (x, y, width, height)."""
-
-PANEL_X = MAP_RECT[0] + MAP_RECT[2] + 20
-"""Left edge of the game's information panel."""
-
-PREVIEW_RECT = (640, 110, 470, 470)
-"""Where the designer draws its preview map."""
-
-TUTORIAL: tuple[tuple[str, tuple[str, ...]], ...] = (
-    (
-        "Controls",
-        (
-            "Keys 1-9 select an agent (P = perception, A = action, H = hybrid).",
-            "Click on the map to add a goal at the end of the selected agent's route.",
-            "Click near the route's first goal to close a patrol loop (two goals or more).",
-            "A later click replaces the loop with a new route.",
-            "Up / Down: raise or lower a perception or hybrid agent by 5 m.",
-            "   Higher = a larger field of view but less reliable sensing (100 % -> 40 %).",
-            "Click on the agent base (depot) to send the selected agent home.",
-            "Space pauses, Esc ends the game early. Every game is recorded.",
-        ),
-    ),
-    (
-        "The team",
-        (
-            "Perception agents (blue circles) find fire: only fire the team has sensed is shown.",
-            "Action agents (yellow triangles) put out sensed fire: one water dump per goal",
-            "   reached, over their field of view (the box), 90 % of the cells each time.",
-            "Hybrid agents (violet diamonds) do both, pruning with 80 % confidence.",
-            "Agents return to the base on low battery or an empty tank, recharge and refill,",
-            "   then resume their route. An action agent idle at its last goal for 3 s goes home.",
-            "The panel shows battery now and at the last planned goal, altitude and tank.",
-        ),
-    ),
-    (
-        "Scores",
-        (
-            "Negative reward: 0.1 per burning cell per second, plus the facility penalty",
-            "   (house 1, hospital 2, power station 5, base 5) per burning cell inside it.",
-            "OFS: pruned / all fire.  PS: sensed / all fire.  AS: pruned / sensed fire.",
-            "FPS: facilities never on fire.  NRR: negative reward / expected without pruning.",
-            "Final score = PS + AS + FPS - 3 NRR.",
-            "Grades: Excellent >= 90, Well Done >= 80, Almost There! >= 60, Fair >= 50.",
-        ),
-    ),
+from fcplan.game.layout import (
+    MAP_RECT,
+    PANEL_X,
+    PREVIEW_RECT,
+    SCREENS,
+    WINDOW,
+    Button,
+    agent_row_rect,
+    designer_buttons,
+    evaluation_buttons,
+    field_rows,
+    game_buttons,
+    playback_buttons,
+    preview_buttons,
+    scenario_buttons,
+    scenario_groups,
+    tutorial_buttons,
+    welcome_buttons,
 )
-"""Tutorial pages: (title, lines)."""
+from fcplan.game.session import GameSession
+from fcplan.game.storage import default_recording_path, make_recorder
+from fcplan.game.tutorial import TUTORIAL
+from fcplan.metrics import Metrics
+
+__all__ = [
+    "App",
+    "Button",
+    "SCREENS",
+    "WINDOW",
+    "MAP_RECT",
+    "PANEL_X",
+    "PREVIEW_RECT",
+    "default_recording_path",
+    "TUTORIAL",
+]
 
 _KEYS_TO_GAME = {"1", "2", "3", "4", "5", "6", "7", "8", "9", "up", "down"}
 
 
 @dataclass(frozen=True)
-class Button:
-    """A clickable rectangle: ``id`` names the action, ``rect`` is (x, y, width, height)."""
+class _Preview:
+    """The designer's preview image and the scenario (at the size) it shows."""
 
-    id: str
-    label: str
-    rect: tuple[int, int, int, int]
-    style: str = "normal"  #: normal | primary | small | selected | danger
-
-    def contains(self, x: float, y: float) -> bool:
-        bx, by, bw, bh = self.rect
-        return bx <= x < bx + bw and by <= y < by + bh
-
-    @property
-    def center(self) -> tuple[int, int]:
-        bx, by, bw, bh = self.rect
-        return (bx + bw // 2, by + bh // 2)
-
-
-def default_recording_path(
-    scenario, seed: int, *, data_dir: str | os.PathLike | None = None
-) -> Path:
-    """Where a game is recorded when no path is given: the user's data folder.
-
-    ``$FCPLAN_DATA_DIR``, else ``$XDG_DATA_HOME/fcplan`` (``~/.local/share/fcplan``) on Linux,
-    ``~/Library/Application Support/fcplan`` on macOS, ``%APPDATA%/fcplan`` on Windows; then
-    ``recordings/<scenario>-seed<seed>-<UTC time>.npz``.
-
-    Examples
-    --------
-    >>> from fcplan import load_scenario
-    >>> p = default_recording_path(load_scenario(3), 7, data_dir="/tmp/x")
-    >>> p.parent.as_posix(), p.name.startswith("03-seed7-")
-    ('/tmp/x/recordings', True)
-    """
-    if data_dir is None:
-        data_dir = os.environ.get("FCPLAN_DATA_DIR")
-    if data_dir is None:
-        if sys.platform == "win32":
-            base = Path(os.environ.get("APPDATA", Path.home() / "AppData" / "Roaming"))
-        elif sys.platform == "darwin":
-            base = Path.home() / "Library" / "Application Support"
-        else:
-            base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
-        data_dir = base / "fcplan"
-    if scenario.number is not None:
-        slug = "practice" if scenario.number == 0 else f"{scenario.number:02d}"
-    else:
-        slug = "".join(c if c.isalnum() else "-" for c in scenario.name).strip("-") or "design"
-    stamp = time.strftime("%Y%m%d-%H%M%S", time.gmtime())
-    return Path(data_dir) / "recordings" / f"{slug}-seed{seed}-{stamp}.npz"
-
-
-def _grid_buttons(items, x0, y0, w, h, gap, per_row, style="normal"):
-    out = []
-    for k, (bid, label) in enumerate(items):
-        r, c = divmod(k, per_row)
-        out.append(Button(bid, label, (x0 + c * (w + gap), y0 + r * (h + gap), w, h), style))
-    return out
+    scenario: Any
+    size: int
+    image: np.ndarray
 
 
 class App:
@@ -197,14 +122,14 @@ class App:
 
     def __init__(
         self,
-        scenario=None,
+        scenario: Any = None,
         *,
         seed: int = 0,
-        record: str | os.PathLike | None = None,
+        record: str | os.PathLike[str] | None = None,
         speed: float = 1.0,
         fast: bool = False,
         frame_ticks: int = 10,
-        data_dir: str | os.PathLike | None = None,
+        data_dir: str | os.PathLike[str] | None = None,
         exit_at_end: bool = False,
     ) -> None:
         if not (speed > 0 and np.isfinite(speed)):
@@ -222,21 +147,22 @@ class App:
         self.error = False  #: whether the message is an error
         self.tutorial_page = 0
         self.hover: str | None = None  #: id of the button under the mouse
-        self.pending_scenario = None  #: open-world design waiting behind the tutorial
+        self.pending_scenario: Any = None  #: open-world design waiting behind the tutorial
         self.design = Design()
         self.focus: str | None = None  #: designer field being typed into
         self.typed = ""
         self.file_text = ""  #: designer's "load a scenario file" box
-        self.preview_scenario = None
-        self.scenario = None
+        self.preview_scenario: Any = None
+        self._preview: _Preview | None = None
+        self.scenario: Any = None
         self.session: GameSession | None = None
-        self.recorder = None
+        self.recorder: Any = None
         self.recording_path: Path | None = None
-        self.final = None  #: both metric definitions of the last game
+        self.final: dict[str, Metrics] | None = None  #: both metric definitions of the last game
         self.paused = False
         self._tick_debt = 0.0
         self.video_path: Path | None = None
-        self._saved: tuple | None = None  # (recorder id, path) last saved
+        self._saved: tuple[Any, Path] | None = None  # (recorder, path) last saved
         #: scripted inputs (dicts with a "tick") still to feed to the game, in tick order
         self.script: list[dict[str, Any]] = []
         if scenario is not None:
@@ -245,16 +171,21 @@ class App:
     # ================================================================== layout
     def buttons(self) -> list[Button]:
         """The clickable buttons of the current screen."""
-        return getattr(self, f"_buttons_{self.screen}")()
-
-    def _buttons_welcome(self) -> list[Button]:
-        x, w = WINDOW[0] // 2 - 170, 340
-        return [
-            Button("scenario_mode", "Scenario mode", (x, 300, w, 60), "primary"),
-            Button("open_world", "Open-world mode", (x, 380, w, 60), "primary"),
-            Button("tutorial", "Tutorial", (x, 460, w, 60)),
-            Button("quit", "Quit", (x, 560, w, 44), "small"),
-        ]
+        layouts: dict[str, Callable[[], list[Button]]] = {
+            "welcome": welcome_buttons,
+            "scenarios": scenario_buttons,
+            "tutorial": lambda: tutorial_buttons(
+                self.tutorial_page, len(TUTORIAL), self.pending_scenario is not None
+            ),
+            "designer": lambda: designer_buttons(self.design, PAGES, self.file_text),
+            "preview": preview_buttons,
+            "game": lambda: game_buttons(
+                self.session.world.team.ids if self.session is not None else []
+            ),
+            "evaluation": evaluation_buttons,
+            "playback": playback_buttons,
+        }
+        return layouts[self.screen]()
 
     def hover_summary(self) -> str:
         """One line about the scenario button under the mouse (scenario mode), else ''."""
@@ -262,104 +193,19 @@ class App:
             return ""
         from fcplan.scenario import load_scenario
 
-        return load_scenario(self.hover.split(":", 1)[1]).summary()
+        return load_scenario((self.hover or "").split(":", 1)[1]).summary()
 
     def scenario_groups(self) -> list[tuple[str, list[tuple[str, str]]]]:
         """(group title, [(button id, label)]) for the scenario mode, by difficulty."""
-        groups = [("Practice", [("play:practice", "Practice")])]
-        for title, lo, hi in (("Easy", 1, 6), ("Moderate", 7, 18), ("Hard", 19, 24)):
-            groups.append((title, [(f"play:{n}", f"#{n}") for n in range(lo, hi + 1)]))
-        return groups
-
-    def _buttons_scenarios(self) -> list[Button]:
-        out = []
-        y = 140
-        for _title, items in self.scenario_groups():
-            out += _grid_buttons(items, 220, y, 100 if len(items) > 1 else 160, 44, 12, 6)
-            y += 56 * ((len(items) + 5) // 6) + 24
-        out += [
-            Button("seed:-1", "-", (220, y + 10, 44, 40), "small"),
-            Button("seed:+1", "+", (380, y + 10, 44, 40), "small"),
-            Button("back", "Back", (40, WINDOW[1] - 70, 140, 44), "small"),
-        ]
-        return out
-
-    def _buttons_tutorial(self) -> list[Button]:
-        out = [Button("back", "Back", (40, WINDOW[1] - 70, 140, 44), "small")]
-        if self.pending_scenario is not None:  # open-world: preview -> tutorial -> game
-            out.append(Button("tutorial:start", "Start the game", (WINDOW[0] // 2 - 120,
-                                                                  WINDOW[1] - 70, 240, 44),
-                              "primary"))  # fmt: skip
-        if self.tutorial_page > 0:
-            out.append(Button("tutorial:prev", "Previous", (WINDOW[0] - 360, WINDOW[1] - 70,
-                                                               150, 44), "small"))  # fmt: skip
-        if self.tutorial_page < len(TUTORIAL) - 1:
-            out.append(Button("tutorial:next", "Next", (WINDOW[0] - 190, WINDOW[1] - 70, 150, 44)))
-        return out
+        return scenario_groups()
 
     def field_rows(self) -> list[tuple[Any, tuple[int, int, int, int]]]:
         """(field, value box rect) of the designer's current page."""
-        fields = self.design.fields()
-        h = min(40, 560 // max(len(fields), 1))
-        return [(f, (330, 110 + k * h, 150, h - 6)) for k, f in enumerate(fields)]
-
-    def _buttons_designer(self) -> list[Button]:
-        out = []
-        for k, page in enumerate(PAGES):
-            style = "selected" if page == self.design.page else "small"
-            out.append(Button(f"page:{page}", page.title(), (40 + k * 130, 50, 120, 40), style))
-        for f, (x, y, w, h) in self.field_rows():
-            out.append(Button(f"focus:{f.key}", self.design.text(f.key), (x, y, w, h), "field"))
-            out.append(Button(f"nudge:{f.key}:-1", "-", (x + w + 8, y, h, h), "small"))
-            out.append(Button(f"nudge:{f.key}:+1", "+", (x + w + 14 + h, y, h, h), "small"))
-        bottom = WINDOW[1] - 70
-        out += [
-            Button("back", "Back", (40, bottom, 120, 44), "small"),
-            Button("design:reset", "Reset", (170, bottom, 120, 44), "small"),
-            Button("focus:__file__", self.file_text or "scenario.toml", (640, 600, 330, 40),
-                   "field"),
-            Button("design:load", "Load file", (980, 600, 130, 40), "small"),
-            Button("design:next", "Next" if self.design.page != PAGES[-1] else "Preview",
-                   (WINDOW[0] - 170, bottom, 140, 44), "primary"),
-        ]  # fmt: skip
-        return out
-
-    def _buttons_preview(self) -> list[Button]:
-        bottom = WINDOW[1] - 70
-        return [
-            Button("preview:back", "Back to design", (40, bottom, 200, 44), "small"),
-            Button("preview:start", "Proceed: play", (WINDOW[0] - 240, bottom, 200, 44), "primary"),
-        ]
-
-    def _buttons_game(self) -> list[Button]:
-        out = []
-        if self.session is not None:
-            for i, aid in enumerate(self.session.world.team.ids):
-                out.append(Button(f"select:{i}", aid, self.agent_row_rect(i), "row"))
-        out.append(Button("game:end", "End game (Esc)", (WINDOW[0] - 190, WINDOW[1] - 56, 170, 40),
-                          "small"))  # fmt: skip
-        return out
+        return field_rows(self.design)
 
     def agent_row_rect(self, i: int) -> tuple[int, int, int, int]:
         """Panel row of agent ``i`` in the game screen."""
-        return (PANEL_X, 112 + 30 * i, WINDOW[0] - PANEL_X - 16, 28)
-
-    def _buttons_evaluation(self) -> list[Button]:
-        y = WINDOW[1] - 80
-        return [
-            Button("save_playback", "Save playback", (60, y, 200, 48), "primary"),
-            Button("play_again", "Play again", (280, y, 180, 48)),
-            Button("scenario_mode", "Scenario mode", (480, y, 200, 48)),
-            Button("main_menu", "Main menu", (700, y, 180, 48)),
-            Button("quit", "Quit", (900, y, 160, 48), "small"),
-        ]
-
-    def _buttons_playback(self) -> list[Button]:
-        y = WINDOW[1] - 80
-        out = [Button("back_to_evaluation", "Back", (60, y, 160, 48), "small")]
-        out.append(Button("write_video", "Write GIF video", (240, y, 240, 48), "primary"))
-        out.append(Button("main_menu", "Main menu", (500, y, 180, 48)))
-        return out
+        return agent_row_rect(i)
 
     # ================================================================== events
     def handle(self, event: dict[str, Any]) -> None:
@@ -427,7 +273,7 @@ class App:
     def press(self, bid: str) -> None:
         """Do what button ``bid`` does (also usable directly, e.g. in tests)."""
         head, _, arg = bid.partition(":")
-        simple = {
+        simple: dict[str, Callable[[], Any]] = {
             "scenario_mode": lambda: self._go("scenarios"),
             "open_world": lambda: self._go("designer"),
             "tutorial": self._open_tutorial,
@@ -576,23 +422,22 @@ class App:
             scenario = self.preview_scenario
         if scenario is None:
             return np.zeros((size, size, 3), np.uint8)
-        key = (id(scenario), size)
-        if getattr(self, "_preview_key", None) != key:
+        p = self._preview
+        if p is None or p.size != size or p.scenario != scenario:  # equal scenarios look alike
             world = World().reset(scenario, seed=0)
-            self._preview = (scenario, render_frame(scenario, snapshot(world), size=size,
-                                                    panel=False))  # fmt: skip
-            self._preview_key = key
-        return self._preview[1]
+            image = render_frame(scenario, snapshot(world), size=size, panel=False)
+            p = self._preview = _Preview(scenario, size, image)
+        return p.image
 
-    def preview_target(self):
+    def preview_target(self) -> Any:
         """The scenario the preview image shows (or None)."""
-        return getattr(self, "_preview", (None, None))[0]
+        return None if self._preview is None else self._preview.scenario
 
     # ================================================================== game
-    def start_game(self, scenario) -> None:
+    def start_game(self, scenario: Any) -> None:
         """Start a game of ``scenario`` (recorded) and show the game screen."""
         self.scenario = scenario
-        self.recorder = _make_recorder(scenario, self.seed, self.speed, self.fast)
+        self.recorder = make_recorder(scenario, self.seed, self.speed, self.fast)
         self.session = GameSession(scenario, self.seed, recorder=self.recorder)
         if self.record is not None and self.recording_path is None:
             self.recording_path = self.record
@@ -612,14 +457,21 @@ class App:
     def map_point(self, x: float, y: float) -> tuple[float, float]:
         """World px of window pixel (x, y) in the game map."""
         mx, my, mw, mh = MAP_RECT
-        w = self.session.scenario.world_size
+        w = self.game.scenario.world_size
         return (round((x - mx) * w / mw, 1), round((y - my) * w / mh, 1))
 
     def window_point(self, x: float, y: float) -> tuple[int, int]:
         """Window pixel of world point (x, y) in the game map."""
         mx, my, mw, mh = MAP_RECT
-        w = self.session.scenario.world_size
+        w = self.game.scenario.world_size
         return (int(round(mx + x * mw / w)), int(round(my + y * mh / w)))
+
+    @property
+    def game(self) -> GameSession:
+        """The game being played (an error outside a game)."""
+        if self.session is None:
+            raise FcplanError("no game has been started")
+        return self.session
 
     def _in_map(self, x: float, y: float) -> bool:
         mx, my, mw, mh = MAP_RECT
@@ -655,7 +507,7 @@ class App:
             self.end_game()
         return played
 
-    def set_script(self, events) -> None:
+    def set_script(self, events: Iterable[Mapping[str, Any]]) -> None:
         """Feed these input dicts (each with a ``"tick"``) to the game when it reaches their
         ticks, as if the player had made them then (e.g. the inputs of a recording)."""
         self.script = sorted((dict(e) for e in events), key=lambda e: int(e["tick"]))
@@ -678,11 +530,12 @@ class App:
         """Save the game's recording (once) to :attr:`recording_path`."""
         if self.recorder is None or self.recording_path is None:
             return None
-        if self._saved == (id(self.recorder), self.recording_path):
+        saved = self._saved
+        if saved is not None and saved[0] is self.recorder and saved[1] == self.recording_path:
             return self.recording_path
         self.recording_path.parent.mkdir(parents=True, exist_ok=True)
         self.recorder.save(self.recording_path)
-        self._saved = (id(self.recorder), self.recording_path)
+        self._saved = (self.recorder, self.recording_path)
         return self.recording_path
 
     def write_video(self, *, speed: float = 10.0, size: int = 384) -> Path | None:
@@ -706,19 +559,3 @@ class App:
         self.video_path = out
         self._say(f"playback written to {out}")
         return out
-
-
-def _make_recorder(scenario, seed: int, speed: float, fast: bool = False):
-    """A :class:`fcplan.recording.Recorder` for a human game, or None if it is unavailable."""
-    try:
-        from fcplan.recording import Recorder
-    except ImportError:
-        return None
-    settings = {
-        "game": "fcplan play",
-        "mode": "scenario" if scenario.number is not None else "open-world",
-        "speed": float(speed),
-        "fast": bool(fast),
-        "ticks_per_second": int(scenario.ticks_per_second),
-    }
-    return Recorder(scenario, seed, source="human", settings=settings)

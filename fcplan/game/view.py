@@ -14,13 +14,25 @@ altitude and tank, then the online scores.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from fcplan.game.controls import PATROL_RADIUS_STEPS
-from fcplan.game.screens import MAP_RECT, PANEL_X, PREVIEW_RECT, TUTORIAL, WINDOW, App
-from fcplan.render import COLORS
+from fcplan.game.layout import MAP_RECT, PANEL_X, PREVIEW_RECT, WINDOW, Button
+from fcplan.game.scores import ONLINE_METRICS, shown_text
+from fcplan.game.screens import App
+from fcplan.game.session import GameSession
+from fcplan.game.tutorial import TUTORIAL
+from fcplan.metrics import METRICS
+from fcplan.render import COLORS, FrameData, render_frame, snapshot
+
+Surface = Any  # a pygame.Surface (pygame is imported only when drawing)
+Color = tuple[int, int, int]
+Point = tuple[float, float]
 
 __all__ = ["draw", "reset_fonts", "THEME"]
 
@@ -50,7 +62,9 @@ _GRADE_COLOR = {
     "Failed": (255, 90, 70),
 }
 
-_fonts: dict[tuple[int, bool], object] = {}
+_FINAL_SCORE = "PS + AS + FPS - 3 NRR"  # the manual's Eq. (6), beside the final score
+
+_fonts: dict[tuple[int, bool], Any] = {}
 
 
 def reset_fonts() -> None:
@@ -58,7 +72,7 @@ def reset_fonts() -> None:
     _fonts.clear()
 
 
-def _font(size: int, bold: bool = False):
+def _font(size: int, bold: bool = False) -> Any:
     import pygame
 
     if not pygame.font.get_init():  # pygame was shut down since: old fonts are invalid
@@ -72,14 +86,22 @@ def _font(size: int, bold: bool = False):
     return _fonts[key]
 
 
-def _text(surf, text, pos, size=22, color=THEME["text"], bold=False, anchor="topleft"):
+def _text(
+    surf: Surface,
+    text: object,
+    pos: Point,
+    size: int = 22,
+    color: Color = THEME["text"],
+    bold: bool = False,
+    anchor: str = "topleft",
+) -> Any:
     img = _font(size, bold).render(str(text), True, color)
     rect = img.get_rect(**{anchor: pos})
     surf.blit(img, rect)
     return rect
 
 
-def _button(surf, b, app: App) -> None:
+def _button(surf: Surface, b: Button, app: App) -> None:
     import pygame
 
     x, y, w, h = b.rect
@@ -114,16 +136,16 @@ def _fit(text: str, width: int, size: int) -> str:
     return "..." + text
 
 
-def _blit_array(surf, img: np.ndarray, pos) -> None:
+def _blit_array(surf: Surface, img: np.ndarray, pos: Point) -> None:
     import pygame
 
     surf.blit(pygame.surfarray.make_surface(np.ascontiguousarray(img.swapaxes(0, 1))), pos)
 
 
-def draw(surf, app: App) -> None:
+def draw(surf: Surface, app: App) -> None:
     """Paint the app's current screen into ``surf`` (a ``WINDOW``-sized pygame surface)."""
     surf.fill(THEME["bg"])
-    globals()[f"_draw_{app.screen}"](surf, app)
+    _SCREENS[app.screen](surf, app)
     for b in app.buttons():
         _button(surf, b, app)
     if app.message and app.screen not in ("game",):
@@ -132,26 +154,22 @@ def draw(surf, app: App) -> None:
 
 
 # ------------------------------------------------------------------------------ menu screens
-_backdrop_cache: dict[str, np.ndarray] = {}
-
-
+@functools.cache
 def _backdrop() -> np.ndarray:
-    if "img" not in _backdrop_cache:
-        from fcplan import World, load_scenario
-        from fcplan.render import render_frame, snapshot
+    """The welcome screen's dimmed backdrop: scenario #24 after 40 s, its fire all shown."""
+    from fcplan.scenario import load_scenario
 
-        world = World().reset(load_scenario(24), seed=3)
-        for _ in range(400):
-            world.step()
-        frame = snapshot(world)
-        frame = dataclasses.replace(frame, known=frame.fire == 1)
-        img = render_frame(world.scenario, frame, size=WINDOW[0], panel=False)
-        img = img[(WINDOW[0] - WINDOW[1]) // 2 :][: WINDOW[1]]
-        _backdrop_cache["img"] = (img.astype(np.float32) * 0.35).astype(np.uint8)
-    return _backdrop_cache["img"]
+    game = GameSession(load_scenario(24), seed=3)
+    while game.tick < 400:
+        game.step()
+    frame = snapshot(game.world)
+    frame = dataclasses.replace(frame, known=np.asarray(frame.fire == 1))
+    img = render_frame(game.scenario, frame, size=WINDOW[0], panel=False)
+    img = img[(WINDOW[0] - WINDOW[1]) // 2 :][: WINDOW[1]]
+    return (img.astype(np.float32) * 0.35).astype(np.uint8)
 
 
-def _draw_welcome(surf, app: App) -> None:
+def _draw_welcome(surf: Surface, app: App) -> None:
     _blit_array(surf, _backdrop(), (0, 0))
     cx = WINDOW[0] // 2
     _text(surf, "FireCommander", (cx, 130), 96, THEME["accent"], True, "center")
@@ -161,7 +179,7 @@ def _draw_welcome(surf, app: App) -> None:
           (cx, 236), 22, THEME["dim"], anchor="center")  # fmt: skip
 
 
-def _draw_scenarios(surf, app: App) -> None:
+def _draw_scenarios(surf: Surface, app: App) -> None:
     _text(surf, "Scenario mode", (40, 40), 48, THEME["accent"], True)
     _text(surf, "Pick a scenario: the game starts at once and runs in real time.", (40, 90), 24,
           THEME["dim"])  # fmt: skip
@@ -176,7 +194,7 @@ def _draw_scenarios(surf, app: App) -> None:
         _text(surf, " ".join(summary.split()), (40, y + 80), 24, THEME["accent"])
 
 
-def _draw_tutorial(surf, app: App) -> None:
+def _draw_tutorial(surf: Surface, app: App) -> None:
     title, lines = TUTORIAL[app.tutorial_page]
     _text(surf, f"Tutorial: {title}", (40, 40), 48, THEME["accent"], True)
     _text(surf, f"page {app.tutorial_page + 1} of {len(TUTORIAL)}", (40, 92), 22, THEME["dim"])
@@ -187,7 +205,7 @@ def _draw_tutorial(surf, app: App) -> None:
         y += 44
 
 
-def _draw_designer(surf, app: App) -> None:
+def _draw_designer(surf: Surface, app: App) -> None:
     import pygame
 
     _text(surf, "Open-world mode: design a scenario", (40, 12), 34, THEME["accent"], True)
@@ -213,7 +231,7 @@ def _draw_designer(surf, app: App) -> None:
     _text(surf, "or load a scenario TOML file:", (640, 582), 20, THEME["dim"])
 
 
-def _draw_regions(surf, scenario, rect) -> None:
+def _draw_regions(surf: Surface, scenario: Any, rect: tuple[int, int, int, int]) -> None:
     """Red squares and front counts on fire regions (the preview shows no burning fire yet)."""
     import pygame
 
@@ -227,7 +245,7 @@ def _draw_regions(surf, scenario, rect) -> None:
         _text(surf, label, (box.left + 2, box.bottom + 2), 18, (255, 200, 160))
 
 
-def _draw_preview(surf, app: App) -> None:
+def _draw_preview(surf: Surface, app: App) -> None:
     sc = app.preview_scenario
     _text(surf, "Preview", (40, 20), 40, THEME["accent"], True)
     size = 620
@@ -256,10 +274,8 @@ def _draw_preview(surf, app: App) -> None:
 
 
 # ------------------------------------------------------------------------------ game
-def _game_frame(app: App):
-    from fcplan.render import snapshot
-
-    s = app.session
+def _game_frame(app: App) -> FrameData:
+    s = app.game
     team, ctl = s.world.team, s.controller
     routes = []
     for i in range(team.n):
@@ -271,12 +287,10 @@ def _game_frame(app: App):
     return dataclasses.replace(frame, selected=ctl.selected)
 
 
-def _draw_game(surf, app: App) -> None:
+def _draw_game(surf: Surface, app: App) -> None:
     import pygame
 
-    from fcplan.render import render_frame
-
-    s = app.session
+    s = app.game
     mx, my, mw, mh = MAP_RECT
     frame = _game_frame(app)
     _blit_array(surf, render_frame(s.scenario, frame, size=mw, panel=False), (mx, my))
@@ -301,11 +315,11 @@ def _draw_game(surf, app: App) -> None:
     _draw_panel(surf, app, frame, role_col)
 
 
-def _role_colors(scenario) -> list[tuple[int, int, int]]:
+def _role_colors(scenario: Any) -> list[Color]:
     return [COLORS[_ROLE_NAME[a.id[0]]] for a in scenario.agents]
 
 
-def _dashed(surf, color, a, b, dash=8) -> None:
+def _dashed(surf: Surface, color: Color, a: Point, b: Point, dash: int = 8) -> None:
     import pygame
 
     d = math.dist(a, b)
@@ -316,7 +330,7 @@ def _dashed(surf, color, a, b, dash=8) -> None:
         pygame.draw.line(surf, color, p, q, 2)
 
 
-def _dashed_circle(surf, color, c, r, n=36) -> None:
+def _dashed_circle(surf: Surface, color: Color, c: Point, r: float, n: int = 36) -> None:
     import pygame
 
     for k in range(0, n, 2):
@@ -326,10 +340,10 @@ def _dashed_circle(surf, color, c, r, n=36) -> None:
         pygame.draw.line(surf, color, p, q, 1)
 
 
-def _draw_panel(surf, app: App, frame, role_col) -> None:
+def _draw_panel(surf: Surface, app: App, frame: FrameData, role_col: list[Color]) -> None:
     import pygame
 
-    s = app.session
+    s = app.game
     sc = s.scenario
     x, right = PANEL_X, WINDOW[0] - 16
     pygame.draw.rect(surf, THEME["panel"], pygame.Rect(x - 10, 10, right - x + 20, WINDOW[1] - 20),
@@ -384,20 +398,13 @@ def _draw_panel(surf, app: App, frame, role_col) -> None:
     m = s.metrics()
     _text(surf, "Online scores", (x, y + 10), 24, THEME["dim"], True)
     y += 38
-    rows = [
-        ("Total negative reward", f"{-m.total_negative_reward:.1f}"),
-        ("Overall firefighting", f"{m.overall_firefighting:.1f} %"),
-        ("Perception", f"{m.perception:.1f} %"),
-        ("Action", f"{m.action:.1f} %"),
-        ("Facility protection", f"{m.facility_protection:.1f} %"),
-        ("Negative reward ratio", f"{m.negative_reward_ratio:.1f} %"),
-    ]
-    for k, v in rows:
-        _text(surf, k, (x, y), 22)
-        _text(surf, v, (right, y), 22, anchor="topright")
+    *rows, final = ONLINE_METRICS
+    for spec in rows:
+        _text(surf, spec.heading, (x, y), 22)
+        _text(surf, shown_text(spec, m, 1), (right, y), 22, anchor="topright")
         y += 25
-    _text(surf, "Final score", (x, y + 4), 26, bold=True)
-    _text(surf, f"{m.final_score:.1f}", (right, y + 4), 26, _GRADE_COLOR[m.grade], True,
+    _text(surf, final.title, (x, y + 4), 26, bold=True)
+    _text(surf, shown_text(final, m, 1), (right, y + 4), 26, _GRADE_COLOR[m.grade], True,
           anchor="topright")  # fmt: skip
     _text(surf, m.grade, (right, y + 30), 22, _GRADE_COLOR[m.grade], anchor="topright")
     y += 60
@@ -413,36 +420,31 @@ def _draw_panel(surf, app: App, frame, role_col) -> None:
 
 
 # ------------------------------------------------------------------------------ results
-def _draw_evaluation(surf, app: App) -> None:
+def _draw_evaluation(surf: Surface, app: App) -> None:
+    if app.final is None:  # no game scored yet
+        return
     m = app.final["manual"]
     cx = WINDOW[0] // 2
     sc = app.scenario
     _text(surf, "Performance evaluation", (cx, 40), 36, THEME["dim"], anchor="center")
     _text(surf, m.grade, (cx, 110), 96, _GRADE_COLOR[m.grade], True, "center")
-    _text(surf, f"{sc.name} ({sc.difficulty}), seed {app.seed}, {app.session.world.time_s:g} s played",
+    _text(surf, f"{sc.name} ({sc.difficulty}), seed {app.seed}, {app.game.world.time_s:g} s played",
           (cx, 168), 24, THEME["dim"], anchor="center")  # fmt: skip
-    rows = [
-        ("Total negative reward", f"{-m.total_negative_reward:.2f}"),
-        ("Expected negative reward", f"{-m.expected_negative_reward:.2f}"),
-        ("Negative reward ratio (NRR)", f"{m.negative_reward_ratio:.2f} %"),
-        ("Overall firefighting score (OFS)", f"{m.overall_firefighting:.2f} %"),
-        ("Perception score (PS)", f"{m.perception:.2f} %"),
-        ("Action score (AS)", f"{m.action:.2f} %"),
-        ("Facility protection score (FPS)", f"{m.facility_protection:.2f} %"),
-        ("Final score = PS + AS + FPS - 3 NRR", f"{m.final_score:.2f}"),
-    ]
     y = 220
-    for k, v in rows:
-        bold = k.startswith("Final")
-        _text(surf, k, (cx - 330, y), 30, bold=bold)
-        _text(surf, v, (cx + 330, y), 30, bold=bold, anchor="topright")
+    for spec in METRICS:
+        if spec.name == "grade":  # shown above, large
+            continue
+        bold = spec.name == "final_score"
+        label = f"{spec.title} = {_FINAL_SCORE}" if bold else spec.title
+        _text(surf, label, (cx - 330, y), 30, bold=bold)
+        _text(surf, shown_text(spec, m, 2), (cx + 330, y), 30, bold=bold, anchor="topright")
         y += 44
     ref = app.final["reference2020"]
     _text(surf, f"2020 reference definition: final {ref.final_score:.2f} ({ref.grade})",
           (cx, y + 14), 22, THEME["dim"], anchor="center")  # fmt: skip
 
 
-def _draw_playback(surf, app: App) -> None:
+def _draw_playback(surf: Surface, app: App) -> None:
     _text(surf, "Save playback", (40, 40), 48, THEME["accent"], True)
     path = str(app.recording_path) if app.recording_path else "(not recorded)"
     lines = [
@@ -460,3 +462,16 @@ def _draw_playback(surf, app: App) -> None:
     for text, color in lines:
         _text(surf, _fit(text, WINDOW[0] - 100, 26), (60, y), 26, color)
         y += 40
+
+
+_SCREENS: dict[str, Callable[[Surface, App], None]] = {
+    "welcome": _draw_welcome,
+    "scenarios": _draw_scenarios,
+    "tutorial": _draw_tutorial,
+    "designer": _draw_designer,
+    "preview": _draw_preview,
+    "game": _draw_game,
+    "evaluation": _draw_evaluation,
+    "playback": _draw_playback,
+}
+"""The drawing function of each screen."""

@@ -9,8 +9,6 @@ import math
 import multiprocessing
 
 import pytest
-from hypothesis import given
-from hypothesis import strategies as st
 
 from fcplan import scheduling
 from fcplan.errors import FcplanError, UnknownNameError
@@ -18,11 +16,10 @@ from fcplan.experiments.compare import (
     METRICS,
     ComparisonResult,
     ProgressPrinter,
-    RangeError,
     compare,
-    parse_range,
 )
 from fcplan.scenario import load_scenario
+from tests.experiments.schedulers import DiesOnce
 
 # the package exports the function `compare`, which shadows the module's name as an attribute
 compare_mod = importlib.import_module("fcplan.experiments.compare")
@@ -53,44 +50,6 @@ def _same(a, b):
             assert isinstance(b[k], float) and math.isnan(b[k]), k
         else:
             assert a[k] == b[k], k
-
-
-# ---- parse_range ------------------------------------------------------------------------------
-
-
-def test_parse_range_cases():
-    """Single numbers, inclusive ranges, lists, names and duplicates parse in the order given."""
-    assert parse_range("1-24") == list(range(1, 25))
-    assert parse_range("1,3,5-7") == [1, 3, 5, 6, 7]
-    assert parse_range("practice") == ["practice"]
-    assert parse_range(" practice , 2-3, 2 ") == ["practice", 2, 3]
-    assert parse_range("0", names=False) == [0]
-    assert parse_range("4-4", names=False) == [4]
-
-
-@pytest.mark.parametrize(
-    ("text", "names", "match"),
-    [
-        ("", True, "empty item"),
-        ("1,,2", True, "empty item"),
-        ("5-3", True, "empty range"),
-        ("a-b", False, "integer >= 0"),
-        ("-1", False, "integer >= 0"),
-        ("1.5", False, "integer >= 0"),
-        ("0-100000000", False, "more than"),
-    ],
-)
-def test_parse_range_errors(text, names, match):
-    """Malformed lists raise RangeError (an FcplanError and a ValueError) naming the problem."""
-    with pytest.raises(RangeError, match=match) as info:
-        parse_range(text, names=names)
-    assert isinstance(info.value, FcplanError) and isinstance(info.value, ValueError)
-
-
-@given(st.lists(st.integers(0, 500), min_size=1, max_size=20))
-def test_parse_range_reads_back_joined_lists(values):
-    """Joining integers with commas and parsing gives them back, first occurrences only."""
-    assert parse_range(",".join(map(str, values)), names=False) == list(dict.fromkeys(values))
 
 
 # ---- validation -------------------------------------------------------------------------------
@@ -254,6 +213,19 @@ def test_failing_episode_is_recorded_and_others_complete(monkeypatch):
     assert (rows["idle"]["episodes"], rows["idle"]["errors"]) == (1, 1)
     assert math.isnan(rows["idle"]["final_score_ci"])  # one completed episode
     assert "1 episode(s) failed" in res.format()
+
+
+def test_dead_worker_restarts_the_pool_and_every_episode_completes(tmp_path, monkeypatch):
+    """A worker process that dies mid-episode breaks the pool; the pool restarts (as for sweeps),
+    the episodes in flight run again, and every episode completes with greedy's scores."""
+    marker = tmp_path / "died"
+    monkeypatch.setitem(scheduling._RUNTIME, "dies-once", DiesOnce)
+    dies = f"dies-once:marker={marker}"
+    res = compare([short(3, 10)], [dies, "greedy"], [0, 1], jobs=2)
+    assert marker.exists()
+    assert [e["error"] for e in res.episodes] == [""] * 4
+    scores = {(e["scheduler"], e["seed"]): e["manual.final_score"] for e in res.episodes}
+    assert [scores[dies, k] for k in (0, 1)] == [scores["greedy", k] for k in (0, 1)]
 
 
 def test_keyboard_interrupt_stops_workers():

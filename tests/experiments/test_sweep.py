@@ -14,6 +14,7 @@ import pytest
 
 from fcplan import scheduling
 from fcplan.experiments import load_results, load_sweep_config, sweep
+from tests.experiments.schedulers import DiesOnce
 
 pytest.importorskip("pyarrow")
 pytest.importorskip("pandas")
@@ -98,26 +99,10 @@ def test_failing_episodes_are_recorded_and_retried_on_request(tmp_path, monkeypa
     _assert_exactly_once(tmp_path, config)
 
 
-class _DiesOnce:
-    """A scheduler whose first plan() call anywhere kills its worker process (os._exit)."""
-
-    name = "dies-once"
-
-    def __init__(self, marker: str = ""):
-        self.marker = Path(marker)
-        self._greedy = scheduling.make_scheduler("greedy")
-
-    def plan(self, graph, *, time_limit=None, rng=None):
-        if self.marker.name and not self.marker.exists():
-            self.marker.touch()
-            os._exit(3)
-        return self._greedy.plan(graph, time_limit=time_limit, rng=rng)
-
-
 def test_killed_worker_loses_only_episodes_in_flight(tmp_path, monkeypatch):
     """A worker process that dies mid-episode breaks the pool; the pool restarts, the episodes in
     flight run again, and every episode is stored exactly once."""
-    monkeypatch.setitem(scheduling._RUNTIME, "dies-once", _DiesOnce)
+    monkeypatch.setitem(scheduling._RUNTIME, "dies-once", DiesOnce)
     marker = tmp_path / "died"
     config = {
         **TINY,

@@ -1,15 +1,12 @@
-"""The game's screens (fcplan.game.screens), the open-world designer and the online scores,
-without pygame."""
+"""The game's screens (fcplan.game.screens) and the open-world designer, without pygame."""
 
 from __future__ import annotations
 
 import pytest
 
-from fcplan import World, load_scenario
+from fcplan import load_scenario
 from fcplan.game.designer import PAGES, Design
-from fcplan.game.scores import OnlineScores
 from fcplan.game.screens import SCREENS, TUTORIAL, App
-from fcplan.metrics import compute_metrics
 
 
 def test_welcome_navigation_reaches_every_menu_screen():
@@ -214,22 +211,6 @@ def test_default_recording_path_uses_the_data_dir(monkeypatch, tmp_path):
     assert p.parent == tmp_path / "recordings" and p.name.startswith("practice-seed3-")
 
 
-def test_online_scores_follow_the_world_tick_by_tick():
-    """OnlineScores gives compute_metrics of the trace so far, updated as the world advances."""
-    from fcplan.team import Command
-
-    world = World().reset(load_scenario(3), seed=1)
-    scores = OnlineScores(world)
-    world.step({"P1": Command(route=((300.0, 300.0),)), "A1": Command(route=((320.0, 300.0),))})
-    seen = []
-    while world.tick < 300:
-        world.step()
-        if world.tick % 100 == 0:
-            assert scores.metrics() == compute_metrics(world.trace())
-            seen.append(scores.metrics().total_negative_reward)
-    assert seen == sorted(seen) and seen[0] < seen[-1]
-
-
 def test_design_defaults_fit_every_world_size():
     """The default design builds at 800, 1000 and 1200 px."""
     d = Design()
@@ -237,3 +218,28 @@ def test_design_defaults_fit_every_world_size():
         assert d.set("world_size", size) is None
         sc, problems = d.build()
         assert problems == [] and sc.world_size == size
+
+
+def test_preview_is_drawn_again_only_when_the_design_changes():
+    """The designer's preview image is kept while the design builds an equal scenario, and drawn
+    again once a field changes."""
+    app = App()
+    app.press("open_world")
+    first = app.preview_image(120)
+    assert app.preview_image(120) is first
+    assert app.edit("world_size", "800") is None
+    second = app.preview_image(120)
+    assert second is not first and app.preview_target().world_size == 800
+    assert app.preview_image(100).shape == (100, 100, 3)
+
+
+def test_recording_is_saved_once_per_game(tmp_path):
+    """Ending a game saves its recording; saving again writes nothing new until the next game."""
+    sc = load_scenario("practice").replace(duration_s=1)
+    app = App(sc, fast=True, frame_ticks=5, record=tmp_path / "g.npz")
+    while app.screen == "game":
+        app.advance()
+    path = app.save_recording()
+    assert path == tmp_path / "g.npz" and path.exists()
+    path.unlink()
+    assert app.save_recording() == path and not path.exists()  # already saved: not rewritten

@@ -1,4 +1,4 @@
-"""Tests of the numpy frame renderer (fcplan.render)."""
+"""Tests of fcplan.render.renderer: whole frames, drawn by a Renderer or render_frame."""
 
 from __future__ import annotations
 
@@ -8,34 +8,18 @@ import sys
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from fcplan import World, load_scenario
 from fcplan.render import (
     COLORS,
     FrameData,
+    Renderer,
     RenderError,
-    draw_text,
     panel_width,
     render_frame,
     snapshot,
-    text_size,
 )
 from fcplan.team import Command
-
-
-@pytest.fixture(scope="module")
-def world():
-    """Scenario 1 after a few seconds with agents sent out (so routes and FOVs exist)."""
-    w = World().reset(load_scenario(1), seed=0)
-    cmds = {
-        aid: Command(route=((600.0, 600.0), (700.0, 300.0)), altitude=50.0) for aid in w.team.ids
-    }
-    w.step(cmds)
-    for _ in range(40):
-        w.step()
-    return w
 
 
 def _blank(world) -> FrameData:
@@ -124,14 +108,6 @@ def test_deterministic(world):
     assert np.array_equal(a, b)
 
 
-def test_panel_lists_scores_and_agents(world):
-    """The panel draws text for scores and one row per agent (more ink with more scores)."""
-    base = render_frame(world.scenario, snapshot(world), size=512)
-    more = render_frame(world.scenario, snapshot(world, scores={"a": 1, "b": 2}), size=512)
-    panel = slice(512, None)
-    assert (more[:, panel] != base[:, panel]).any()
-
-
 def test_mismatched_frame_is_refused(world):
     """A frame whose grids or team do not fit the scenario raises RenderError naming the field."""
     frame = snapshot(world)
@@ -154,18 +130,34 @@ def test_headless_without_gui_libraries():
     assert out.stdout.split() == ["False", "False"]
 
 
-@settings(max_examples=40, deadline=None)
-@given(
-    st.text(alphabet=st.characters(min_codepoint=32, max_codepoint=126), max_size=20),
-    st.integers(1, 3),
-)
-def test_text_fits_its_size(text, scale):
-    """draw_text inks only inside the box text_size reports, and returns the next x."""
-    w, h = text_size(text, scale)
-    img = np.zeros((h + 10, w + 10, 3), np.uint8)
-    end = draw_text(img, text, 5, 5, (255, 255, 255), scale)
-    ink = img[..., 0] > 0
-    outside = ink.copy()
-    outside[5 : 5 + h, 5 : 5 + w] = False
-    assert not outside.any()
-    assert end == (5 + w + scale if text else 5)
+def test_renderer_holds_the_static_map_and_matches_render_frame(world):
+    """A Renderer draws its read-only static map once; its frames equal render_frame's, with and
+    without panel, for every frame it is given."""
+    renderer = Renderer(world.scenario, 300)
+    assert renderer.background.shape == (300, 300, 3) and not renderer.background.flags.writeable
+    background = renderer.background
+    for frame in (snapshot(world), _blank(world)):
+        for panel in (True, False):
+            got = renderer.render(frame, panel=panel, show_truth=True)
+            want = render_frame(world.scenario, frame, size=300, panel=panel, show_truth=True)
+            assert np.array_equal(got, want)
+    assert renderer.background is background
+
+
+def test_render_frame_reuses_a_renderer_for_equal_scenarios(world):
+    """render_frame shares one renderer between equal scenarios (the static map depends only on
+    the scenario's values and the size), and a different size gets its own."""
+    from fcplan.render import renderer as renderer_mod
+
+    copy = dataclasses.replace(world.scenario)
+    assert copy == world.scenario and copy is not world.scenario
+    assert renderer_mod._shared(world.scenario, 256) is renderer_mod._shared(copy, 256)
+    assert renderer_mod._shared(world.scenario, 257) is not renderer_mod._shared(copy, 256)
+
+
+def test_too_small_size_is_refused(world):
+    """Maps smaller than 32 px are a RenderError, from render_frame and Renderer alike."""
+    with pytest.raises(RenderError, match="at least 32"):
+        render_frame(world.scenario, snapshot(world), size=31)
+    with pytest.raises(RenderError, match="at least 32"):
+        Renderer(world.scenario, 16)

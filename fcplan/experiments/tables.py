@@ -1,0 +1,136 @@
+"""The layout shared by experiment tables: the columns they summarise, and their row order.
+
+An experiment table (:meth:`~fcplan.experiments.ComparisonResult.table`, the sweep report) has a
+``mean ± ci`` cell per scheduler for a fixed list of columns. A *score column* is one metric of
+:data:`fcplan.metrics.METRICS` under one definition (the manual's final score, OFS, PS, AS, FPS,
+NRR and total negative reward, and the reference2020 final score); its header, decimals and
+direction come from the metric's :class:`~fcplan.metrics.MetricSpec`, so no label is written here
+again. A *run column* is a measurement of the episode run (solve time per replan, fallbacks, wall
+time), which the sweep report tabulates as well.
+
+* :data:`SCORE_COLUMNS`: what :func:`~fcplan.experiments.compare` tabulates; each has the short
+  ``key`` of its ``<key>_mean`` / ``<key>_ci`` fields in comparison tables and CSV files.
+* :data:`REPORT_COLUMNS`: what :func:`~fcplan.experiments.report` tabulates (scores, then runs).
+* :func:`higher_is_better`: the direction of any result column, for paired verdicts.
+* :func:`difficulty_key`: rows by difficulty group come in the order of
+  :data:`fcplan.scenario.model.DIFFICULTIES` (practice, easy, moderate, hard, custom).
+
+Examples
+--------
+>>> [c.key for c in SCORE_COLUMNS][:3]
+['final_score', 'ofs', 'ps']
+>>> SCORE_COLUMNS[1].name, SCORE_COLUMNS[1].label, SCORE_COLUMNS[1].decimals
+('manual.overall_firefighting', 'OFS %', 1)
+>>> higher_is_better("manual.negative_reward_ratio"), higher_is_better("solve_p95_ms")
+(False, False)
+>>> sorted(["hard", "mine", "easy"], key=difficulty_key)
+['easy', 'hard', 'mine']
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fcplan.errors import UnknownNameError
+from fcplan.metrics import DEFINITIONS, metric_spec
+from fcplan.scenario.model import DIFFICULTIES
+
+__all__ = [
+    "Column",
+    "REPORT_COLUMNS",
+    "RUN_COLUMNS",
+    "SCORE_COLUMNS",
+    "difficulty_key",
+    "higher_is_better",
+]
+
+
+@dataclass(frozen=True)
+class Column:
+    """One summarised column of an experiment table.
+
+    Attributes
+    ----------
+    name : str
+        The column of episode rows and sweep results (``"manual.overall_firefighting"``).
+    label : str
+        Its header in text, Markdown and HTML tables (``"OFS %"``).
+    decimals : int
+        Decimals of its ``mean ± ci`` cells.
+    higher_is_better : bool
+        Which way a difference between two schedulers counts as better.
+    key : str
+        Short name in comparison tables (``"ofs"`` gives ``ofs_mean`` and ``ofs_ci``); ``""`` for
+        columns that only the sweep report shows.
+    """
+
+    name: str
+    label: str
+    decimals: int
+    higher_is_better: bool
+    key: str = ""
+
+
+def _score(key: str, metric: str, definition: str = "manual", label: str = "") -> Column:
+    """The column of ``metric`` under ``definition``, described by its metric-table entry."""
+    spec = metric_spec(metric)
+    return Column(
+        spec.key(definition), label or spec.column, spec.decimals, spec.higher_is_better, key
+    )
+
+
+SCORE_COLUMNS: tuple[Column, ...] = (
+    _score("final_score", "final_score"),
+    _score("ofs", "overall_firefighting"),
+    _score("ps", "perception"),
+    _score("as", "action"),
+    _score("fps", "facility_protection"),
+    _score("nrr", "negative_reward_ratio"),
+    _score("neg_reward", "total_negative_reward"),
+    _score("ref2020_final_score", "final_score", "reference2020", "ref2020 final"),
+)
+"""Scores in experiment tables: the manual's metrics and the reference2020 final score."""
+
+RUN_COLUMNS: tuple[Column, ...] = (
+    Column("solve_p50_ms", "solve p50 ms", 2, False),
+    Column("solve_p95_ms", "solve p95 ms", 2, False),
+    Column("fallbacks", "fallbacks", 1, False),
+    Column("wall_time_s", "wall s", 2, False),
+)
+"""Measurements of the episode run that the sweep report tabulates after the scores."""
+
+REPORT_COLUMNS: tuple[Column, ...] = SCORE_COLUMNS + RUN_COLUMNS
+"""Every column of the sweep report's tables, in order."""
+
+# Result columns outside the tables that are better when lower (matched as substrings).
+_LOWER_IS_BETTER = ("solve_", "wall_time", "fallbacks")
+
+
+def higher_is_better(name: str) -> bool:
+    """Whether a larger value of result column ``name`` is better.
+
+    A column of :data:`REPORT_COLUMNS` or a metric (``"<definition>.<metric>"``) answers from its
+    description; any other column is lower-is-better when its name says it is a solve time, a
+    wall time or a fallback count.
+
+    Examples
+    --------
+    >>> higher_is_better("reference2020.total_negative_reward"), higher_is_better("tasks_mean")
+    (False, True)
+    """
+    for col in REPORT_COLUMNS:
+        if col.name == name:
+            return col.higher_is_better
+    definition, _, metric = name.partition(".")
+    if definition in DEFINITIONS:
+        try:
+            return metric_spec(metric).higher_is_better
+        except UnknownNameError:
+            pass
+    return not any(k in name for k in _LOWER_IS_BETTER)
+
+
+def difficulty_key(difficulty: str) -> tuple[int, str]:
+    """Sort key of a difficulty group: the known groups in order, then any other by name."""
+    known = DIFFICULTIES.index(difficulty) if difficulty in DIFFICULTIES else len(DIFFICULTIES)
+    return (known, difficulty)

@@ -1,0 +1,37 @@
+"""Tests for fcplan.experiments.backends: which backend runs a batch, and substitute players."""
+
+from __future__ import annotations
+
+from fcplan.experiments.backends import select_backend
+
+
+class _Spec:
+    def __init__(self, key: str):
+        self.key = key
+
+
+def _square(spec: _Spec) -> int:
+    """A module-level (so picklable) player: the square of the spec's key."""
+    return int(spec.key) ** 2
+
+
+def test_backend_choice():
+    """jobs=1 or a single spec runs here; more run on a pool of at most one worker per spec;
+    a Dask address names the Dask backend but starts nothing for no specs."""
+    specs = [_Spec(str(k)) for k in range(3)]
+    assert select_backend(specs, 1)[0] == "serial"
+    assert select_backend(specs[:1], 8)[0] == "serial"
+    name, outcomes = select_backend(specs, 8, play=_square)
+    outcomes.close()
+    assert name == "pool:3"
+    name, outcomes = select_backend([], 2, dask="tcp://nowhere:1")
+    assert (name, list(outcomes)) == ("dask:tcp://nowhere:1", [])
+
+
+def test_substitute_player_runs_on_every_backend():
+    """``play`` replaces the sweep episode player, in this process and in pool workers alike."""
+    specs = [_Spec(str(k)) for k in range(4)]
+    for jobs in (1, 2):
+        _, outcomes = select_backend(specs, jobs, play=_square)
+        got = {spec.key: (result, lost) for spec, result, lost in outcomes}
+        assert got == {str(k): (k * k, None) for k in range(4)}
