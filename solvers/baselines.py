@@ -15,7 +15,6 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
-from solvers._feasible import round_trip_ok, start_budget, start_positions
 
 __all__ = ["IdleScheduler", "RandomScheduler"]
 
@@ -47,11 +46,7 @@ class RandomScheduler:
 
     def plan(self, graph: TaskGraph, *, time_limit=None, rng: np.random.Generator) -> Plan:
         """Draw a random feasible route of one task per free agent."""
-        start = start_positions(graph)
-        budget = start_budget(graph)
-        d_first = np.hypot(*(start[:, None, :] - graph.task_pos[None, :, :]).transpose(2, 0, 1))
-        feasible = graph.can_do & round_trip_ok(graph)
-        feasible &= d_first + graph.task_home_distance <= budget[:, None]
+        feasible = graph.reachable
         routes, alts = {}, {}
         for i, agent in enumerate(graph.agent_ids):
             if graph.agent_mode[i] == Mode.HOMING:

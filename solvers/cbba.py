@@ -144,7 +144,6 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = ["CBBAScheduler", "CBBAResult", "CommGraph", "StageResult", "communication_graph"]
 
@@ -621,7 +620,7 @@ class CBBAScheduler:
             if res.service[i] == "sense":
                 watch = graph.task_kind[tasks[-1]] == TaskKind.FIRE
                 z = self.watch_altitude if watch else self.search_altitude
-                alts[agent] = clip_altitude(graph, i, z)
+                alts[agent] = graph.clip_altitude(i, z)
         comm = res.comm
         size = {
             "agents": graph.n_agents,
@@ -660,10 +659,10 @@ class CBBAScheduler:
         a = graph.n_agents
         forced = graph.agent_mode == Mode.RETURNING
         free = graph.agent_mode != Mode.HOMING
-        start = start_positions(graph)
-        budget = start_budget(graph)
-        d_start = np.where(forced[:, None], graph.task_home_distance, graph.agent_task_distance)
-        trip = round_trip_ok(graph)
+        start = graph.agent_start_pos
+        budget = graph.agent_budget_px
+        d_start = graph.start_task_distance
+        trip = graph.in_round_trip
         rate = math.log(2.0) / self.half_life_s
         fires = graph.fire_tasks
         stale = graph.task_staleness

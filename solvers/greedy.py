@@ -36,7 +36,6 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
-from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = ["GreedyScheduler"]
 
@@ -88,8 +87,8 @@ class GreedyScheduler:
         """Build the greedy plan for ``graph``."""
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}
-        start = start_positions(graph)
-        budget = start_budget(graph)
+        start = graph.agent_start_pos
+        budget = graph.agent_budget_px
         free = graph.agent_mode != Mode.HOMING
         fires = graph.fire_tasks
         objective = 0.0
@@ -147,7 +146,7 @@ class GreedyScheduler:
                 busy.add(i)
                 watched_clusters.add(cl)
                 routes[graph.agent_ids[i]] = (graph.task_ids[k],)
-                alts[graph.agent_ids[i]] = clip_altitude(graph, i, self.watch_altitude)
+                alts[graph.agent_ids[i]] = graph.clip_altitude(i, self.watch_altitude)
 
         # 3. the others search
         searchers = np.array(
@@ -174,7 +173,7 @@ class GreedyScheduler:
             for row, tasks in picks.items():
                 if tasks:
                     routes[graph.agent_ids[row]] = tuple(graph.task_ids[k] for k in tasks)
-                    alts[graph.agent_ids[row]] = clip_altitude(graph, row, self.search_altitude)
+                    alts[graph.agent_ids[row]] = graph.clip_altitude(row, self.search_altitude)
         return Plan(
             routes=routes,
             altitudes=alts,
@@ -214,7 +213,7 @@ class GreedyScheduler:
         used = np.zeros(n_a)  # px already planned
         elapsed = np.zeros(n_a)  # s already planned
         home = graph.task_home_distance[np.ix_(agents, tasks)]  # (a, k)
-        ok = round_trip_ok(graph)[np.ix_(agents, tasks)] & (value > 0)[None, :]
+        ok = graph.in_round_trip[np.ix_(agents, tasks)] & (value > 0)[None, :]
         left = budget[agents]
         count = np.zeros(n_a, dtype=np.int64)
         taken = np.zeros(n_k, dtype=bool)

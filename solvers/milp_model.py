@@ -125,7 +125,6 @@ import scipy.sparse as sp
 from fcplan.plan import Plan
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = [
     "DUMP",
@@ -308,13 +307,13 @@ def build_milp_model(graph: TaskGraph, params: MilpParams | None = None) -> Milp
     kind[np.ix_(act, fire)] = DUMP
 
     # ---- battery terms (whole px, conservative) and feasibility pre-filter
-    start = start_positions(graph)
+    start = graph.agent_start_pos
     d0 = np.hypot(*(start[:, None, :] - graph.task_pos[None, :, :]).transpose(2, 0, 1))
     dh = graph.task_home_distance
     first_leg = np.ceil(d0 + dh - 1e-9)
     later_leg = np.ceil(2.0 * dh - 1e-9)
-    rng_px = np.floor(start_budget(graph) + 1e-6)
-    ok = (kind >= 0) & round_trip_ok(graph)
+    rng_px = np.floor(graph.agent_budget_px + 1e-6)
+    ok = (kind >= 0) & graph.in_round_trip
     ok0 = ok & (first_leg <= rng_px[:, None])
     min_first = np.where(ok0, first_leg, np.inf).min(axis=1, initial=np.inf)
     ok_later = ok & (min_first[:, None] + later_leg <= rng_px[:, None])
@@ -536,7 +535,7 @@ def decode_plan(model: MilpModel, x: np.ndarray, graph: TaskGraph, stats=None) -
         routes[aid] = tuple(graph.task_ids[k] for k in ks)
         if graph.agent_can_sense[a]:
             z = p.watch_altitude if graph.task_kind[ks[0]] == TaskKind.FIRE else p.search_altitude
-            alts[aid] = clip_altitude(graph, a, z)
+            alts[aid] = graph.clip_altitude(a, z)
     return Plan(routes=routes, altitudes=alts, stats=stats)
 
 

@@ -5,7 +5,8 @@ models, first the **action** model, then the **perception** model:
 
 * **Vehicles** are the available agents of the role (not ``HOMING``). A vehicle starts where the
   agent is, or at its depot slot with a full battery if the agent is on a forced return (it
-  recharges first, see :mod:`solvers._feasible`), and ends at its depot slot.
+  recharges first, see :attr:`fcplan.taskgraph.TaskGraph.agent_start_pos`), and ends at its depot
+  slot.
 * **Nodes** are the tasks that role can serve: fire tasks for action agents; search blocks *and*
   fire tasks for perception agents. Hybrids (camera and water) that still have water are action
   vehicles (fires only, no altitude is set for them, as in ``greedy``); hybrids with an empty
@@ -128,7 +129,6 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = ["RoutingScheduler", "RouteSolution", "RoutingFailedError", "solve_routes"]
 
@@ -537,9 +537,9 @@ class RoutingScheduler:
         limit = self.time_limit if time_limit is None else float(time_limit)
         # keep a little of the limit for turning routes into the plan and freeing the models
         deadline = time.perf_counter() + limit - min(0.1 * limit, 0.005)
-        start = start_positions(graph)
-        budget = start_budget(graph)
-        trip = round_trip_ok(graph)
+        start = graph.agent_start_pos
+        budget = graph.agent_budget_px
+        trip = graph.in_round_trip
         free = graph.agent_mode != Mode.HOMING
         actors = np.flatnonzero(free & graph.agent_can_act & (graph.agent_tank > 0))
         sensors = np.flatnonzero(
@@ -610,7 +610,7 @@ class RoutingScheduler:
                     else:
                         z = self.search_altitude
                     routes[graph.agent_ids[i]] = tuple(graph.task_ids[k] for k in ks)
-                    alts[graph.agent_ids[i]] = clip_altitude(graph, i, z)
+                    alts[graph.agent_ids[i]] = graph.clip_altitude(i, z)
 
         status = (
             "time_limit" if any(s.status == "time_limit" for s in sols.values()) else "feasible"

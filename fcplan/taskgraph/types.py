@@ -44,8 +44,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import IntEnum
-from functools import cached_property
-from typing import Any, TypeVar
+from typing import Any, Generic, TypeVar, overload
 
 import numpy as np
 
@@ -66,6 +65,31 @@ __all__ = [
 FEASIBILITY_TOL_PX = 1e-6
 
 _T = TypeVar("_T")
+
+
+class cached_view(Generic[_T]):  # noqa: N801 - named like functools.cached_property
+    """:func:`functools.cached_property` without its lock (Python 3.11 takes one at every first
+    access, a third of the cost of the cheaper views; graphs are not shared between threads
+    while their views are being filled in). The value is kept in the instance's ``__dict__``,
+    which also lets a builder fill views in at construction."""
+
+    def __init__(self, func: Callable[[Any], _T]) -> None:
+        self.func = func
+        self.__doc__ = func.__doc__
+        self.name = func.__name__
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, obj: None, owner: type | None = None) -> cached_view[_T]: ...
+    @overload
+    def __get__(self, obj: object, owner: type | None = None) -> _T: ...
+    def __get__(self, obj: object | None, owner: type | None = None) -> cached_view[_T] | _T:
+        if obj is None:
+            return self
+        value = obj.__dict__[self.name] = self.func(obj)
+        return value
 
 
 class TaskKind(IntEnum):
@@ -143,9 +167,11 @@ class SharedMemo:
     def get(self, key: str, inputs: tuple[np.ndarray, ...], make: Callable[[], _T]) -> _T:
         """The value under ``key`` made from ``inputs`` (see the class docstring)."""
         hit = self._entries.get(key)
-        if hit is not None:
-            held = hit[0]
-            if len(held) == len(inputs) and all(a is b for a, b in zip(held, inputs, strict=True)):
+        if hit is not None and len(hit[0]) == len(inputs):
+            for a, b in zip(hit[0], inputs, strict=True):
+                if a is not b:
+                    break
+            else:
                 value: _T = hit[1]
                 return value
         value = make()
@@ -223,34 +249,34 @@ class TaskGraph:
         """(k,) indices of the search tasks."""
         return np.flatnonzero(self.task_kind == TaskKind.SEARCH)
 
-    @cached_property
+    @cached_view
     def task_index(self) -> dict[str, int]:
         """Task id -> row."""
         return dict(zip(self.task_ids, range(len(self.task_ids)), strict=True))
 
-    @cached_property
+    @cached_view
     def agent_index(self) -> dict[str, int]:
         """Agent id -> row."""
         return dict(zip(self.agent_ids, range(len(self.agent_ids)), strict=True))
 
-    @cached_property
+    @cached_view
     def shared_memo(self) -> SharedMemo | None:
         """The memo of the builder that made this graph (None: not made by a builder, or
         changed since, e.g. by :func:`dataclasses.replace`)."""
         return None
 
     # ------------------------------------------------------------------ distances
-    @cached_property
+    @cached_view
     def agent_task_distance(self) -> np.ndarray:
         """(A, K) straight-line px from each agent to each task."""
         return self._agent_distances()[0]
 
-    @cached_property
+    @cached_view
     def task_distance(self) -> np.ndarray:
         """(K, K) px between tasks."""
         return pairwise_distance(self.task_pos, self.task_pos)
 
-    @cached_property
+    @cached_view
     def task_home_distance(self) -> np.ndarray:
         """(A, K) px from each task back to each agent's depot slot."""
         return self._agent_distances()[1]
@@ -266,56 +292,56 @@ class TaskGraph:
             d.setdefault("task_home_distance", both[n_a:]),
         )
 
-    @cached_property
+    @cached_view
     def agent_task_time(self) -> np.ndarray:
         """(A, K) seconds of flight from each agent to each task."""
         return self.agent_task_distance / self.agent_speed[:, None]
 
-    @cached_property
+    @cached_view
     def can_do(self) -> np.ndarray:
         """(A, K) bool: the agent's role can serve the task (fires: anyone; search: sensors)."""
         return (self.task_kind == _FIRE_KIND)[None, :] | self.agent_can_sense[:, None]
 
-    @cached_property
+    @cached_view
     def node_ids(self) -> tuple[str, ...]:
         """All node ids in the order of :attr:`positions`: agents, depot, tasks, facilities."""
         fac = tuple(f"facility:{i}:{k}" for i, k in enumerate(self.facility_kinds))
         return self.agent_ids + ("depot",) + self.task_ids + fac
 
-    @cached_property
+    @cached_view
     def positions(self) -> np.ndarray:
         """(N, 2) positions of all nodes in :attr:`node_ids` order."""
         return np.concatenate(
             [self.agent_pos, self.depot_pos[None, :], self.task_pos, self.facility_pos]
         )
 
-    @cached_property
+    @cached_view
     def distance(self) -> np.ndarray:
         """(N, N) straight-line travel distance between all nodes (px)."""
         return pairwise_distance(self.positions, self.positions)
 
     # ------------------------------------------------------------------ feasibility
-    @cached_property
+    @cached_view
     def _returning(self) -> list[bool]:
         """Per agent, is it on a forced return (it recharges at its depot slot before its next
         route)? A list: a handful of agents, and Python's any/all beat numpy's."""
         return [m == _RETURNING for m in self.agent_mode.tolist()]
 
-    @cached_property
+    @cached_view
     def agent_start_pos(self) -> np.ndarray:
         """(A, 2) where each agent's next route starts: its depot slot on a forced return,
         else where it is."""
         forced = np.array(self._returning, dtype=bool).reshape(-1)
         return np.where(forced[:, None], self.agent_home, self.agent_pos)
 
-    @cached_property
+    @cached_view
     def agent_budget_px(self) -> np.ndarray:
         """(A,) px of flight each agent has for its next route, the way home included: a full
         battery on a forced return, else ``agent_battery / DRAIN_PER_PX``."""
         forced = np.array(self._returning, dtype=bool).reshape(-1)
         return np.where(forced, self.agent_full_range, self.agent_battery / DRAIN_PER_PX)
 
-    @cached_property
+    @cached_view
     def start_task_distance(self) -> np.ndarray:
         """(A, K) px from each agent's :attr:`agent_start_pos` to each task."""
         forced = self._returning
@@ -325,14 +351,14 @@ class TaskGraph:
             np.array(forced)[:, None], self.task_home_distance, self.agent_task_distance
         )
 
-    @cached_property
+    @cached_view
     def in_round_trip(self) -> np.ndarray:
         """(A, K) bool: the task lies within a round trip of the agent's depot slot on a full
         battery, ``2 * task_home_distance <= agent_full_range`` (+ tolerance)."""
         dh, full = self.task_home_distance, self.agent_full_range
-        return self._shared("in_round_trip", (dh, full), lambda: _round_trip(dh, full))
+        return self._shared("in_round_trip", (dh, full), lambda: _round_trip(dh, full[:, None]))
 
-    @cached_property
+    @cached_view
     def reachable(self) -> np.ndarray:
         """(A, K) bool: the agent can serve the task as its next route and fly home, exactly
         when :func:`fcplan.plan.validate_plan` accepts the one-task route ``(task,)``.
@@ -343,17 +369,42 @@ class TaskGraph:
         tolerance), unless it is on a forced return (it recharges first).
         """
         dh, full, can = self.task_home_distance, self.agent_full_range, self.can_do
-        ok = self._shared("serviceable", (dh, full, can), lambda: self.in_round_trip & can)
+        memo = self.shared_memo
+        if memo is None or dh.flags.writeable or full.flags.writeable or can.flags.writeable:
+            ok = _serviceable(dh, full, can)  # (this graph's own arrays: nothing to share)
+        else:
+            ok = memo.get("serviceable", (dh, full, can), lambda: _serviceable(dh, full, can))
         forced = self._returning
         if all(forced):
             return ok
-        reach = self.agent_task_distance + dh
         # (rows of agents on a forced return are overwritten below)
-        reach = reach <= (self.agent_battery / DRAIN_PER_PX + FEASIBILITY_TOL_PX)[:, None]
+        reach = _battery_ok(self.agent_task_distance, dh, self.agent_battery[:, None])
         if True in forced:
             reach |= np.array(forced)[:, None]
         reach &= ok
         return reach
+
+    def in_round_trip_at(self, agents: np.ndarray, tasks: np.ndarray) -> np.ndarray:
+        """:attr:`in_round_trip` at the pairs ``(agents[n], tasks[n])`` of agent and task rows
+        (without computing the whole table)."""
+        dh = self.task_home_distance[agents, tasks]
+        return _round_trip(dh, self.agent_full_range[agents])
+
+    def reachable_at(self, agents: np.ndarray, tasks: np.ndarray) -> np.ndarray:
+        """:attr:`reachable` at the pairs ``(agents[n], tasks[n])`` of agent and task rows
+        (without computing the whole table unless it is there already)."""
+        table = self.__dict__.get("reachable")
+        if table is not None:
+            out: np.ndarray = table[agents, tasks]
+            return out
+        kind, sense = self.task_kind[tasks], self.agent_can_sense[agents]
+        dh = self.task_home_distance[agents, tasks]
+        battery = self.agent_battery[agents]
+        ok = _battery_ok(self.agent_task_distance[agents, tasks], dh, battery)
+        ok |= self.agent_mode[agents] == _RETURNING
+        ok &= _round_trip(dh, self.agent_full_range[agents])
+        ok &= (kind == _FIRE_KIND) | sense
+        return ok
 
     def route_length_px(self, agent: int | str, route: Sequence[int] | Sequence[str]) -> float:
         """Px of flying ``route`` (task rows or ids) from the agent's :attr:`agent_start_pos`
@@ -374,7 +425,7 @@ class TaskGraph:
         lo, hi = self._alt_bounds[agent]
         return float(min(max(z, lo), hi))
 
-    @cached_property
+    @cached_view
     def _alt_bounds(self) -> list[list[float]]:
         """:attr:`agent_alt_range` as Python floats."""
         alt = self.agent_alt_range
@@ -387,10 +438,15 @@ class TaskGraph:
     def _shared(self, key: str, inputs: tuple[np.ndarray, ...], make: Callable[[], _T]) -> _T:
         """``make()``, kept in :attr:`shared_memo` when the inputs are shared read-only arrays."""
         memo = self.shared_memo
-        return make() if memo is None else memo.get(key, inputs, make)
+        if memo is None:
+            return make()
+        for a in inputs:
+            if a.flags.writeable:  # this graph's own array: nothing to share
+                return make()
+        return memo.get(key, inputs, make)
 
     # ------------------------------------------------------------------ networkx
-    @cached_property
+    @cached_view
     def graph(self) -> Any:
         """The task graph as a :class:`networkx.DiGraph` (built on first access)."""
         import networkx as nx
@@ -457,6 +513,22 @@ def pairwise_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _round_trip(dh: np.ndarray, full: np.ndarray) -> np.ndarray:
-    """:attr:`TaskGraph.in_round_trip` of the distance table ``dh`` and full ranges ``full``."""
-    out: np.ndarray = 2.0 * dh <= (full + FEASIBILITY_TOL_PX)[:, None]
+    """The round-trip rule, element-wise: ``2 * dh <= full`` (+ tolerance) for the px ``dh``
+    from a task to the depot slot and the full-battery range ``full`` of the agent."""
+    out: np.ndarray = 2.0 * dh <= full + FEASIBILITY_TOL_PX
+    return out
+
+
+def _serviceable(dh: np.ndarray, full: np.ndarray, can: np.ndarray) -> np.ndarray:
+    """(A, K) bool: the role can serve the task and it lies within a round trip."""
+    ok = _round_trip(dh, full[:, None])
+    ok &= can
+    return ok
+
+
+def _battery_ok(d: np.ndarray, dh: np.ndarray, battery: np.ndarray) -> np.ndarray:
+    """The battery rule, element-wise: an agent ``d`` px from a task that is ``dh`` px from its
+    depot slot can fly there and home on ``battery``: ``d + dh <= battery / DRAIN_PER_PX`` (+
+    tolerance)."""
+    out: np.ndarray = d + dh <= battery / DRAIN_PER_PX + FEASIBILITY_TOL_PX
     return out

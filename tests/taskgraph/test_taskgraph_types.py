@@ -244,3 +244,18 @@ def test_shared_memo_keeps_values_of_read_only_inputs_only():
     b = a.copy()  # equal values, another array
     assert np.array_equal(memo.get("double", (b,), lambda: b * 3), a * 3)
     assert np.array_equal(memo.get("double", (b,), lambda: b * 4), a * 4)  # writable: not kept
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n_agents=st.integers(2, 7), n_tasks=st.integers(1, 30))
+def test_pair_views_equal_the_tables(seed, n_agents, n_tasks):
+    """in_round_trip_at and reachable_at at any (agent, task) pairs are the tables' entries,
+    whether the table was computed before or not."""
+    g = graph_with_modes(seed, n_agents, n_tasks)
+    rng = np.random.default_rng(seed)
+    ai = rng.integers(0, n_agents, 20)
+    ti = rng.integers(0, n_tasks, 20)
+    fresh = dataclasses.replace(g)
+    assert np.array_equal(fresh.reachable_at(ai, ti), g.reachable[ai, ti])
+    assert np.array_equal(fresh.in_round_trip_at(ai, ti), g.in_round_trip[ai, ti])
+    assert np.array_equal(g.reachable_at(ai, ti), g.reachable[ai, ti])  # from the table
