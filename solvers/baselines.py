@@ -9,6 +9,8 @@ Examples
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from fcplan.plan import Plan
@@ -24,7 +26,7 @@ class IdleScheduler:
 
     name = "idle"
 
-    def plan(self, graph: TaskGraph, *, time_limit=None, rng=None) -> Plan:
+    def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Return the empty plan."""
         return Plan(stats=SolveStats(status="heuristic", objective=0.0))
 
@@ -44,7 +46,9 @@ class RandomScheduler:
     def __init__(self, keep_probability: float = 0.5) -> None:
         self.keep_probability = float(keep_probability)
 
-    def plan(self, graph: TaskGraph, *, time_limit=None, rng: np.random.Generator) -> Plan:
+    def plan(
+        self, graph: TaskGraph, *, time_limit: float | None = None, rng: np.random.Generator
+    ) -> Plan:
         """Draw a random feasible route of one task per free agent."""
         feasible = graph.reachable
         routes, alts = {}, {}

@@ -30,6 +30,8 @@ True
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from fcplan.plan import Plan
@@ -83,7 +85,7 @@ class GreedyScheduler:
         self.spread_px = float(spread_px)
 
     # ------------------------------------------------------------------ main
-    def plan(self, graph: TaskGraph, *, time_limit=None, rng=None) -> Plan:
+    def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Build the greedy plan for ``graph``."""
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}
@@ -126,27 +128,7 @@ class GreedyScheduler:
 
         # 2. perception agents watch the fires being fought
         sensors = np.flatnonzero(free & graph.agent_can_sense & ~graph.agent_can_act)
-        busy: set[int] = set()
-        if sensors.size and first_fire:
-            n_watch = max(1, int(self.max_watch_fraction * sensors.size)) if sensors.size > 1 else 1
-            watched_clusters: set[int] = set()
-            targets = sorted(first_fire.values(), key=lambda k: -graph.task_value[k])
-            for k in targets:
-                if len(busy) >= n_watch:
-                    break
-                cl = int(graph.task_cluster[k])
-                if cl in watched_clusters:
-                    continue
-                cand = [i for i in sensors if i not in busy]
-                d = np.hypot(*(start[cand] - graph.task_pos[k]).T)
-                ok = d + graph.task_home_distance[cand, k] <= budget[cand]
-                if not ok.any():
-                    continue
-                i = int(np.asarray(cand)[ok][np.argmin(d[ok])])
-                busy.add(i)
-                watched_clusters.add(cl)
-                routes[graph.agent_ids[i]] = (graph.task_ids[k],)
-                alts[graph.agent_ids[i]] = graph.clip_altitude(i, self.watch_altitude)
+        busy = self._watch(graph, sensors, first_fire, routes, alts)
 
         # 3. the others search
         searchers = np.array(
@@ -185,6 +167,43 @@ class GreedyScheduler:
         )
 
     # ------------------------------------------------------------------ helpers
+    def _watch(
+        self,
+        graph: TaskGraph,
+        sensors: np.ndarray,
+        first_fire: dict[int, int],
+        routes: dict[str, tuple[str, ...]],
+        alts: dict[str, float],
+    ) -> set[int]:
+        """Each fire an action agent heads to first (most valuable first, one per connected
+        fire) gets the nearest free perception agent that can fly there and home, for at most
+        ``max_watch_fraction`` of them (at least one); their routes and altitudes go into
+        ``routes`` and ``alts``. Returns the rows of the watchers."""
+        start, budget = graph.agent_start_pos, graph.agent_budget_px
+        busy: set[int] = set()
+        if not (sensors.size and first_fire):
+            return busy
+        n_watch = max(1, int(self.max_watch_fraction * sensors.size)) if sensors.size > 1 else 1
+        watched_clusters: set[int] = set()
+        targets = sorted(first_fire.values(), key=lambda k: -graph.task_value[k])
+        for k in targets:
+            if len(busy) >= n_watch:
+                break
+            cl = int(graph.task_cluster[k])
+            if cl in watched_clusters:
+                continue
+            cand = [i for i in sensors if i not in busy]
+            d = np.hypot(*(start[cand] - graph.task_pos[k]).T)
+            ok = d + graph.task_home_distance[cand, k] <= budget[cand]
+            if not ok.any():
+                continue
+            i = int(np.asarray(cand)[ok][np.argmin(d[ok])])
+            busy.add(i)
+            watched_clusters.add(cl)
+            routes[graph.agent_ids[i]] = (graph.task_ids[k],)
+            alts[graph.agent_ids[i]] = graph.clip_altitude(i, self.watch_altitude)
+        return busy
+
     def _assign(
         self,
         graph: TaskGraph,

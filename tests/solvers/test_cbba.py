@@ -169,7 +169,8 @@ def test_vectorised_consensus_applies_the_table(seed, n_agents, n_items):
     """One round of the vectorised consensus gives, on random states (random winners, bids and
     timestamps with many ties, random communication graphs), exactly what the case-by-case table
     gives when each receiver reads its neighbours' messages in index order, task by task."""
-    from solvers.cbba import CommGraph, _Agents, _Auction
+    from solvers.cbba.auction import Auction, _Agents
+    from solvers.cbba.comms import CommGraph
 
     rng = np.random.default_rng(seed)
     a, m = n_agents, n_items
@@ -180,7 +181,7 @@ def test_vectorised_consensus_applies_the_table(seed, n_agents, n_items):
     y = np.where(z >= 0, rng.choice([1.0, 2.0, 3.0], size=(a, m)), 0.0)
     s = rng.integers(0, 4, size=(a, a)).astype(float)
     zeros = np.zeros((a, m))
-    auc = _Auction(
+    auc = Auction(
         zeros,
         zeros > 0,
         np.zeros(m, bool),
