@@ -89,8 +89,6 @@ class GreedyScheduler:
         """Build the greedy plan for ``graph``."""
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}
-        start = graph.agent_start_pos
-        budget = graph.agent_budget_px
         free = graph.agent_mode != Mode.HOMING
         fires = graph.fire_tasks
         objective = 0.0
@@ -116,8 +114,6 @@ class GreedyScheduler:
                 actors,
                 fires,
                 value,
-                start,
-                budget,
                 limit=np.minimum(graph.agent_tank[actors], self.route_length),
             )
             objective += gained
@@ -146,8 +142,6 @@ class GreedyScheduler:
                 searchers,
                 blocks,
                 graph.task_value[blocks].astype(np.float64),
-                start,
-                budget,
                 limit=np.full(searchers.size, self.search_route_length),
                 spread=True,
             )
@@ -210,8 +204,6 @@ class GreedyScheduler:
         agents: np.ndarray,
         tasks: np.ndarray,
         value: np.ndarray,
-        start: np.ndarray,
-        budget: np.ndarray,
         *,
         limit: np.ndarray,
         spread: bool = False,
@@ -228,12 +220,12 @@ class GreedyScheduler:
             return routes, 0.0
         value = value.astype(np.float64)
         speed = graph.agent_speed[agents]
-        pos = start[agents].copy()
+        pos = graph.agent_start_pos[agents].copy()
         used = np.zeros(n_a)  # px already planned
         elapsed = np.zeros(n_a)  # s already planned
         home = graph.task_home_distance[np.ix_(agents, tasks)]  # (a, k)
         ok = graph.in_round_trip[np.ix_(agents, tasks)] & (value > 0)[None, :]
-        left = budget[agents]
+        left = graph.agent_budget_px[agents]
         count = np.zeros(n_a, dtype=np.int64)
         taken = np.zeros(n_k, dtype=bool)
         tpos = graph.task_pos[tasks]

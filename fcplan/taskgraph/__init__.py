@@ -34,15 +34,11 @@ Examples
 >>> from fcplan.belief import Belief
 >>> from fcplan.taskgraph import TaskGraphBuilder
 >>> world = World().reset(load_scenario(1), seed=0)
->>> belief = Belief(world.scenario)
->>> builder = TaskGraphBuilder(world.scenario)
->>> for _ in range(10):
-...     belief.update(world.step())
->>> g = builder.build(world.team, belief)
->>> g.n_agents, g.n_tasks > 0
-(4, True)
+>>> g = TaskGraphBuilder(world.scenario).build(world.team, Belief(world.scenario))
 >>> sorted({d["kind"] for _, d in g.graph.nodes(data=True)})
 ['agent', 'depot', 'facility', 'search']
+>>> bool(g.reachable[:, g.search_tasks].any())  # some agent can go searching
+True
 """
 
 from fcplan.taskgraph.build import TaskGraphBuilder, build_task_graph, default_tile

@@ -398,8 +398,8 @@ def build_task_graph(
     >>> from fcplan.belief import Belief
     >>> world = World().reset(load_scenario(1), seed=0)
     >>> g = build_task_graph(world.scenario, world.team, Belief(world.scenario))
-    >>> sorted({d["kind"] for _, d in g.graph.nodes(data=True)})
-    ['agent', 'depot', 'facility', 'search']
+    >>> g.fire_tasks.size, g.n_tasks  # nothing sensed yet: the 12 x 12 search blocks
+    (0, 144)
     """
     return TaskGraphBuilder(scenario, params).build(team, belief)
 

@@ -150,29 +150,27 @@ def _resource_rows(rows: _Rows, graph: TaskGraph, p: MilpParams, v: Variables) -
 
 def _coupling_rows(rows: _Rows, graph: TaskGraph, v: Variables) -> None:
     """``couple_dump`` and ``couple_watch`` rows of the auxiliary ``z``."""
-    va, vk, vs, vkind = v.va, v.vk, v.vs, v.vkind
-    zk, zs, n_z = v.zk, v.zs, v.n_z
-    zi = v.n_x + np.arange(n_z)
+    va, vk, vs, vkind, zk, zs = v.va, v.vk, v.vs, v.vkind, v.zk, v.zs
     # z[k,s] <= sum_a dump[a,k,s]
     dump = np.flatnonzero(vkind == DUMP)
     match = (vk[dump][None, :] == zk[:, None]) & (vs[dump][None, :] == zs[:, None])
-    zr, dj = np.nonzero(match)
-    rows.add(
-        np.r_[np.arange(n_z), zr],
-        np.r_[zi, dump[dj]],
-        np.r_[np.ones(n_z), -np.ones(zr.size)],
-        _zeros,
-        "couple_dump",
-    )
+    _couple(rows, v, dump, match, "couple_dump")
     # z[k,s] <= sum of sensors on the same cluster in slots <= s
     sensor = np.flatnonzero((vkind == WATCH) | ((vkind == DUMP) & graph.agent_can_sense[va]))
     cl = graph.task_cluster
     match = (cl[vk[sensor]][None, :] == cl[zk][:, None]) & (vs[sensor][None, :] <= zs[:, None])
-    zr, wj = np.nonzero(match)
+    _couple(rows, v, sensor, match, "couple_watch")
+
+
+def _couple(rows: _Rows, v: Variables, cols: np.ndarray, match: np.ndarray, name: str) -> None:
+    """One row per ``z[k, s]``: ``z[k, s] - sum of the x in cols matching it <= 0`` (``match``:
+    (n_z, len(cols)) bool)."""
+    n_z = v.n_z
+    zr, j = np.nonzero(match)
     rows.add(
         np.r_[np.arange(n_z), zr],
-        np.r_[zi, sensor[wj]],
+        np.r_[v.n_x + np.arange(n_z), cols[j]],
         np.r_[np.ones(n_z), -np.ones(zr.size)],
         _zeros,
-        "couple_watch",
+        name,
     )

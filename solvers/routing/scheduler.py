@@ -243,13 +243,12 @@ class RoutingScheduler:
     ) -> list[int]:
         """Action agents -> fires (one visit per dump left in the tank); the routes go into
         ``routes``, the model's solution into ``sols``. Returns the first fire of each route."""
-        start, budget, trip = graph.agent_start_pos, graph.agent_budget_px, graph.in_round_trip
         fires, blocks = graph.fire_tasks, graph.search_tasks
         stale = graph.task_staleness[fires]
         fresh = np.exp(-np.maximum(stale - self.fresh_s, 0.0) / max(self.fresh_s, 1e-9))
         act_value = self.fire_base_px + self.fire_value_px * graph.task_value[fires] * fresh
         act_value = np.where(graph.task_value[fires] > 0, act_value, 0.0)
-        act_nodes = self._candidates(graph, actors, fires, act_value, start, budget, trip)
+        act_nodes = self._candidates(graph, actors, fires, act_value)
         sense_value_guess = np.r_[
             self.watch_value_px * graph.task_value[fires],
             self.search_value_px * graph.task_value[blocks],
@@ -263,9 +262,8 @@ class RoutingScheduler:
             share = act_nodes[0].size / (act_nodes[0].size + n_sense)
             share = 1.0 if n_sense == 0 else min(max(share, 0.25), 0.5)
             sol = self._solve(
-                graph, actors, act_nodes, start, budget, trip, deadline, share,
-                capacity=graph.agent_tank[actors],
-            )  # fmt: skip
+                graph, actors, act_nodes, deadline, share, capacity=graph.agent_tank[actors]
+            )
             sols["action"] = sol
             for v, route in enumerate(sol.routes):
                 if route:
@@ -286,7 +284,6 @@ class RoutingScheduler:
     ) -> None:
         """Perception agents -> search blocks and fires to watch; the routes and altitudes go
         into ``routes`` and ``alts``, the model's solution into ``sols``."""
-        start, budget, trip = graph.agent_start_pos, graph.agent_budget_px, graph.in_round_trip
         fires, blocks = graph.fire_tasks, graph.search_tasks
         stale = graph.task_staleness[fires]
         fought = self._fought(graph, fires, first_fires, sensors.size)
@@ -298,14 +295,15 @@ class RoutingScheduler:
             # information is worth less the later it comes: discount each block by the
             # earliest arrival of any perception vehicle (keeps searchers near the action)
             eta = (
-                _pairwise(start[sensors], graph.task_pos[blocks]) / graph.agent_speed[sensors, None]
+                _pairwise(graph.agent_start_pos[sensors], graph.task_pos[blocks])
+                / graph.agent_speed[sensors, None]
             )
             search = search * self.search_horizon_s / (self.search_horizon_s + eta.min(0))
         value = np.r_[watch, search]
-        nodes = self._candidates(graph, sensors, tasks, value, start, budget, trip)
+        nodes = self._candidates(graph, sensors, tasks, value)
         if not nodes[0].size:
             return
-        sol = self._solve(graph, sensors, nodes, start, budget, trip, deadline, 1.0)
+        sol = self._solve(graph, sensors, nodes, deadline, 1.0)
         sols["perception"] = sol
         for v, route in enumerate(sol.routes):
             if not route:
@@ -342,20 +340,14 @@ class RoutingScheduler:
         return max(self.max_nodes, self.nodes_per_vehicle * n_vehicles)
 
     def _candidates(
-        self,
-        graph: TaskGraph,
-        agents: np.ndarray,
-        tasks: np.ndarray,
-        value: np.ndarray,
-        start: np.ndarray,
-        budget: np.ndarray,
-        trip: np.ndarray,
+        self, graph: TaskGraph, agents: np.ndarray, tasks: np.ndarray, value: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
         """(task rows, penalties px) of the most valuable tasks (see :meth:`_n_candidates`) some
         agent of ``agents`` can serve (positive value, within a round trip, reachable with the way
         home)."""
         if agents.size == 0 or tasks.size == 0:
             return np.zeros(0, np.int64), np.zeros(0)
+        start, budget, trip = graph.agent_start_pos, graph.agent_budget_px, graph.in_round_trip
         d = (
             _pairwise(start[agents], graph.task_pos[tasks])
             + graph.task_home_distance[np.ix_(agents, tasks)]
@@ -371,9 +363,6 @@ class RoutingScheduler:
         graph: TaskGraph,
         agents: np.ndarray,
         nodes: tuple[np.ndarray, np.ndarray],
-        start: np.ndarray,
-        budget: np.ndarray,
-        trip: np.ndarray,
         deadline: float,
         share: float,
         capacity: np.ndarray | None = None,
@@ -382,13 +371,13 @@ class RoutingScheduler:
         tasks, penalty = nodes
         left = max(deadline - time.perf_counter(), 0.0) * share
         return solve_routes(
-            start[agents],
+            graph.agent_start_pos[agents],
             graph.agent_home[agents],
             graph.task_pos[tasks],
             penalty,
-            budget[agents],
+            graph.agent_budget_px[agents],
             capacity=capacity,
-            allowed=trip[np.ix_(agents, tasks)],
+            allowed=graph.in_round_trip[np.ix_(agents, tasks)],
             max_visits=self.max_visits,
             charge_return=self.charge_return,
             time_limit=max(left, 1e-6),

@@ -272,9 +272,7 @@ def test_incremental_picks_equal_full_recomputation(seed, n_agents, n_tasks, spr
     tasks = np.arange(g.n_tasks)
     limit = np.full(g.n_agents, 3)
     start, budget = g.agent_start_pos, g.agent_budget_px
-    fast, _ = sched._assign(
-        g, agents, tasks, g.task_value, start, budget, limit=limit, spread=spread
-    )
+    fast, _ = sched._assign(g, agents, tasks, g.task_value, limit=limit, spread=spread)
     slow = _naive_assign(
         g, agents, tasks, g.task_value, start, budget, limit, spread, sched.spread_px
     )
