@@ -69,6 +69,8 @@ def validate_plan(plan: Plan, graph: TaskGraph) -> None:
     camera); altitudes are within the agent's bounds; no agent is both routed and sent home; and
     battery feasibility: every task is within a round trip of the agent's depot slot on a full
     battery, and an active agent can reach its first task and still fly home on what it has left.
+    The battery rule is the graph's (:attr:`fcplan.taskgraph.TaskGraph.in_round_trip` and
+    :attr:`fcplan.taskgraph.TaskGraph.reachable`), which schedulers can read before they plan.
     """
     if not isinstance(plan, Plan):
         raise PlanError(f"a scheduler must return a Plan, got {type(plan).__name__}")
