@@ -23,7 +23,7 @@ import numpy as np
 
 from fcplan.errors import PlanError
 from fcplan.taskgraph import TaskGraph, TaskKind
-from fcplan.team import Command, Mode
+from fcplan.team import Command
 
 __all__ = ["Plan", "validate_plan", "plan_commands"]
 
@@ -52,7 +52,7 @@ class Plan:
     home: frozenset[str] = frozenset()
     stats: object | None = None
 
-    def with_stats(self, stats) -> Plan:
+    def with_stats(self, stats: object | None) -> Plan:
         """The same plan carrying ``stats``."""
         return Plan(self.routes, self.altitudes, self.patrol, self.home, stats)
 
@@ -69,6 +69,8 @@ def validate_plan(plan: Plan, graph: TaskGraph) -> None:
     camera); altitudes are within the agent's bounds; no agent is both routed and sent home; and
     battery feasibility: every task is within a round trip of the agent's depot slot on a full
     battery, and an active agent can reach its first task and still fly home on what it has left.
+    The battery rule is the graph's (:attr:`fcplan.taskgraph.TaskGraph.in_round_trip` and
+    :attr:`fcplan.taskgraph.TaskGraph.reachable`), which schedulers can read before they plan.
     """
     if not isinstance(plan, Plan):
         raise PlanError(f"a scheduler must return a Plan, got {type(plan).__name__}")
@@ -81,11 +83,10 @@ def validate_plan(plan: Plan, graph: TaskGraph) -> None:
 
 
 _NUMBER = (int, float, np.integer, np.floating)
-_RETURNING = int(Mode.RETURNING)
 
 
 def _plan_ok(plan: Plan, graph: TaskGraph) -> bool:
-    """True when every check of :func:`validate_plan` passes (vectorised, same arithmetic);
+    """True when every check of :func:`validate_plan` passes (vectorised, the same views);
     False sends the plan through :func:`_check_plan` for the precise error."""
     aidx, tidx = graph.agent_index, graph.task_index
     routes, alts = plan.routes, plan.altitudes
@@ -101,9 +102,9 @@ def _plan_ok(plan: Plan, graph: TaskGraph) -> bool:
     if alts:
         if not all(isinstance(z, _NUMBER) for z in alts.values()):
             return False
-        ai = [aidx[a] for a in alts]
+        rows = [aidx[a] for a in alts]
         z = np.array(list(alts.values()), dtype=np.float64)
-        rng = graph.agent_alt_range[ai]
+        rng = graph.agent_alt_range[rows]
         if not (np.isfinite(z) & (rng[:, 0] - 1e-9 <= z) & (z <= rng[:, 1] + 1e-9)).all():
             return False
     agent_rows: list[int] = []
@@ -127,14 +128,10 @@ def _plan_ok(plan: Plan, graph: TaskGraph) -> bool:
     search = graph.task_kind[ti] == TaskKind.SEARCH
     if (search & ~graph.agent_can_sense[ai]).any():
         return False
-    if (2.0 * graph.task_home_distance[ai, ti] > graph.agent_full_range[ai] + 1e-6).any():
+    if not graph.in_round_trip_at(ai, ti).all():
         return False
     f = np.array(first)
-    ai, ti = ai[f], ti[f]
-    active = graph.agent_mode[ai] != _RETURNING
-    need = graph.agent_task_distance[ai, ti] + graph.task_home_distance[ai, ti]
-    have = graph.agent_battery[ai] / 0.1
-    return not (active & (need > have + 1e-6)).any()
+    return bool(graph.reachable_at(ai[f], ti[f]).all())
 
 
 def _check_plan(plan: Plan, graph: TaskGraph) -> None:
@@ -157,7 +154,7 @@ def _check_plan(plan: Plan, graph: TaskGraph) -> None:
         i = aidx[agent]
         if isinstance(route, str):
             raise PlanError(f"agent {agent}: route must be a sequence of task ids, not a string")
-        rows = []
+        rows: list[int] = []
         for t in route:
             k = tidx.get(t)
             if k is None:
@@ -167,23 +164,20 @@ def _check_plan(plan: Plan, graph: TaskGraph) -> None:
             rows.append(k)
         if not rows:
             continue
-        rows = np.asarray(rows)
-        round_trip = 2.0 * graph.task_home_distance[i, rows]
-        too_far = round_trip > graph.agent_full_range[i] + 1e-6
+        too_far = ~graph.in_round_trip_at(np.full(len(rows), i), np.array(rows))
         if too_far.any():
-            t = graph.task_ids[rows[np.argmax(too_far)]]
+            t = graph.task_ids[rows[int(np.argmax(too_far))]]
             raise PlanError(
                 f"agent {agent}: task {t!r} is beyond a round trip on a full battery "
                 f"({graph.agent_full_range[i]:.0f} px)"
             )
-        if graph.agent_mode[i] != Mode.RETURNING:
+        if not graph.reachable_at(np.array([i]), np.array(rows[:1]))[0]:  # (role, round trip: ok)
             need = graph.agent_task_distance[i, rows[0]] + graph.task_home_distance[i, rows[0]]
-            have = graph.agent_battery[i] / 0.1
-            if need > have + 1e-6:
-                raise PlanError(
-                    f"agent {agent}: cannot reach {graph.task_ids[rows[0]]!r} and fly home on its "
-                    f"remaining battery ({have:.0f} px < {need:.0f} px)"
-                )
+            have = graph.agent_budget_px[i]
+            raise PlanError(
+                f"agent {agent}: cannot reach {graph.task_ids[rows[0]]!r} and fly home on its "
+                f"remaining battery ({have:.0f} px < {need:.0f} px)"
+            )
 
 
 def plan_commands(plan: Plan, graph: TaskGraph) -> dict[str, Command]:

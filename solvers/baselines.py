@@ -9,13 +9,14 @@ Examples
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
-from solvers._feasible import round_trip_ok, start_budget, start_positions
 
 __all__ = ["IdleScheduler", "RandomScheduler"]
 
@@ -25,7 +26,7 @@ class IdleScheduler:
 
     name = "idle"
 
-    def plan(self, graph: TaskGraph, *, time_limit=None, rng=None) -> Plan:
+    def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Return the empty plan."""
         return Plan(stats=SolveStats(status="heuristic", objective=0.0))
 
@@ -45,13 +46,11 @@ class RandomScheduler:
     def __init__(self, keep_probability: float = 0.5) -> None:
         self.keep_probability = float(keep_probability)
 
-    def plan(self, graph: TaskGraph, *, time_limit=None, rng: np.random.Generator) -> Plan:
+    def plan(
+        self, graph: TaskGraph, *, time_limit: float | None = None, rng: np.random.Generator
+    ) -> Plan:
         """Draw a random feasible route of one task per free agent."""
-        start = start_positions(graph)
-        budget = start_budget(graph)
-        d_first = np.hypot(*(start[:, None, :] - graph.task_pos[None, :, :]).transpose(2, 0, 1))
-        feasible = graph.can_do & round_trip_ok(graph)
-        feasible &= d_first + graph.task_home_distance <= budget[:, None]
+        feasible = graph.reachable
         routes, alts = {}, {}
         for i, agent in enumerate(graph.agent_ids):
             if graph.agent_mode[i] == Mode.HOMING:

@@ -30,13 +30,14 @@ True
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
-from solvers._feasible import clip_altitude, round_trip_ok, start_budget, start_positions
 
 __all__ = ["GreedyScheduler"]
 
@@ -84,12 +85,10 @@ class GreedyScheduler:
         self.spread_px = float(spread_px)
 
     # ------------------------------------------------------------------ main
-    def plan(self, graph: TaskGraph, *, time_limit=None, rng=None) -> Plan:
+    def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Build the greedy plan for ``graph``."""
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}
-        start = start_positions(graph)
-        budget = start_budget(graph)
         free = graph.agent_mode != Mode.HOMING
         fires = graph.fire_tasks
         objective = 0.0
@@ -115,8 +114,6 @@ class GreedyScheduler:
                 actors,
                 fires,
                 value,
-                start,
-                budget,
                 limit=np.minimum(graph.agent_tank[actors], self.route_length),
             )
             objective += gained
@@ -127,27 +124,7 @@ class GreedyScheduler:
 
         # 2. perception agents watch the fires being fought
         sensors = np.flatnonzero(free & graph.agent_can_sense & ~graph.agent_can_act)
-        busy: set[int] = set()
-        if sensors.size and first_fire:
-            n_watch = max(1, int(self.max_watch_fraction * sensors.size)) if sensors.size > 1 else 1
-            watched_clusters: set[int] = set()
-            targets = sorted(first_fire.values(), key=lambda k: -graph.task_value[k])
-            for k in targets:
-                if len(busy) >= n_watch:
-                    break
-                cl = int(graph.task_cluster[k])
-                if cl in watched_clusters:
-                    continue
-                cand = [i for i in sensors if i not in busy]
-                d = np.hypot(*(start[cand] - graph.task_pos[k]).T)
-                ok = d + graph.task_home_distance[cand, k] <= budget[cand]
-                if not ok.any():
-                    continue
-                i = int(np.asarray(cand)[ok][np.argmin(d[ok])])
-                busy.add(i)
-                watched_clusters.add(cl)
-                routes[graph.agent_ids[i]] = (graph.task_ids[k],)
-                alts[graph.agent_ids[i]] = clip_altitude(graph, i, self.watch_altitude)
+        busy = self._watch(graph, sensors, first_fire, routes, alts)
 
         # 3. the others search
         searchers = np.array(
@@ -165,8 +142,6 @@ class GreedyScheduler:
                 searchers,
                 blocks,
                 graph.task_value[blocks].astype(np.float64),
-                start,
-                budget,
                 limit=np.full(searchers.size, self.search_route_length),
                 spread=True,
             )
@@ -174,7 +149,7 @@ class GreedyScheduler:
             for row, tasks in picks.items():
                 if tasks:
                     routes[graph.agent_ids[row]] = tuple(graph.task_ids[k] for k in tasks)
-                    alts[graph.agent_ids[row]] = clip_altitude(graph, row, self.search_altitude)
+                    alts[graph.agent_ids[row]] = graph.clip_altitude(row, self.search_altitude)
         return Plan(
             routes=routes,
             altitudes=alts,
@@ -186,14 +161,49 @@ class GreedyScheduler:
         )
 
     # ------------------------------------------------------------------ helpers
+    def _watch(
+        self,
+        graph: TaskGraph,
+        sensors: np.ndarray,
+        first_fire: dict[int, int],
+        routes: dict[str, tuple[str, ...]],
+        alts: dict[str, float],
+    ) -> set[int]:
+        """Each fire an action agent heads to first (most valuable first, one per connected
+        fire) gets the nearest free perception agent that can fly there and home, for at most
+        ``max_watch_fraction`` of them (at least one); their routes and altitudes go into
+        ``routes`` and ``alts``. Returns the rows of the watchers."""
+        start, budget = graph.agent_start_pos, graph.agent_budget_px
+        busy: set[int] = set()
+        if not (sensors.size and first_fire):
+            return busy
+        n_watch = max(1, int(self.max_watch_fraction * sensors.size)) if sensors.size > 1 else 1
+        watched_clusters: set[int] = set()
+        targets = sorted(first_fire.values(), key=lambda k: -graph.task_value[k])
+        for k in targets:
+            if len(busy) >= n_watch:
+                break
+            cl = int(graph.task_cluster[k])
+            if cl in watched_clusters:
+                continue
+            cand = [i for i in sensors if i not in busy]
+            d = np.hypot(*(start[cand] - graph.task_pos[k]).T)
+            ok = d + graph.task_home_distance[cand, k] <= budget[cand]
+            if not ok.any():
+                continue
+            i = int(np.asarray(cand)[ok][np.argmin(d[ok])])
+            busy.add(i)
+            watched_clusters.add(cl)
+            routes[graph.agent_ids[i]] = (graph.task_ids[k],)
+            alts[graph.agent_ids[i]] = graph.clip_altitude(i, self.watch_altitude)
+        return busy
+
     def _assign(
         self,
         graph: TaskGraph,
         agents: np.ndarray,
         tasks: np.ndarray,
         value: np.ndarray,
-        start: np.ndarray,
-        budget: np.ndarray,
         *,
         limit: np.ndarray,
         spread: bool = False,
@@ -210,12 +220,12 @@ class GreedyScheduler:
             return routes, 0.0
         value = value.astype(np.float64)
         speed = graph.agent_speed[agents]
-        pos = start[agents].copy()
+        pos = graph.agent_start_pos[agents].copy()
         used = np.zeros(n_a)  # px already planned
         elapsed = np.zeros(n_a)  # s already planned
         home = graph.task_home_distance[np.ix_(agents, tasks)]  # (a, k)
-        ok = round_trip_ok(graph)[np.ix_(agents, tasks)] & (value > 0)[None, :]
-        left = budget[agents]
+        ok = graph.in_round_trip[np.ix_(agents, tasks)] & (value > 0)[None, :]
+        left = graph.agent_budget_px[agents]
         count = np.zeros(n_a, dtype=np.int64)
         taken = np.zeros(n_k, dtype=bool)
         tpos = graph.task_pos[tasks]

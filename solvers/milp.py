@@ -10,35 +10,13 @@ best bound, relative gap and the model size. If CP-SAT finds no solution (e.g. a
 the scheduler raises, and :func:`fcplan.scheduling.solve` falls back to greedy for that replan and
 records it (``status="fallback"``).
 
-Why CP-SAT
-----------
-OR-Tools 9.15 wheels offer CP-SAT directly and, through MathOpt, HiGHS, SCIP and CP-SAT. All were
-run on the same 1,195 models captured from ``milp`` episodes of scenarios 1-24 (seed 0, every 4th
-replan; up to 238 binaries and 88 rows), one thread, 0.2 s limit, gap 0; wall time of model transfer
-plus solve (``python bench/bench_milp.py --backends``; 2-core VM shared with other jobs, load ~3.5,
-so the tails are noisy):
-
-=================  =======  ======  ======  ======
-backend            optimal  p50 ms  p95 ms  max ms
-=================  =======  ======  ======  ======
-CP-SAT (cp_model)  100 %     7.2    17.3    136
-MathOpt + SCIP     100 %     8.8    17.2    286
-MathOpt + CP-SAT   100 %     6.9    21.9    175
-MathOpt + HiGHS    100 %     9.0    20.3     42
-=================  =======  ======  ======  ======
-
-All reach the same optima (to 1e-12). CP-SAT directly is as fast as any at the median and p95, is
-deterministic with one worker and a fixed seed (``num_workers=1``, ``random_seed``), and builds
-from the arrays without MathOpt's proto round trip, so it is used. Its default single-worker search
-failed to prove optimality within 0.2 s on about 1 % of the replans of the 8-agent scenarios (CP-SAT
-p95 26 ms, max 200 ms on those); ``linearization_level=2`` (the full LP relaxation of the rows)
-solved all of them (max 29 ms) and is set. CP-SAT needs integral rows, which the model provides
-(battery terms are whole px, rounded conservatively); the real objective coefficients are scaled
-by CP-SAT itself (its reported bound can be loose by its working precision, about 1e-5 relative).
-
-Over whole episodes of scenarios 1-24 (seed 0, two worker processes) the scheduler call took
-p50 15.7 ms, p95 34.2 ms per replan, and 4,736 of 4,737 replans were solved to proven optimality
-(one hit the limit under the machine's load).
+CP-SAT
+------
+One worker and a fixed seed (``num_workers=1``, ``random_seed``) make the solve deterministic;
+``linearization_level=2`` adds the full LP relaxation of the rows. CP-SAT needs integral rows,
+which the model provides (battery terms are whole px, rounded conservatively); the real objective
+coefficients are scaled by CP-SAT itself (its reported bound can be loose by its working
+precision, about 1e-5 relative).
 
 Examples
 --------
@@ -79,7 +57,9 @@ class MilpScheduler(MilpSchedulerBase):
     name = "milp"
     default_time_limit = 0.2
 
-    def _solve(self, model: MilpModel, *, time_limit: float, seed: int):
+    def _solve(
+        self, model: MilpModel, *, time_limit: float, seed: int
+    ) -> tuple[np.ndarray, SolveStats]:
         return solve_cpsat(model, time_limit=time_limit, seed=seed)
 
 
@@ -123,8 +103,8 @@ def solve_cpsat(
     solver.parameters.num_workers = 1
     solver.parameters.random_seed = int(seed)
     solver.parameters.max_time_in_seconds = float(time_limit)
-    # full LP relaxation of the linear rows: with one worker CP-SAT otherwise failed to prove
-    # optimality within 0.2 s on ~1 % of the replans of 8-agent scenarios (see module docstring)
+    # full LP relaxation of the linear rows (it proves optimality within the replan's limit
+    # where the single-worker default may not)
     solver.parameters.linearization_level = 2
     status = solver.solve(md)
     if status not in (cp_model.OPTIMAL, cp_model.FEASIBLE):

@@ -21,12 +21,9 @@ object: ``mip_dual_bound``, ``mip_gap`` and ``objective_function_value`` of the 
 hands to HiGHS (cvxpy negates a ``Maximize`` objective), so the reported bound is
 ``-mip_dual_bound``; ``mip_gap`` is HiGHS's relative gap. ``solve_time`` is HiGHS's run time.
 
-Performance: cvxpy's canonicalisation adds a few milliseconds per replan on top of HiGHS. Over
-whole episodes of scenarios 1, 12 and 24 (seed 0, ``python bench/bench_milp.py``, a shared 2-core
-VM) the scheduler call took p50 31.6 ms and p95 56.4 ms per replan, every replan solved to
-optimality; ``milp`` is the fast path (p50 15.7 ms, p95 34.2 ms in the same run). The two backends
-solve the same model to the same optimal value, but where several plans tie they may return
-different ones, so their episodes can diverge.
+cvxpy's canonicalisation adds some time per replan on top of HiGHS; ``milp`` is the fast path.
+The two backends solve the same model to the same optimal value, but where several plans tie they
+may return different ones, so their episodes can diverge.
 
 Examples
 --------
@@ -67,7 +64,9 @@ class MilpCvxpyScheduler(MilpSchedulerBase):
     name = "milp-cvxpy"
     default_time_limit = 0.5
 
-    def _solve(self, model: MilpModel, *, time_limit: float, seed: int):
+    def _solve(
+        self, model: MilpModel, *, time_limit: float, seed: int
+    ) -> tuple[np.ndarray, SolveStats]:
         return solve_cvxpy(model, time_limit=time_limit, seed=seed)
 
 

@@ -24,4 +24,7 @@ fire
     cells on Python ints, a cheaper ``np.unique``.
 world
     The :class:`~fcplan.world.StepInfo` builder and the field-of-view scan box.
+taskgraph
+    The task graph's dataclass constructor without ``__init__`` (``new_frozen``), tested equal
+    to the plain constructor.
 """

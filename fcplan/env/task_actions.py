@@ -112,7 +112,7 @@ def decode_actions(
     conflict = np.zeros(n_a, dtype=bool)
     sent = [i for i, r in enumerate(out) if r >= 0]
     if len(sent) > 1:
-        role = _as_list(graph.agent_role)
+        role = _as_list(graph, "agent_role")
         keys = [out[i] * 8 + role[i] for i in sent]
         if len(set(keys)) < len(keys):  # rare: resolve by arrival time
             chosen = np.array(sent)
@@ -138,15 +138,13 @@ def actions_plan(
     alts: dict[str, float] = {}
     ids, tids = graph.agent_ids, graph.task_ids
     fire = (graph.task_kind == _FIRE).tolist()
-    lo, hi = graph.agent_alt_range[:, 0].tolist(), graph.agent_alt_range[:, 1].tolist()
     sense = graph.agent_can_sense.tolist()
     rows_l = rows.tolist()
     for i in np.flatnonzero(rows >= 0).tolist():
         t = rows_l[i]
         routes[ids[i]] = (tids[t],)
         if sense[i]:
-            z = watch_altitude if fire[t] else search_altitude
-            alts[ids[i]] = float(min(max(z, lo[i]), hi[i]))
+            alts[ids[i]] = graph.clip_altitude(i, watch_altitude if fire[t] else search_altitude)
     return Plan(routes=routes, altitudes=alts)
 
 
@@ -184,16 +182,13 @@ def rows_commands(
     t = [rows[i] for i in sel]
     pos = graph.task_pos[t].tolist()
     kind = graph.task_kind[t].tolist()
-    sense = _as_list(graph.agent_can_sense)
-    bounds = _as_list(graph.agent_alt_range)
+    sense = _as_list(graph, "agent_can_sense")
     ids = graph.agent_ids
     out: dict[str, Command] = {}
     for j, i in enumerate(sel):
         z = None
         if sense[i]:
-            z = watch_altitude if kind[j] == _FIRE else search_altitude
-            lo, hi = bounds[i]
-            z = float(min(max(z, lo), hi))
+            z = graph.clip_altitude(i, watch_altitude if kind[j] == _FIRE else search_altitude)
         x, y = pos[j]
         out[ids[i]] = Command(route=((x, y),), patrol=False, altitude=z)
     return out, pos

@@ -5,10 +5,10 @@ At every step each agent is offered its ``k`` most relevant tasks of the current
 networkx, no Python loop over tasks), so it costs a few tens of microseconds per step.
 
 Feasibility (the action mask)
-    A task is legal for agent ``i`` exactly when :func:`fcplan.plan.validate_plan` would accept
-    the one-task route ``(task,)``: the agent's role can serve it (search blocks need a camera),
-    it lies within a round trip of the agent's depot slot on a full battery, and, unless the agent
-    is on a forced return (it recharges first), it can fly there and home on what it has left.
+    The legal tasks of agent ``i`` are :attr:`fcplan.taskgraph.TaskGraph.reachable`: exactly the
+    one-task routes ``(task,)`` that :func:`fcplan.plan.validate_plan` accepts (the agent's role
+    can serve the task, it lies within a round trip of the agent's depot slot on a full battery,
+    and, unless the agent is on a forced return, it can fly there and home on what it has left).
 
 Relevance (the deterministic ranking)
     ``priority = value * freshness / (1 + eta)``, with ``value`` the task's value in the graph
@@ -25,10 +25,11 @@ Task features (one row of the ``k x F`` table, see :data:`TASK_FEATURES`)
     all finite, clipped to ``[-FEATURE_BOUND, FEATURE_BOUND]``; padding rows are all zero.
 
 Shared arrays
-    What depends only on read-only arrays that :func:`fcplan.taskgraph.build_task_graph` shares
-    between graphs (the depot round-trip part of the legality, the constant task-feature rows
-    and who can serve a task of a fire-free graph, lists of per-agent constants) is computed once
-    per set of arrays, keyed by their identity: the same values as computing it every step.
+    What depends only on read-only arrays that the graphs of one
+    :class:`fcplan.taskgraph.TaskGraphBuilder` share (the constant task-feature rows and who can
+    serve a task of a fire-free graph, lists of per-agent constants) is computed once and kept
+    in the graphs' :attr:`~fcplan.taskgraph.TaskGraph.shared_memo`: the same values as computing
+    it every step.
 
 Examples
 --------
@@ -46,6 +47,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -112,10 +114,8 @@ FEATURE_BOUND = 10.0
 
 # plain ints: comparing arrays with IntEnum members goes through slow enum attribute lookups
 _FIRE, _SEARCH = int(TaskKind.FIRE), int(TaskKind.SEARCH)
-_RETURNING = int(Mode.RETURNING)
 _POS1 = np.arange(1, 1 << 16)  # 1-based positions (task graphs hold far fewer tasks)
 _ROWS = np.arange(256)[:, None]  # agent rows as a column, for fancy indexing
-_NONE_FORCED = np.zeros(0, dtype=bool)  # forced-return flags when no agent is on one (unused)
 
 
 @dataclass(frozen=True, eq=False)
@@ -158,47 +158,21 @@ class Candidates:
 
 
 def legal_tasks(graph: TaskGraph) -> np.ndarray:
-    """(A, T) bool: one-task routes :func:`fcplan.plan.validate_plan` accepts (same arithmetic)."""
-    forced = graph.agent_mode == _RETURNING
-    return _legal(graph, forced, forced.tolist())
+    """(A, T) bool: one-task routes :func:`fcplan.plan.validate_plan` accepts (a copy of
+    :attr:`fcplan.taskgraph.TaskGraph.reachable`)."""
+    return graph.reachable.copy()
 
 
-def _legal(graph: TaskGraph, forced: np.ndarray, forced_l: list) -> np.ndarray:
-    """:func:`legal_tasks` given the forced-return flags (array and list)."""
-    dh = graph.task_home_distance
-    full, can = graph.agent_full_range, graph.can_do
-    if dh.flags.writeable or full.flags.writeable or can.flags.writeable:
-        ok = 2.0 * dh <= (full + 1e-6)[:, None]
-        ok &= can
-    else:  # read-only inputs shared by graphs (build_task_graph without fire): once per inputs
-        hit = _HOME_OK.get(id(dh))
-        if hit is None or hit[0] is not dh or hit[1] is not full or hit[2] is not can:
-            if len(_HOME_OK) >= 16:
-                _HOME_OK.pop(next(iter(_HOME_OK)))
-            ok = 2.0 * dh <= (full + 1e-6)[:, None]
-            ok &= can
-            hit = _HOME_OK[id(dh)] = (dh, full, can, ok)
-        ok = hit[3].copy()
-    if all(forced_l):
-        return ok
-    reach = graph.agent_task_distance + dh
-    reach = reach <= (graph.agent_battery / DRAIN_PER_PX + 1e-6)[:, None]
-    if True in forced_l:
-        reach |= forced[:, None]
-    ok &= reach
-    return ok
-
-
-#: id(read-only home-distance table) -> (the table, the read-only full-range and can_do arrays,
-#: the part of the legality they give); an entry holds its inputs, so their ids are not reused
-#: while cached, and read-only arrays keep their values
-_HOME_OK: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
-
-
-def _candidates(rows, start_distance, priority, freshness, legal, valid=None) -> Candidates:
-    """``Candidates(...)`` without the frozen dataclass's per-field ``object.__setattr__``."""
-    c = object.__new__(Candidates)
-    c.__dict__.update(
+def _candidates(
+    rows: np.ndarray,
+    start_distance: np.ndarray,
+    priority: np.ndarray,
+    freshness: np.ndarray,
+    legal: np.ndarray,
+    valid: np.ndarray | None = None,
+) -> Candidates:
+    """``Candidates(...)`` with ``valid`` defaulting to the slots holding a task."""
+    return Candidates(
         rows=rows,
         valid=rows >= 0 if valid is None else valid,
         start_distance=start_distance,
@@ -206,7 +180,6 @@ def _candidates(rows, start_distance, priority, freshness, legal, valid=None) ->
         freshness=freshness,
         legal=legal,
     )
-    return c
 
 
 @lru_cache(maxsize=16)
@@ -220,13 +193,8 @@ def _ones(n: int) -> np.ndarray:
 def rank_candidates(graph: TaskGraph, k: int, *, fresh_s: float = 5.0) -> Candidates:
     """The ``k`` most relevant legal tasks of every agent (see the module docstring)."""
     n_a, n_t = graph.n_agents, graph.n_tasks
-    # a handful of agents: Python any/all beat numpy's reductions
-    forced_l = [m == _RETURNING for m in graph.agent_mode.tolist()]
-    forced = np.array(forced_l, dtype=bool) if True in forced_l else _NONE_FORCED
-    legal = _legal(graph, forced, forced_l)
-    d_start = graph.agent_task_distance
-    if True in forced_l:
-        d_start = np.where(forced[:, None], graph.task_home_distance, d_start)
+    legal = graph.reachable
+    d_start = graph.start_task_distance
     kind = graph.task_kind
     # fires (kind 0) come first: none when the first task is a search block
     n_f = n_t - int(np.count_nonzero(kind)) if n_t and kind[0] == _FIRE else 0
@@ -315,7 +283,7 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     out[12] = graph.task_home_distance[ai, r]
     # other capable agents: how many are closer, and how close is the nearest; incapable others
     # at +inf: never closer (distances are finite), never the nearest
-    per_agent = _capable_per_agent(graph.can_do, n_a)
+    per_agent = _capable_per_agent(graph, n_a)
     if per_agent is None:
         capable = graph.can_do[:, r]  # (A_other, A, k)
         capable &= _not_self(n_a)
@@ -339,30 +307,25 @@ def task_features(graph: TaskGraph, cand: Candidates, goal: np.ndarray) -> np.nd
     return out.transpose(1, 2, 0).astype(np.float32, order="C")
 
 
-def _capable_per_agent(can_do: np.ndarray, n_a: int) -> tuple[np.ndarray, np.ndarray] | None:
-    """For a read-only ``can_do`` whose every row is constant (graphs without fire: only the
-    agent's camera matters), the (A_other, A, 1) bool "other agent j can serve agent i's
+def _capable_per_agent(graph: TaskGraph, n_a: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """For a shared read-only ``can_do`` whose every row is constant (graphs without fire: only
+    the agent's camera matters), the (A_other, A, 1) bool "other agent j can serve agent i's
     tasks" and the (A, 1) int64 ``max(count, 1)`` of those agents; else None."""
-    if can_do.flags.writeable or can_do.shape[1] == 0:
+    can_do, memo = graph.can_do, graph.shared_memo
+    if memo is None or can_do.flags.writeable or can_do.shape[1] == 0:
         return None
-    hit = _CAPABLE.get(id(can_do))
-    if hit is None or hit[0] is not can_do:
-        per_agent = None
-        if (can_do == can_do[:, :1]).all():
-            capable = can_do[:, :1][:, None, :] & _not_self(n_a)  # (A_other, A, 1)
-            n_cap = np.add.reduce(capable, axis=0)
-            np.maximum(n_cap, 1, out=n_cap)
-            capable.flags.writeable = n_cap.flags.writeable = False
-            per_agent = (capable, n_cap)
-        if len(_CAPABLE) >= 16:
-            _CAPABLE.pop(next(iter(_CAPABLE)))
-        hit = _CAPABLE[id(can_do)] = (can_do, per_agent)
-    return hit[1]
+    return memo.get("capable_per_agent", (can_do,), lambda: _capable_table(can_do, n_a))
 
 
-#: id(read-only can_do) -> (the array, its _capable_per_agent); an entry holds its array, so the
-#: id is not reused while cached, and a read-only array keeps its values
-_CAPABLE: dict[int, tuple[np.ndarray, tuple[np.ndarray, np.ndarray] | None]] = {}
+def _capable_table(can_do: np.ndarray, n_a: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`_capable_per_agent` computed (read-only arrays)."""
+    if not (can_do == can_do[:, :1]).all():
+        return None
+    capable = can_do[:, :1][:, None, :] & _not_self(n_a)  # (A_other, A, 1)
+    n_cap = np.add.reduce(capable, axis=0)
+    np.maximum(n_cap, 1, out=n_cap)
+    capable.flags.writeable = n_cap.flags.writeable = False
+    return capable, n_cap
 
 
 def _task_rows(graph: TaskGraph, freshness: np.ndarray) -> np.ndarray:
@@ -370,17 +333,21 @@ def _task_rows(graph: TaskGraph, freshness: np.ndarray) -> np.ndarray:
     threat, freshness, position) with the rows that do not depend on the step filled in: all but
     rows 2 (log value) and 4 (staleness), which the caller fills.
 
-    Graphs without fire share their kind, cell, threat and position arrays (read-only, see
-    :func:`fcplan.taskgraph.build_task_graph`) and their freshness (all ones): those rows are
-    computed once per set of arrays and copied.
+    Graphs of one builder without fire share their kind, cell, threat and position arrays
+    (read-only) and their freshness (all ones): those rows are computed once per set of arrays
+    (kept in the graphs' memo) and copied.
     """
     src = (graph.task_kind, graph.task_cells, graph.task_threat, graph.task_pos, freshness)
-    shared = not any(a.flags.writeable for a in src)
-    if shared:
-        hit = _TASK_ROWS.get(id(src[0]))
-        if hit is not None and all(a is b for a, b in zip(hit[0], src, strict=True)):
-            return hit[1].copy()
-    pt = np.empty((9, len(src[0])))
+    memo = graph.shared_memo
+    if memo is None or any(a.flags.writeable for a in src):
+        return _make_task_rows(graph, freshness)
+    kept = memo.get("task_rows", src, lambda: _make_task_rows(graph, freshness))
+    return kept.copy()
+
+
+def _make_task_rows(graph: TaskGraph, freshness: np.ndarray) -> np.ndarray:
+    """:func:`_task_rows` computed."""
+    pt = np.empty((9, graph.n_tasks))
     pt[1] = graph.task_kind  # is_search: kinds are 0 (fire) and 1 (search)
     np.subtract(1.0, pt[1], out=pt[0])
     np.log1p(graph.task_cells, out=pt[3])
@@ -388,16 +355,7 @@ def _task_rows(graph: TaskGraph, freshness: np.ndarray) -> np.ndarray:
     np.log1p(graph.task_threat, out=pt[5])
     pt[6] = freshness
     pt[7:9] = graph.task_pos.T
-    if shared:
-        if len(_TASK_ROWS) >= 16:
-            _TASK_ROWS.pop(next(iter(_TASK_ROWS)))
-        _TASK_ROWS[id(src[0])] = (src, pt.copy())
     return pt
-
-
-#: id(read-only task kinds) -> (the read-only source arrays, their _task_rows); an entry holds
-#: its arrays, so their ids are not reused while cached, and read-only arrays keep their values
-_TASK_ROWS: dict[int, tuple[tuple[np.ndarray, ...], np.ndarray]] = {}
 
 
 def _clip(out: np.ndarray) -> None:
@@ -450,18 +408,14 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
             known,
             sh,
         ]
-        for (x, y), z, bat, full, tank, cap, sense, act, mode, rng, (hx, hy), sh in zip(
+        for (x, y), z, bat, (full, cap, sense, act, (hx, hy)), tank, mode, rng, sh in zip(
             graph.agent_pos.tolist(),
             graph.agent_z.tolist(),
             graph.agent_battery.tolist(),
-            _as_list(graph.agent_full_range),
+            _agent_constants(graph),
             graph.agent_tank.tolist(),
-            _as_list(graph.agent_tank_capacity),
-            _as_list(graph.agent_can_sense),
-            _as_list(graph.agent_can_act),
             graph.agent_mode.tolist(),
             graph.agent_range.tolist(),
-            _as_list(graph.agent_home),
             share,
             strict=True,
         )
@@ -471,22 +425,36 @@ def agent_features(graph: TaskGraph, cand: Candidates, time_fraction: float) -> 
     return out.astype(np.float32)
 
 
-def _as_list(a: np.ndarray) -> list:
-    """``a.tolist()``, kept for read-only arrays (the per-team constants graphs share); the
-    caller must not change the list."""
-    if a.flags.writeable:
-        return a.tolist()
-    hit = _LISTS.get(id(a))
-    if hit is None or hit[0] is not a:
-        if len(_LISTS) >= 64:
-            _LISTS.pop(next(iter(_LISTS)))
-        hit = _LISTS[id(a)] = (a, a.tolist())
-    return hit[1]
+def _agent_constants(graph: TaskGraph) -> list[tuple[Any, ...]]:
+    """Per agent, its full range, tank capacity, camera and water flags and depot slot (Python
+    numbers; kept in the memo of a builder's graphs, whose arrays of these never change)."""
+    src = (
+        graph.agent_full_range,
+        graph.agent_tank_capacity,
+        graph.agent_can_sense,
+        graph.agent_can_act,
+        graph.agent_home,
+    )
+    memo = graph.shared_memo
+    if memo is None or any(a.flags.writeable for a in src):
+        return _zip_lists(src)
+    return memo.get("agent_constants", src, lambda: _zip_lists(src))
 
 
-#: id(read-only array) -> (the array, its tolist()); an entry holds its array, so the id is not
-#: reused while cached, and a read-only array keeps its values
-_LISTS: dict[int, tuple[np.ndarray, list]] = {}
+def _zip_lists(arrays: tuple[np.ndarray, ...]) -> list[tuple[Any, ...]]:
+    """Per row, the rows of ``arrays`` as Python numbers (or lists)."""
+    return list(zip(*(a.tolist() for a in arrays), strict=True))
+
+
+def _as_list(graph: TaskGraph, name: str) -> list[Any]:
+    """``getattr(graph, name).tolist()``, kept in the graph's memo for the read-only arrays the
+    graphs of a builder share (the per-team constants); the caller must not change the list."""
+    a: np.ndarray = getattr(graph, name)
+    memo = graph.shared_memo
+    if memo is None or a.flags.writeable:
+        out: list[Any] = a.tolist()
+        return out
+    return memo.get("list:" + name, (a,), a.tolist)
 
 
 _MODE_ONE_HOT = np.eye(4)[[int(Mode.IDLE), int(Mode.ACTIVE), int(Mode.RETURNING), int(Mode.HOMING)]]

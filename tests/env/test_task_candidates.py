@@ -238,16 +238,18 @@ def _writable_copy(g):
 @settings(max_examples=10, deadline=None)
 @given(name=st.sampled_from(["practice", "1", "24", "open_world_example"]), seed=st.integers(0, 9))
 def test_shared_array_shortcuts_equal_the_generic_paths(name, seed):
-    """On graphs built by build_task_graph (read-only per-team and fire-free task arrays, cached
-    legality, task rows and capable-agent tables), candidates, masks and features are bit for
-    bit those of the same graph with fresh writable arrays, with and without known fire."""
+    """On graphs of a TaskGraphBuilder (read-only per-team and fire-free task arrays, legality,
+    task rows and capable-agent tables kept in their shared memo), candidates, masks and features
+    are bit for bit those of the same graph with fresh writable arrays and no memo, with and
+    without known fire."""
     from fcplan import World, load_scenario, make_scheduler
     from fcplan.belief import Belief
     from fcplan.plan import plan_commands
-    from fcplan.taskgraph import build_task_graph
+    from fcplan.taskgraph import TaskGraphBuilder
 
     world = World().reset(load_scenario(name), seed=seed)
     belief = Belief(world.scenario)
+    builder = TaskGraphBuilder(world.scenario)
     sched = make_scheduler("greedy")
     goal = np.full((len(world.team.ids), 2), np.nan)
     goal[0] = (100.0, 200.0)
@@ -257,12 +259,13 @@ def test_shared_array_shortcuts_equal_the_generic_paths(name, seed):
         commands = None
         if tick % 10:
             continue
-        g = build_task_graph(world.scenario, world.team, belief)
+        g = builder.build(world.team, belief)
         commands = plan_commands(sched.plan(g, time_limit=None, rng=world.controller_rng), g)
         if tick % 50:
             continue
-        for f in (g, build_task_graph(world.scenario, world.team, belief)):  # caches warm
+        for f in (g, builder.build(world.team, belief)):  # memo warm
             h = _writable_copy(f)
+            assert f.shared_memo is not None and h.shared_memo is None
             a, b = rank_candidates(f, 6), rank_candidates(h, 6)
             for field in ("rows", "valid", "start_distance", "priority", "freshness", "legal"):
                 assert np.array_equal(getattr(a, field), getattr(b, field)), field

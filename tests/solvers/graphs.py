@@ -32,17 +32,3 @@ def episode_graphs(name, ticks: tuple[int, ...]) -> tuple[TaskGraph, ...]:
             commands = plan_commands(solve(greedy, g, time_limit=None, rng=rng), g)
         belief.update(world.step(commands))
     return tuple(out)
-
-
-def route_length_home(g, i: int, route) -> tuple[float, float]:
-    """(px of the route from the agent's start plus the way home, px it may fly)."""
-    import numpy as np
-
-    from fcplan.team import Mode
-
-    if g.agent_mode[i] == Mode.RETURNING:
-        start, budget = g.agent_home[i], g.agent_full_range[i]
-    else:
-        start, budget = g.agent_pos[i], g.agent_battery[i] / 0.1
-    pts = np.vstack([start] + [g.task_pos[g.task_index[t]] for t in route] + [g.agent_home[i]])
-    return float(np.hypot(*np.diff(pts, axis=0).T).sum()), float(budget)

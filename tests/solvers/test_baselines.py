@@ -88,15 +88,7 @@ def test_random_gives_one_feasible_task_to_each_free_agent(name):
     for g in episode_graphs(name):
         plan = RandomScheduler(keep_probability=0.0).plan(g, rng=np.random.default_rng(3))
         validate_plan(plan, g)
-        forced = g.agent_mode == Mode.RETURNING
-        start = np.where(forced[:, None], g.agent_home, g.agent_pos)
-        budget = np.where(forced, g.agent_full_range, g.agent_battery / 0.1)
-        first = np.hypot(*(start[:, None, :] - g.task_pos[None, :, :]).transpose(2, 0, 1))
-        options = (
-            g.can_do
-            & (2.0 * g.task_home_distance <= g.agent_full_range[:, None])
-            & (first + g.task_home_distance <= budget[:, None])
-        )
+        options = g.reachable  # (the feasibility rule: exactly what validate_plan accepts)
         for i, a in enumerate(g.agent_ids):
             route = plan.routes.get(a)
             if g.agent_mode[i] == Mode.HOMING or not options[i].any():

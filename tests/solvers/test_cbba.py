@@ -23,16 +23,6 @@ TICKS = (0, 100, 300, 600)
 COMM_RANGES = [None, 5000.0, 150.0]
 
 
-def route_and_home_px(g: TaskGraph, i: int, route) -> tuple[float, float]:
-    """(px of the route from the agent's start plus the way home, px it may fly)."""
-    if g.agent_mode[i] == Mode.RETURNING:
-        start, budget = g.agent_home[i], g.agent_full_range[i]
-    else:
-        start, budget = g.agent_pos[i], g.agent_battery[i] / 0.1
-    pts = np.vstack([start] + [g.task_pos[k] for k in route] + [g.agent_home[i]])
-    return float(np.hypot(*np.diff(pts, axis=0).T).sum()), float(budget)
-
-
 def check_result(g: TaskGraph, res: CBBAResult, plan: Plan, cbba: CBBAScheduler) -> None:
     """Everything a CBBA plan must satisfy, whatever the communication graph."""
     validate_plan(plan, g)
@@ -54,8 +44,7 @@ def check_result(g: TaskGraph, res: CBBAResult, plan: Plan, cbba: CBBAScheduler)
             # a watch (a fire task for a camera) is a whole route on its own
             assert (kinds == TaskKind.SEARCH).all() or len(route) == 1
         assert g.agent_mode[i] != Mode.HOMING
-        need, have = route_and_home_px(g, i, route)
-        assert need <= have + 1e-6
+        assert g.route_ok(i, route), (g.route_length_px(i, route), g.agent_budget_px[i])
         for k in route:
             key = (int(k), service)
             assert key not in holders, f"task {k} ({service}) given to {holders[key]} and {i}"
@@ -180,7 +169,8 @@ def test_vectorised_consensus_applies_the_table(seed, n_agents, n_items):
     """One round of the vectorised consensus gives, on random states (random winners, bids and
     timestamps with many ties, random communication graphs), exactly what the case-by-case table
     gives when each receiver reads its neighbours' messages in index order, task by task."""
-    from solvers.cbba import CommGraph, _Agents, _Auction
+    from solvers.cbba.auction import Auction, _Agents
+    from solvers.cbba.comms import CommGraph
 
     rng = np.random.default_rng(seed)
     a, m = n_agents, n_items
@@ -191,7 +181,7 @@ def test_vectorised_consensus_applies_the_table(seed, n_agents, n_items):
     y = np.where(z >= 0, rng.choice([1.0, 2.0, 3.0], size=(a, m)), 0.0)
     s = rng.integers(0, 4, size=(a, a)).astype(float)
     zeros = np.zeros((a, m))
-    auc = _Auction(
+    auc = Auction(
         zeros,
         zeros > 0,
         np.zeros(m, bool),
@@ -258,10 +248,8 @@ def reference_bundle(g: TaskGraph, cbba: CBBAScheduler) -> list[int]:
     def ok(path):
         if not g.agent_can_act[0] and len(path) > 1 and fire[path].any():
             return False  # a watch is a route on its own
-        need, have = route_and_home_px(g, 0, path)
-        return need <= have + 1e-9 and all(
-            2 * g.task_home_distance[0, k] <= g.agent_full_range[0] for k in path
-        )
+        need, have = g.route_length_px(0, path), g.agent_budget_px[0]
+        return need <= have + 1e-9 and bool(g.in_round_trip[0, path].all())
 
     path: list[int] = []
     while len(path) < limit:

@@ -14,9 +14,9 @@ from fcplan import World, load_scenario
 from fcplan.belief import Belief
 from fcplan.plan import Plan, validate_plan
 from fcplan.taskgraph import TaskGraph, TaskKind, build_task_graph, synthetic_task_graph
-from fcplan.team import Command, Mode
+from fcplan.team import DRAIN_PER_PX, Command, Mode
 from solvers.greedy import GreedyScheduler
-from tests.solvers.graphs import SCENARIOS, route_length_home
+from tests.solvers.graphs import SCENARIOS
 from tests.solvers.graphs import episode_graphs as _episode_graphs
 
 #: every shipped scenario, plus the open-world example (hybrids, 1000 px map)
@@ -50,8 +50,8 @@ def check_greedy_plan(g: TaskGraph, plan: Plan) -> None:
                 if k == TaskKind.FIRE:
                     assert t not in fire_owner, f"{t} given to {fire_owner.get(t)} and {a}"
                     fire_owner[t] = a
-        need, have = route_length_home(g, i, route)
-        assert need <= have + 1e-6, f"{a}: route + way home {need:.1f} px > {have:.1f} px"
+        need, have = g.route_length_px(i, route), g.agent_budget_px[i]
+        assert g.route_ok(i, route), f"{a}: route + way home {need:.1f} px > {have:.1f} px"
     for a, z in plan.altitudes.items():
         i = g.agent_index[a]
         lo, hi = g.agent_alt_range[i]
@@ -121,7 +121,7 @@ def test_route_respects_a_low_battery():
     bat = g.agent_battery.copy()
     mode = g.agent_mode.copy()
     acting = np.flatnonzero(g.agent_can_act)
-    bat[acting] = 0.1 * (g.task_home_distance[acting].min(axis=1) * 2 + 5.0)
+    bat[acting] = DRAIN_PER_PX * (g.task_home_distance[acting].min(axis=1) * 2 + 5.0)
     mode[acting] = Mode.ACTIVE
     g = dataclasses.replace(g, agent_battery=bat, agent_mode=mode)
     plan = greedy_plan(g)
@@ -203,12 +203,11 @@ def test_episode_graphs_with_fire_dispatch_action_agents(name):
             g.agent_can_act
             & (g.agent_mode == Mode.IDLE)
             & (g.agent_tank > 0)
-            & (g.agent_battery >= 0.999 * g.agent_full_range * 0.1)
+            & (g.agent_battery >= 0.999 * g.agent_full_range * DRAIN_PER_PX)
         )
         if fresh.size == 0 or not idle.any():
             continue
-        reach = 2.0 * g.task_home_distance[np.ix_(np.flatnonzero(idle), fresh)]
-        if not (reach <= g.agent_full_range[idle][:, None]).any():
+        if not g.in_round_trip[np.ix_(np.flatnonzero(idle), fresh)].any():
             continue
         plan = greedy_plan(g)
         fire_ids = {g.task_ids[k] for k in g.fire_tasks}
@@ -221,8 +220,6 @@ def test_episode_graphs_with_fire_dispatch_action_agents(name):
 
 def _naive_assign(graph, agents, tasks, value, start, budget, limit, spread, spread_px):
     """The greedy pick loop written plainly: rebuild the whole score matrix before every pick."""
-    from solvers._feasible import round_trip_ok
-
     value = value.astype(float).copy()
     pos = start[agents].copy()
     used = np.zeros(agents.size)
@@ -230,7 +227,7 @@ def _naive_assign(graph, agents, tasks, value, start, budget, limit, spread, spr
     count = np.zeros(agents.size, dtype=int)
     taken = np.zeros(tasks.size, dtype=bool)
     home = graph.task_home_distance[np.ix_(agents, tasks)]
-    ok = round_trip_ok(graph)[np.ix_(agents, tasks)]
+    ok = graph.in_round_trip[np.ix_(agents, tasks)]
     routes = {int(a): [] for a in agents}
     tpos = graph.task_pos[tasks]
     while True:
@@ -269,17 +266,13 @@ def _naive_assign(graph, agents, tasks, value, start, budget, limit, spread, spr
 def test_incremental_picks_equal_full_recomputation(seed, n_agents, n_tasks, spread):
     """Greedy's incremental score updates pick exactly what rebuilding the whole (agent, task)
     score matrix before every pick would pick."""
-    from solvers._feasible import start_budget, start_positions
-
     g = synthetic_task_graph(n_agents, n_tasks, np.random.default_rng(seed))
     sched = GreedyScheduler()
     agents = np.arange(g.n_agents)
     tasks = np.arange(g.n_tasks)
     limit = np.full(g.n_agents, 3)
-    start, budget = start_positions(g), start_budget(g)
-    fast, _ = sched._assign(
-        g, agents, tasks, g.task_value, start, budget, limit=limit, spread=spread
-    )
+    start, budget = g.agent_start_pos, g.agent_budget_px
+    fast, _ = sched._assign(g, agents, tasks, g.task_value, limit=limit, spread=spread)
     slow = _naive_assign(
         g, agents, tasks, g.task_value, start, budget, limit, spread, sched.spread_px
     )

@@ -26,7 +26,7 @@ from solvers.milp_model import (
     build_milp_model,
     decode_plan,
 )
-from tests.solvers.graphs import SCENARIOS, route_length_home
+from tests.solvers.graphs import SCENARIOS
 from tests.solvers.graphs import episode_graphs as _episode_graphs
 
 TICKS = (0, 100, 300, 600)
@@ -72,8 +72,8 @@ def check_plan(g: TaskGraph, plan: Plan, params: MilpParams | None = None) -> No
                 assert t not in watched, f"{t} watched twice"
                 watched.add(t)
         assert n_fire <= tank, f"{a}: {n_fire} fires for tank {tank}"
-        need, have = route_length_home(g, i, route)
-        assert need <= have + 1e-6, f"{a}: route + way home {need:.1f} px > {have:.1f} px"
+        need, have = g.route_length_px(i, route), g.agent_budget_px[i]
+        assert g.route_ok(i, route), f"{a}: route + way home {need:.1f} px > {have:.1f} px"
 
 
 def random_graph(seed: int, n_agents: int, n_tasks: int, **kw) -> TaskGraph:

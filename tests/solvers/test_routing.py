@@ -17,7 +17,7 @@ from fcplan.scheduling import SolveStats, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph, TaskKind, synthetic_task_graph
 from fcplan.team import Mode
 from solvers.routing import RoutingFailedError, RoutingScheduler, solve_routes
-from tests.solvers.graphs import SCENARIOS, episode_graphs, route_length_home
+from tests.solvers.graphs import SCENARIOS, episode_graphs
 from tests.solvers.test_greedy import known_fire_graph
 
 #: replan ticks of the greedy episodes the real graphs come from (shared with test_greedy's cache)
@@ -52,8 +52,8 @@ def check_routing_plan(g: TaskGraph, plan: Plan, max_visits: int = 4) -> None:
                 fire_owner[t] = a
         else:
             assert g.agent_can_sense[i], f"{a} has no water and no camera but got a route"
-        need, have = route_length_home(g, i, route)
-        assert need <= have + 1e-6, f"{a}: route + way home {need:.1f} px > {have:.1f} px"
+        need, have = g.route_length_px(i, route), g.agent_budget_px[i]
+        assert g.route_ok(i, route), f"{a}: route + way home {need:.1f} px > {have:.1f} px"
     for a, z in plan.altitudes.items():
         i = g.agent_index[a]
         lo, hi = g.agent_alt_range[i]

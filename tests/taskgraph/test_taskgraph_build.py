@@ -1,117 +1,41 @@
-"""Tests for fcplan.taskgraph: dump-sized fire tiles, search blocks, edges, numpy/networkx views."""
+"""Tests for fcplan.taskgraph.build: dump-sized fire tiles, search blocks, edges, the per-episode
+builder and its shared constants."""
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from functools import lru_cache
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fcplan import World, load_scenario
+from fcplan import World, load_scenario, make_scheduler
 from fcplan.belief import Belief
+from fcplan.plan import plan_commands
 from fcplan.scenario.grid import cell_name
 from fcplan.taskgraph import (
-    TaskGraph,
+    TaskGraphBuilder,
     TaskGraphParams,
     TaskKind,
     build_task_graph,
     grid_block_name,
 )
-from fcplan.team import Command, fov_half_extent
-
-SETTINGS = settings(max_examples=30, deadline=None)
-
-
-@lru_cache(maxsize=4)
-def quiet_scenario(name: str | int = 1):
-    """A shipped scenario whose own fire regions never ignite during the game."""
-    sc = load_scenario(name)
-    regions = tuple(dataclasses.replace(r, delay_s=10_000.0) for r in sc.regions)
-    return sc.replace(regions=regions)
-
-
-def hover_world(cells, at, *, z: float = 100.0, hover_ticks: int = 30, scenario=None):
-    """Ignite ``cells`` by hand, fly P1 to ``at`` (or each agent of a dict ``{id: xy}`` to its
-    point) at altitude ``z`` and hover there.
-
-    Returns the world and the team's belief. At z = 100 the view is 200 x 115 px; each cell in it
-    is sensed with probability 0.4 per tick, so after ~30 ticks almost every cell is known (the
-    tests compare the graph with the belief, not with the ignited cells).
-    """
-    sc = scenario or quiet_scenario(1)
-    world = World().reset(sc, seed=0)
-    if len(cells):
-        world.ignite(np.asarray(cells, dtype=np.int64).reshape(-1, 2))
-    belief = Belief(sc)
-    targets = at if isinstance(at, dict) else {"P1": at}
-    team = world.team
-    n = 0
-    cmd = {}
-    for agent, xy in targets.items():
-        i = team.index(agent)
-        travel = math.hypot(xy[0] - team.pos[i, 0], xy[1] - team.pos[i, 1])
-        n = max(n, int(travel / team.speed[i]) + 2 + hover_ticks)
-        cmd[agent] = Command(route=((float(xy[0]), float(xy[1])),), altitude=z)
-    for _ in range(n):
-        belief.update(world.step(cmd))
-        cmd = None
-    return world, belief
-
-
-def graph_of(world, belief, params=None) -> TaskGraph:
-    return build_task_graph(world.scenario, world.team, belief, params)
-
-
-def block_cells(center, half=(40, 25), step=3):
-    """A filled rectangle of cells (every ``step`` px) around ``center``."""
-    cx, cy = center
-    xs = np.arange(cx - half[0], cx + half[0] + 1, step)
-    ys = np.arange(cy - half[1], cy + half[1] + 1, step)
-    gx, gy = np.meshgrid(xs, ys, indexing="ij")
-    return np.stack([gx.ravel(), gy.ravel()], axis=1)
-
-
-def rect_distance(p, rect) -> float:
-    x0, x1, y0, y1 = rect
-    dx = max(x0 - p[0], 0.0, p[0] - x1)
-    dy = max(y0 - p[1], 0.0, p[1] - y1)
-    return math.hypot(dx, dy)
-
-
-def fire_tile_of_cells(graph: TaskGraph, xy: np.ndarray) -> np.ndarray:
-    """(k,) row of the fire task whose tile holds each cell (-1 when none)."""
-    tw, th = graph.tile_px
-    fires = graph.fire_tasks
-    tiles = {
-        (int(graph.task_pos[k, 0] // tw), int(graph.task_pos[k, 1] // th)): int(k) for k in fires
-    }
-    assert len(tiles) == fires.size, "two fire tasks share a tile"
-    return np.array([tiles.get((int(x // tw), int(y // th)), -1) for x, y in xy], dtype=np.int64)
-
-
-# strategies: a few clumps of cells inside one 200 x 115 px view centred on a random point
-centres = st.tuples(st.integers(150, 1050), st.integers(150, 1050))
-offsets = st.lists(
-    st.tuples(st.integers(-95, 95), st.integers(-55, 55)), min_size=1, max_size=60, unique=True
+from fcplan.team import fov_half_extent
+from tests.taskgraph.worlds import (
+    block_cells,
+    centres,
+    fire_far_away,
+    fire_near_house,
+    fire_tile_of_cells,
+    graph_of,
+    hover_world,
+    offsets,
+    rect_distance,
 )
 
-
-@lru_cache(maxsize=1)
-def fire_near_house():
-    """Known fire just north of the house at I-02 (footprint x 840..960, y 125..275)."""
-    cells = block_cells((900, 100), half=(20, 10), step=2)
-    return hover_world(cells, (900, 100))
-
-
-@lru_cache(maxsize=1)
-def fire_far_away():
-    """Known fire at (520, 500): more than 250 px from every facility footprint of #1."""
-    cells = block_cells((520, 500), half=(30, 20), step=2)
-    return hover_world(cells, (520, 500))
+SETTINGS = settings(max_examples=30, deadline=None)
 
 
 # ---------------------------------------------------------------------- fire tiles
@@ -326,120 +250,6 @@ def test_no_threatens_edges_for_far_fire():
     np.testing.assert_allclose(g.task_value[g.fire_tasks], g.task_cells[g.fire_tasks])
 
 
-# ---------------------------------------------------------------------- views
-def test_numpy_and_networkx_views_agree():
-    """The networkx view has one node per entry of node_ids (agents, depot, tasks, facilities)
-    at the same positions and with the same kinds as the numpy arrays; ``can_do`` edges match
-    the can_do matrix."""
-    world, belief = fire_near_house()
-    g = graph_of(world, belief)
-    G = g.graph
-    n_fac = len(g.facility_kinds)
-    assert G.number_of_nodes() == len(g.node_ids) == g.n_agents + 1 + g.n_tasks + n_fac
-    assert g.positions.shape == (len(g.node_ids), 2)
-    for row, nid in enumerate(g.node_ids):
-        np.testing.assert_allclose(G.nodes[nid]["pos"], g.positions[row])
-    kinds = [G.nodes[n]["kind"] for n in g.node_ids]
-    assert kinds == (
-        ["agent"] * g.n_agents
-        + ["depot"]
-        + ["fire" if k == TaskKind.FIRE else "search" for k in g.task_kind]
-        + ["facility"] * n_fac
-    )
-    for k, t in enumerate(g.task_ids):
-        assert G.nodes[t]["cells"] == g.task_cells[k]
-    np.testing.assert_allclose(G.nodes["depot"]["pos"], world.scenario.depot.center)
-    can = [(a, t) for a, t, d in G.edges(data=True) if d["kind"] == "can_do"]
-    assert len(can) == int(g.can_do.sum())
-    for a, t in can:
-        assert g.can_do[g.agent_index[a], g.task_index[t]]
-    for a, t, d in G.edges(data=True):
-        if d["kind"] == "can_do":
-            i, k = g.agent_index[a], g.task_index[t]
-            assert d["time_s"] == pytest.approx(g.agent_task_distance[i, k] / g.agent_speed[i])
-
-
-points = st.lists(
-    st.tuples(st.floats(0, 1199, allow_nan=False), st.floats(0, 1199, allow_nan=False)),
-    min_size=1,
-    max_size=8,
-)
-
-
-@lru_cache(maxsize=1)
-def base_graph() -> TaskGraph:
-    world, belief = fire_far_away()
-    return graph_of(world, belief)
-
-
-@SETTINGS
-@given(agents=points, tasks=points)
-def test_distances_are_straight_lines(agents, tasks):
-    """agent_task_distance[i, k] is the Euclidean distance between agent i and task k;
-    task_distance is the symmetric Euclidean matrix with a zero diagonal."""
-    g0 = base_graph()
-    a = np.array(agents, dtype=np.float64)
-    t = np.array(tasks, dtype=np.float64)
-    n_a, n_t = len(a), len(t)
-    g = dataclasses.replace(
-        g0,
-        agent_ids=tuple(f"X{i}" for i in range(n_a)),
-        agent_pos=a,
-        agent_home=np.zeros((n_a, 2)),
-        agent_speed=np.full(n_a, 200.0),
-        agent_can_sense=np.ones(n_a, bool),
-        task_ids=tuple(f"t{k}" for k in range(n_t)),
-        task_pos=t,
-        task_kind=np.full(n_t, TaskKind.SEARCH, np.int8),
-    )
-    d = g.agent_task_distance
-    assert d.shape == (n_a, n_t)
-    for i in range(n_a):
-        for k in range(n_t):
-            assert d[i, k] == pytest.approx(math.dist(a[i], t[k]), abs=1e-9)
-            assert g.task_home_distance[i, k] == pytest.approx(math.hypot(*t[k]), abs=1e-9)
-    td = g.task_distance
-    np.testing.assert_allclose(td, td.T)
-    np.testing.assert_allclose(np.diag(td), 0.0, atol=1e-9)
-    np.testing.assert_allclose(g.agent_task_time, d / 200.0)
-
-
-def test_agent_task_distance_from_the_real_team():
-    """On a built graph, agent_task_distance equals the distance from the team's positions."""
-    world, belief = fire_near_house()
-    g = graph_of(world, belief)
-    exp = np.hypot(
-        world.team.pos[:, None, 0] - g.task_pos[None, :, 0],
-        world.team.pos[:, None, 1] - g.task_pos[None, :, 1],
-    )
-    np.testing.assert_allclose(g.agent_task_distance, exp, atol=1e-9)
-    np.testing.assert_allclose(g.agent_pos, world.team.pos)
-
-
-@pytest.mark.parametrize("name", [1, "open_world_example"])
-def test_can_do_forbids_search_for_action_only_agents(name):
-    """Action-only agents can do fire tasks only; perception and hybrid agents can do
-    everything."""
-    if name == 1:
-        world, belief = fire_near_house()
-    else:
-        sc = quiet_scenario(name)
-        world, belief = hover_world(block_cells((500, 500)), (500, 500), scenario=sc)
-    g = graph_of(world, belief)
-    from fcplan.scenario import Role
-
-    fire = g.task_kind == TaskKind.FIRE
-    assert fire.any() and (~fire).any()
-    for i in range(g.n_agents):
-        role = Role(int(g.agent_role[i]))
-        if role is Role.ACTION:
-            assert not g.can_do[i, ~fire].any()
-            assert g.can_do[i, fire].all()
-            assert not g.agent_can_sense[i]
-        else:
-            assert g.can_do[i].all()
-
-
 # ---------------------------------------------------------------------- no fire
 @pytest.mark.parametrize("name", ["practice", 1, 24, "open_world_example"])
 def test_graph_builds_with_no_known_fire(name):
@@ -475,38 +285,11 @@ def test_graph_reports_team_state():
         np.testing.assert_allclose(g.agent_alt_range[i], a.altitude)
 
 
-@settings(max_examples=80, deadline=None)
-@given(
-    seed=st.integers(0, 2**31 - 1),
-    nx=st.integers(2, 30),
-    ny=st.integers(2, 30),
-    most=st.sampled_from([40, 200]),
-)
-def test_small_fire_clusters_match_scipy_label_also_when_repeated(seed, nx, ny, most):
-    """Up to a few dozen tiles (the closure path) and up to 200 (the numpy labelling), cluster
-    labels equal scipy.ndimage.label (8-connected, numbered by first tile in raster order), and
-    asking again for the same tiles (the memo) gives the same labels."""
-    from scipy.ndimage import label
-
-    from fcplan.taskgraph import _EIGHT, _clusters
-
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(1, min(nx * ny, most) + 1))
-    flat = np.sort(rng.choice(nx * ny, size=n, replace=False))
-    tx, ty = np.divmod(flat, ny)
-    grid = np.zeros((nx + 1, ny + 1), dtype=bool)
-    grid[tx, ty] = True
-    labels, _ = label(grid, structure=_EIGHT)
-    want = labels[tx, ty].astype(np.int64) - 1
-    assert np.array_equal(_clusters(tx, ty, nx, ny), want)
-    assert np.array_equal(_clusters(tx.copy(), ty.copy(), nx, ny), want)
-
-
 @pytest.mark.parametrize("nb", [1, 2, 5, 12])
 def test_neighbour_table_is_the_3x3_box_sum(nb):
     """Counting each fire block's cells in its 3 x 3 neighbourhood through the neighbour table
     equals the padded 3 x 3 box sum of the per-block counts."""
-    from fcplan.taskgraph import _neighbours
+    from fcplan.taskgraph.build import _neighbours
 
     rng = np.random.default_rng(nb)
     fb = rng.integers(0, nb * nb, 20)
@@ -521,15 +304,18 @@ def test_neighbour_table_is_the_3x3_box_sum(nb):
     assert np.array_equal(got[: nb * nb], box)
 
 
-def test_graph_shares_read_only_constants_between_builds():
-    """Two graphs of one team share their per-agent constants as read-only arrays, and their
-    belief-dependent arrays are their own (writing to them does not touch the other graph)."""
+# ---------------------------------------------------------------------- the builder
+def test_builder_graphs_share_read_only_constants():
+    """Two graphs of one builder share their per-agent and facility constants as read-only
+    arrays, and their belief-dependent arrays are their own (writing to them does not touch the
+    other graph)."""
     world = World().reset(load_scenario(1), seed=0)
     belief = Belief(world.scenario)
+    builder = TaskGraphBuilder(world.scenario)
     belief.update(world.step())
-    a = build_task_graph(world.scenario, world.team, belief)
+    a = builder.build(world.team, belief)
     belief.update(world.step())
-    b = build_task_graph(world.scenario, world.team, belief)
+    b = builder.build(world.team, belief)
     for name in ("agent_home", "agent_speed", "agent_role", "agent_can_sense", "facility_pos"):
         assert getattr(a, name) is getattr(b, name)
         assert not getattr(a, name).flags.writeable
@@ -537,3 +323,52 @@ def test_graph_shares_read_only_constants_between_builds():
         assert getattr(a, name) is not getattr(b, name)
         assert getattr(a, name).flags.writeable
     assert np.array_equal(a.agent_home, world.team.home)
+    assert a.shared_memo is b.shared_memo is not None
+
+
+def assert_same_graph(a, b) -> None:
+    """Every field and every filled-in distance view of two graphs is equal, bit for bit."""
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(x, np.ndarray):
+            assert x.dtype == y.dtype and x.shape == y.shape, f.name
+            assert x.tobytes() == y.tobytes(), f.name
+        else:
+            assert x == y, f.name
+    for name in ("agent_task_distance", "task_home_distance", "can_do"):
+        assert getattr(a, name).tobytes() == getattr(b, name).tobytes(), name
+
+
+@pytest.mark.parametrize("name", ["practice", "12", "open_world_example"])
+def test_builder_reused_over_an_episode_equals_fresh_builds(name):
+    """A builder reused over a greedy episode (its constants computed once, its cluster labels
+    remembered) gives, at every replan, the graph a fresh builder gives, with and without
+    known fire; after a reset the builder follows the new team."""
+    sc = load_scenario(name)
+    builder = TaskGraphBuilder(sc)
+    greedy = make_scheduler("greedy")
+    seen_fire = False
+    for seed in (0, 1):
+        world = World().reset(sc, seed=seed)
+        belief = Belief(sc)
+        commands = None
+        for tick in range(1, 401):
+            belief.update(world.step(commands))
+            commands = None
+            if tick % 10:
+                continue
+            g = builder.build(world.team, belief)
+            assert_same_graph(g, build_task_graph(sc, world.team, belief))
+            seen_fire |= g.fire_tasks.size > 0
+            commands = plan_commands(greedy.plan(g, rng=world.controller_rng), g)
+    assert seen_fire
+
+
+def test_builder_with_params_equals_build_task_graph():
+    """A builder with other settings (tile, block size) builds what build_task_graph builds with
+    them."""
+    world, belief = fire_near_house()
+    params = TaskGraphParams(tile_px=(17.5, 12.0), search_block_px=150, threat_radius_px=400.0)
+    builder = TaskGraphBuilder(world.scenario, params)
+    assert builder.params is params
+    assert_same_graph(builder.build(world.team, belief), graph_of(world, belief, params))

@@ -1,0 +1,416 @@
+"""The routing scheduler: task values, candidate nodes, the two models' time, and the plan.
+
+Per role (action first, then perception; see :mod:`solvers.routing`) the vehicles' budgets are
+:attr:`fcplan.taskgraph.TaskGraph.agent_budget_px` (their remaining range, a full battery for a
+forced return; the way back to the depot slot counts in it), and a vehicle may only serve the
+tasks within a full-battery round trip of its depot slot
+(:attr:`fcplan.taskgraph.TaskGraph.in_round_trip`) that it can reach and still fly home from.
+``visits`` per route are capped by ``max_visits`` and, for action vehicles, by the water left in
+the tank (each fire visit uses one dump).
+
+**Objective** (minimised): total travel in px plus the sum of the drop penalties of the candidate
+tasks left out, both in px-equivalent units. OR-Tools needs integers: distances are scaled by
+``scale`` (10: decimetres) and rounded *up* (so a route the solver accepts is within the battery
+in real px too), capacities are rounded down, penalties are rounded (at least 1, so a visit stays
+optional). The objective in :class:`fcplan.scheduling.SolveStats` is the sum of the models'
+OR-Tools objectives divided by ``scale`` (px). With ``charge_return=False`` (default) the legs
+into the depot slots cost nothing (an agent replans every second, long before it would fly home;
+charging the way home would pull the search towards the depot) but they still count in the
+battery dimension; with ``charge_return=True`` the travel is the whole path start -> tasks ->
+depot slot.
+
+**Values** (drop penalties: how many px a vehicle would fly to serve the task):
+
+* action, fire ``k``: ``fire_base_px + fire_value_px * value_k * freshness_k`` where ``value_k``
+  is the task's known cells weighted by the facilities it threatens and ``freshness_k`` is 1
+  while the fire was sensed within ``fresh_s`` seconds, then decays as
+  ``exp(-(staleness - fresh_s) / fresh_s)`` (as in ``greedy``). Action agents have nothing else
+  to do, so the base term (default 2000 px, more than most trips across a map) makes every
+  reachable fire worth a visit while the tank and ``max_visits`` allow; the value term decides
+  which fires when they do not, and travel decides the order;
+* perception, search block ``k``: ``search_value_px * value_k`` (its coverage age in s, more
+  near known fire), optionally discounted by ``h / (h + eta_k)`` (``search_horizon_s = h > 0``,
+  ``eta_k`` the earliest arrival of any perception vehicle; 0, off, by default);
+* perception, fire ``k`` ("watching"): ``watch_value_px * value_k * w_k``. Only sensed cells can
+  be pruned, and a fire being fought keeps adding unsensed cells, so ``w_k = 1`` for the fires
+  a dump is imminent at: the *first* tasks of this replan's action routes (one per connected
+  fire, the most valuable, for at most ``max_watch_fraction`` of the perception vehicles, at least
+  one, so the others keep searching); this is why the action model is solved first. Other fires
+  get ``w_k = clip((staleness - fresh_s) / fresh_s, 0, 1)``: a fire not sensed for a while is
+  worth refreshing for the action agents. The default ``watch_value_px = 1000`` px per cell makes
+  watching beat searching almost always.
+
+A perception route whose first task is a fire becomes a **watch**: the route is cut to that fire
+(the agent hovers over it until the next replan) at ``watch_altitude`` (low: reliable sensing);
+other perception routes fly at ``search_altitude`` (high: a wide view). Altitudes are clipped to
+each agent's bounds. Agents with an empty route are not mentioned in the plan (they keep their
+current route), as in ``greedy``.
+
+**Model size**: each role's candidate nodes are its ``max(max_nodes, nodes_per_vehicle * V)``
+most valuable tasks that one of its ``V`` vehicles can reach (default 60, or 2 per vehicle on big
+teams); the others are not offered this replan. On big task graphs this is what keeps a replan
+within its time limit. Routes hold at most ``max_visits`` (4) tasks.
+
+**Search and time**: the search starts from ``first_solution`` (default
+``PARALLEL_CHEAPEST_INSERTION``, which weighs insertions against drop penalties) and improves it
+with ``metaheuristic`` (default ``GUIDED_LOCAL_SEARCH``):
+
+* default mode: until ``time_limit`` seconds per replan (default 0.1 s; the ``time_limit``
+  argument of :meth:`RoutingScheduler.plan` overrides it when given), model building included
+  and about 10 % (at most 5 ms) kept back for turning routes into the plan. The action model gets
+  a share in proportion to its node count (25 % to 50 %), the perception model the rest. A
+  ``branch_limit`` (search steps, a machine-independent count) ends the search of small models
+  early so they do not spin until the limit. If the limit ends a model's search before any
+  solution, the first-solution heuristic is run alone past the limit (about a millisecond;
+  ``rescue=True``, status ``time_limit``, noted in the message) rather than failing. The plan
+  depends on the machine's speed in this mode: it is **not** reproducible run to run;
+* ``deterministic=True``: the search stops after ``solution_limit`` solutions or
+  ``branch_limit`` branches, whichever comes first, never on a wall time (also the LNS
+  sub-searches' own time limit is made unreachable), so the same graph gives the same plan run
+  to run and on any machine: use it for reproducible benchmarks (its time per replan then
+  depends on the model, not on a limit).
+
+**Status**: routing never proves optimality. ``feasible``: a solution was found and the local
+search reached a local optimum (OR-Tools ``ROUTING_SUCCESS``; guided local search then goes on
+until the limit), or the deterministic limits stopped it; ``time_limit``: the wall-time limit
+stopped the search before the local search converged
+(``ROUTING_PARTIAL_SUCCESS_LOCAL_OPTIMUM_NOT_REACHED``) or the plan was rescued; the worse of the
+two models is reported. If a model finds no solution (only possible with ``rescue=False``),
+:class:`RoutingFailedError` is raised and :func:`fcplan.scheduling.solve` falls back to
+``greedy`` for that replan (``status="fallback"``, the reason in the message).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from fcplan.plan import Plan
+from fcplan.scheduling import SolveStats
+from fcplan.taskgraph import TaskGraph, TaskKind
+from fcplan.team import Mode
+from solvers.routing.model import RouteSolution, _pairwise, solve_routes
+from solvers.routing.search import FIRST_SOLUTIONS, METAHEURISTICS
+
+__all__ = ["RoutingScheduler"]
+
+
+class RoutingScheduler:
+    """Prize-collecting vehicle routing per role with OR-Tools (see the module docstring).
+
+    Parameters
+    ----------
+    time_limit : float
+        Default seconds per replan (both models together), used when :meth:`plan` gets
+        ``time_limit=None``.
+    deterministic : bool
+        Stop each model's search after ``solution_limit`` solutions instead of a wall time:
+        identical plans run to run.
+    solution_limit : int
+        Solutions per model in deterministic mode.
+    branch_limit : int, optional
+        Search branches per model (both modes; ends the search of small models early).
+    max_visits : int
+        Most tasks per route.
+    max_nodes, nodes_per_vehicle : int
+        Candidate tasks per role per replan: the ``max(max_nodes, nodes_per_vehicle * V)`` most
+        valuable reachable ones, ``V`` the role's vehicles.
+    fire_base_px : float
+        Drop penalty (px) of any fire task for action agents, on top of the value term: action
+        agents have nothing else to do, so every reachable fire is worth a trip this long.
+    fire_value_px : float
+        Drop penalty (px) per unit of (freshness-weighted) fire value for action agents.
+    watch_value_px : float
+        Drop penalty (px) per unit of fire value for perception agents watching a fire that is
+        being fought or is stale.
+    search_value_px : float
+        Drop penalty (px) per unit of search value (coverage age, s) for perception agents.
+    search_horizon_s : float
+        If > 0, a search block's penalty is multiplied by ``h / (h + eta)`` with ``eta`` the
+        earliest arrival (s) of any perception vehicle at the block (0: no discount).
+    fresh_s : float
+        A fire sensed within this many seconds counts as fresh.
+    watch_altitude, search_altitude : float
+        Altitudes (m) of watching and searching perception agents (clipped to their bounds).
+    max_watch_fraction : float
+        Largest share of the perception vehicles offered a fire being fought to watch (at
+        least one; one fire per connected fire), so the others keep searching.
+    charge_return : bool
+        Count the way back to the depot slot in the objective (it always counts for the battery).
+    first_solution, metaheuristic : str
+        OR-Tools ``FirstSolutionStrategy`` / ``LocalSearchMetaheuristic`` names.
+    scale : float
+        Integer units per px in the model (10: decimetres).
+    rescue : bool
+        When the time limit ends a model's search before any solution, use the first-solution
+        heuristic's routes found just after the limit (status ``time_limit``, noted in the
+        message) rather than raising (and falling back to greedy).
+    """
+
+    name = "routing"
+
+    def __init__(
+        self,
+        time_limit: float = 0.1,
+        deterministic: bool = False,
+        solution_limit: int = 40,
+        branch_limit: int | None = 2000,
+        max_visits: int = 4,
+        max_nodes: int = 60,
+        nodes_per_vehicle: int = 2,
+        fire_base_px: float = 2000.0,
+        fire_value_px: float = 200.0,
+        watch_value_px: float = 1000.0,
+        search_value_px: float = 10.0,
+        search_horizon_s: float = 0.0,
+        fresh_s: float = 5.0,
+        watch_altitude: float = 35.0,
+        search_altitude: float = 70.0,
+        max_watch_fraction: float = 0.5,
+        charge_return: bool = False,
+        first_solution: str = "PARALLEL_CHEAPEST_INSERTION",
+        metaheuristic: str = "GUIDED_LOCAL_SEARCH",
+        scale: float = 10.0,
+        rescue: bool = True,
+    ) -> None:
+        for what, value, enum in (
+            ("first_solution", first_solution, FIRST_SOLUTIONS),
+            ("metaheuristic", metaheuristic, METAHEURISTICS),
+        ):
+            names = list(enum.keys())
+            if value not in names:
+                raise ValueError(f"unknown {what} {value!r}; one of {', '.join(names)}")
+        if not time_limit > 0:
+            raise ValueError(f"time_limit must be > 0 s, got {time_limit!r}")
+        self.time_limit = float(time_limit)
+        self.deterministic = bool(deterministic)
+        self.solution_limit = int(solution_limit)
+        self.branch_limit = None if branch_limit is None else int(branch_limit)
+        self.max_visits = int(max_visits)
+        self.max_nodes = int(max_nodes)
+        self.nodes_per_vehicle = int(nodes_per_vehicle)
+        self.fire_base_px = float(fire_base_px)
+        self.fire_value_px = float(fire_value_px)
+        self.watch_value_px = float(watch_value_px)
+        self.search_value_px = float(search_value_px)
+        self.search_horizon_s = float(search_horizon_s)
+        self.fresh_s = float(fresh_s)
+        self.watch_altitude = float(watch_altitude)
+        self.search_altitude = float(search_altitude)
+        self.max_watch_fraction = float(max_watch_fraction)
+        self.charge_return = bool(charge_return)
+        self.first_solution = first_solution
+        self.metaheuristic = metaheuristic
+        self.scale = float(scale)
+        self.rescue = bool(rescue)
+
+    # ------------------------------------------------------------------ main
+    def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
+        """Route both roles on ``graph`` within ``time_limit`` seconds (default: the setting).
+
+        Raises
+        ------
+        RoutingFailedError
+            If a model finds no solution in time (:func:`fcplan.scheduling.solve` then falls
+            back to greedy).
+        """
+        limit = self.time_limit if time_limit is None else float(time_limit)
+        # keep a little of the limit for turning routes into the plan and freeing the models
+        deadline = time.perf_counter() + limit - min(0.1 * limit, 0.005)
+        free = graph.agent_mode != Mode.HOMING
+        actors = np.flatnonzero(free & graph.agent_can_act & (graph.agent_tank > 0))
+        sensors = np.flatnonzero(
+            free & graph.agent_can_sense & ~(graph.agent_can_act & (graph.agent_tank > 0))
+        )
+        routes: dict[str, tuple[str, ...]] = {}
+        alts: dict[str, float] = {}
+        sols: dict[str, RouteSolution] = {}
+        first_fires = self._route_actors(graph, actors, sensors, deadline, routes, sols)
+        if sensors.size:
+            self._route_sensors(graph, sensors, first_fires, deadline, routes, alts, sols)
+        return Plan(routes=routes, altitudes=alts, stats=_stats(graph, sols))
+
+    def _route_actors(
+        self,
+        graph: TaskGraph,
+        actors: np.ndarray,
+        sensors: np.ndarray,
+        deadline: float,
+        routes: dict[str, tuple[str, ...]],
+        sols: dict[str, RouteSolution],
+    ) -> list[int]:
+        """Action agents -> fires (one visit per dump left in the tank); the routes go into
+        ``routes``, the model's solution into ``sols``. Returns the first fire of each route."""
+        fires, blocks = graph.fire_tasks, graph.search_tasks
+        stale = graph.task_staleness[fires]
+        fresh = np.exp(-np.maximum(stale - self.fresh_s, 0.0) / max(self.fresh_s, 1e-9))
+        act_value = self.fire_base_px + self.fire_value_px * graph.task_value[fires] * fresh
+        act_value = np.where(graph.task_value[fires] > 0, act_value, 0.0)
+        act_nodes = self._candidates(graph, actors, fires, act_value)
+        sense_value_guess = np.r_[
+            self.watch_value_px * graph.task_value[fires],
+            self.search_value_px * graph.task_value[blocks],
+        ]
+        n_sense = min(
+            self._n_candidates(sensors.size),
+            int((sense_value_guess > 0).sum()) if sensors.size else 0,
+        )  # for the time split only
+        first_fires: list[int] = []
+        if actors.size and act_nodes[0].size:
+            share = act_nodes[0].size / (act_nodes[0].size + n_sense)
+            share = 1.0 if n_sense == 0 else min(max(share, 0.25), 0.5)
+            sol = self._solve(
+                graph, actors, act_nodes, deadline, share, capacity=graph.agent_tank[actors]
+            )
+            sols["action"] = sol
+            for v, route in enumerate(sol.routes):
+                if route:
+                    ks = act_nodes[0][list(route)]
+                    routes[graph.agent_ids[actors[v]]] = tuple(graph.task_ids[k] for k in ks)
+                    first_fires.append(int(ks[0]))
+        return first_fires
+
+    def _route_sensors(
+        self,
+        graph: TaskGraph,
+        sensors: np.ndarray,
+        first_fires: list[int],
+        deadline: float,
+        routes: dict[str, tuple[str, ...]],
+        alts: dict[str, float],
+        sols: dict[str, RouteSolution],
+    ) -> None:
+        """Perception agents -> search blocks and fires to watch; the routes and altitudes go
+        into ``routes`` and ``alts``, the model's solution into ``sols``."""
+        fires, blocks = graph.fire_tasks, graph.search_tasks
+        stale = graph.task_staleness[fires]
+        fought = self._fought(graph, fires, first_fires, sensors.size)
+        share_stale = np.clip((stale - self.fresh_s) / max(self.fresh_s, 1e-9), 0.0, 1.0)
+        watch = self.watch_value_px * graph.task_value[fires] * np.maximum(fought, share_stale)
+        tasks = np.r_[fires, blocks].astype(np.int64)
+        search = self.search_value_px * graph.task_value[blocks]
+        if self.search_horizon_s > 0 and blocks.size:
+            # information is worth less the later it comes: discount each block by the
+            # earliest arrival of any perception vehicle (keeps searchers near the action)
+            eta = (
+                _pairwise(graph.agent_start_pos[sensors], graph.task_pos[blocks])
+                / graph.agent_speed[sensors, None]
+            )
+            search = search * self.search_horizon_s / (self.search_horizon_s + eta.min(0))
+        value = np.r_[watch, search]
+        nodes = self._candidates(graph, sensors, tasks, value)
+        if not nodes[0].size:
+            return
+        sol = self._solve(graph, sensors, nodes, deadline, 1.0)
+        sols["perception"] = sol
+        for v, route in enumerate(sol.routes):
+            if not route:
+                continue
+            i = int(sensors[v])
+            ks = nodes[0][list(route)]
+            if graph.task_kind[ks[0]] == TaskKind.FIRE:
+                ks, z = ks[:1], self.watch_altitude  # watch: hover over the fire
+            else:
+                z = self.search_altitude
+            routes[graph.agent_ids[i]] = tuple(graph.task_ids[k] for k in ks)
+            alts[graph.agent_ids[i]] = graph.clip_altitude(i, z)
+
+    # ------------------------------------------------------------------ helpers
+    def _fought(
+        self, graph: TaskGraph, fires: np.ndarray, first_fires: list[int], n_sensors: int
+    ) -> np.ndarray:
+        """(len(fires),) bool: the fires worth watching because a dump is imminent: first tasks
+        of action routes, one per connected fire (the most valuable), at most
+        ``max_watch_fraction`` of the perception vehicles (at least one)."""
+        out = np.zeros(fires.size, dtype=bool)
+        if not first_fires:
+            return out
+        ks = np.unique(np.asarray(first_fires, dtype=np.int64))
+        ks = ks[np.argsort(-graph.task_value[ks], kind="stable")]
+        _, first = np.unique(graph.task_cluster[ks], return_index=True)
+        ks = ks[np.sort(first)]  # the most valuable fire of each cluster, by value
+        n_watch = max(1, int(self.max_watch_fraction * n_sensors))
+        out[np.isin(fires, ks[:n_watch])] = True
+        return out
+
+    def _n_candidates(self, n_vehicles: int) -> int:
+        """Candidate nodes for a model with ``n_vehicles`` vehicles."""
+        return max(self.max_nodes, self.nodes_per_vehicle * n_vehicles)
+
+    def _candidates(
+        self, graph: TaskGraph, agents: np.ndarray, tasks: np.ndarray, value: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(task rows, penalties px) of the most valuable tasks (see :meth:`_n_candidates`) some
+        agent of ``agents`` can serve (positive value, within a round trip, reachable with the way
+        home)."""
+        if agents.size == 0 or tasks.size == 0:
+            return np.zeros(0, np.int64), np.zeros(0)
+        start, budget, trip = graph.agent_start_pos, graph.agent_budget_px, graph.in_round_trip
+        d = (
+            _pairwise(start[agents], graph.task_pos[tasks])
+            + graph.task_home_distance[np.ix_(agents, tasks)]
+        )
+        reach = (trip[np.ix_(agents, tasks)] & (d <= budget[agents, None])).any(axis=0)
+        ok = np.flatnonzero(reach & (value > 0))
+        top = ok[np.argsort(-value[ok], kind="stable")[: self._n_candidates(agents.size)]]
+        top = np.sort(top)  # task order: the model does not depend on value ties
+        return tasks[top], value[top]
+
+    def _solve(
+        self,
+        graph: TaskGraph,
+        agents: np.ndarray,
+        nodes: tuple[np.ndarray, np.ndarray],
+        deadline: float,
+        share: float,
+        capacity: np.ndarray | None = None,
+    ) -> RouteSolution:
+        """Solve one role's model with ``share`` of the time left before ``deadline``."""
+        tasks, penalty = nodes
+        left = max(deadline - time.perf_counter(), 0.0) * share
+        return solve_routes(
+            graph.agent_start_pos[agents],
+            graph.agent_home[agents],
+            graph.task_pos[tasks],
+            penalty,
+            graph.agent_budget_px[agents],
+            capacity=capacity,
+            allowed=graph.in_round_trip[np.ix_(agents, tasks)],
+            max_visits=self.max_visits,
+            charge_return=self.charge_return,
+            time_limit=max(left, 1e-6),
+            deterministic=self.deterministic,
+            solution_limit=self.solution_limit,
+            branch_limit=self.branch_limit,
+            first_solution=self.first_solution,
+            metaheuristic=self.metaheuristic,
+            scale=self.scale,
+            rescue=self.rescue,
+        )
+
+
+def _stats(graph: TaskGraph, sols: dict[str, RouteSolution]) -> SolveStats:
+    """The plan's stats from the models' solutions (the worse status of the two)."""
+    status = "time_limit" if any(s.status == "time_limit" for s in sols.values()) else "feasible"
+    size = {
+        "models": len(sols),
+        "vehicles": sum(s.size["vehicles"] for s in sols.values()),
+        "nodes": sum(s.size["nodes"] for s in sols.values()),
+        "dimensions": sum(s.size["dimensions"] for s in sols.values()),
+        "agents": graph.n_agents,
+        "tasks": graph.n_tasks,
+    }
+    message = "; ".join(
+        f"{role}: {s.size['vehicles']} vehicles x {s.size['nodes']} nodes, travel "
+        f"{s.travel_px:.0f} px, dropped {s.dropped_px:.0f} px, {s.status}"
+        + (" (rescued: first solution after the limit)" if s.rescued else "")
+        for role, s in sols.items()
+    )
+    return SolveStats(
+        status=status,
+        objective=float(sum(s.objective_px for s in sols.values())),
+        size=size,
+        message=message,
+    )
