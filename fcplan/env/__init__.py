@@ -32,7 +32,7 @@ from __future__ import annotations
 from importlib import import_module
 from typing import Any
 
-from fcplan.errors import FcplanError
+from fcplan.errors import EnvError
 
 __all__ = [
     "EnvError",
@@ -51,11 +51,6 @@ __all__ = [
 
 #: Environment levels accepted by :func:`parallel_env`.
 MODES = ("task", "motion")
-
-
-class EnvError(FcplanError, ValueError):
-    """Bad environment argument or action (the message names the argument/agent and the
-    allowed range)."""
 
 
 _LAZY = {
