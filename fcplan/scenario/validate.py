@@ -51,7 +51,7 @@ from fcplan.scenario.grid import (
     column_letters,
     parse_cell,
 )
-from fcplan.scenario.model import (
+from fcplan.scenario.parts import (
     ACTION_ALTITUDE,
     ACTION_GATES,
     DEFAULT_PENALTIES,
