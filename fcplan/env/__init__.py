@@ -30,9 +30,12 @@ Examples
 from __future__ import annotations
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fcplan.errors import EnvError
+
+if TYPE_CHECKING:
+    from pettingzoo import AECEnv, ParallelEnv
 
 __all__ = [
     "EnvError",
@@ -73,7 +76,7 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'fcplan.env' has no attribute {name!r}")
 
 
-def parallel_env(scenario, mode: str = "task", **kwargs: Any):
+def parallel_env(scenario: Any, mode: str = "task", **kwargs: Any) -> ParallelEnv:
     """Make a PettingZoo ``ParallelEnv`` on ``scenario``.
 
     Parameters
@@ -102,7 +105,7 @@ def parallel_env(scenario, mode: str = "task", **kwargs: Any):
     raise EnvError(f"mode: must be one of {', '.join(MODES)} (got {mode!r})")
 
 
-def aec_env(scenario, mode: str = "task", **kwargs: Any):
+def aec_env(scenario: Any, mode: str = "task", **kwargs: Any) -> AECEnv:
     """The same environment as :func:`parallel_env`, as a PettingZoo ``AECEnv``
     (``pettingzoo.utils.parallel_to_aec``)."""
     from pettingzoo.utils import parallel_to_aec

@@ -482,7 +482,7 @@ def scenario_to_dict(s: Scenario) -> dict[str, Any]:
         if not members:
             continue
         agents = [a for _, a in members]
-        entry: dict[str, Any] = {"count": len(agents)}
+        entry = {"count": len(agents)}
         if role.can_sense:
             entry["altitude"] = _one_or_list([a.altitude for a in agents])
         entry["battery"] = _one_or_list([a.battery for a in agents])

@@ -215,7 +215,9 @@ class FireRegion:
         return (x - h, x + h, y - h, y + h)
 
 
-def _footprint(center: tuple[float, float], size: tuple[float, float]) -> tuple[float, ...]:
+def _footprint(
+    center: tuple[float, float], size: tuple[float, float]
+) -> tuple[float, float, float, float]:
     (x, y), (w, h) = center, size
     return (x - w / 2, x + w / 2, y - h / 2, y + h / 2)
 
@@ -278,7 +280,7 @@ class Facility:
     def footprint(self) -> tuple[float, float, float, float]:
         """``(x0, x1, y0, y1)``: a cell (int x, int y) is inside iff ``x0 < x < x1`` and
         ``y0 < y < y1`` (strict)."""
-        return _footprint(self.center, self.size)  # type: ignore[return-value]
+        return _footprint(self.center, self.size)
 
     def contains(self, x: Any, y: Any) -> Any:
         """Whether the cell (x, y) is strictly inside the footprint. Works on numpy arrays too."""
@@ -316,7 +318,7 @@ class Depot:
     @property
     def footprint(self) -> tuple[float, float, float, float]:
         """``(x0, x1, y0, y1)``, strict bounds as for :attr:`Facility.footprint`."""
-        return _footprint(self.center, self.size)  # type: ignore[return-value]
+        return _footprint(self.center, self.size)
 
     def as_facility(self) -> Facility:
         """The depot as a scored :class:`Facility` of kind ``"depot"``."""

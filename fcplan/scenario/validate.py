@@ -268,7 +268,9 @@ def _check_sites(s: Scenario) -> None:
     _check_cell("depot", depot, f"depot_{depot.orientation}", world)
     _non_negative("scoring.penalties.depot", depot.penalty)
 
-    placed: list[tuple[str, str, tuple[float, ...]]] = [("the depot", "depot", depot.footprint)]
+    placed: list[tuple[str, str, tuple[float, float, float, float]]] = [
+        ("the depot", "depot", depot.footprint)
+    ]
     last_kind = 0
     for i, f in enumerate(s.facilities):
         p = f"facilities[{i}]"

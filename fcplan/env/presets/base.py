@@ -76,9 +76,17 @@ Examples
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from fcplan.env.presets.core import MOVES, PresetEnv, rf1_penalty_small, rf1_structure_penalty
+from fcplan.env.presets.core import (
+    MOVES,
+    PresetEnv,
+    StepResult,
+    rf1_penalty_small,
+    rf1_structure_penalty,
+)
 from fcplan.errors import EnvError
 
 __all__ = ["BaseEnv", "STATIONARY_FIRE"]
@@ -183,7 +191,9 @@ class BaseEnv(PresetEnv):
         self._inner[0] = 0.0
 
     # ------------------------------------------------------------------ episode
-    def reset(self, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
         """Place fire and agents; return ``(observations, infos)``."""
         rng = np.random.default_rng(self._next_seed(seed))
         w = self.world_size
@@ -206,7 +216,7 @@ class BaseEnv(PresetEnv):
         self.agents = list(self.possible_agents)
         return self._observe(), {a: self._progress() for a in self.agents}
 
-    def step(self, actions: dict):
+    def step(self, actions: dict[str, Any]) -> StepResult:
         """One step with ``{agent: action}`` (missing agents take their no-op)."""
         if not self.agents:
             raise EnvError("step: the episode is over; call reset()")
@@ -253,17 +263,17 @@ class BaseEnv(PresetEnv):
         malus = 10.0 * remaining if timeout else 0.0
         ap = self.a_penalty
         rewards = {}
-        for a, lr, c, d in zip(self.agents, self._local, contrib, dumping, strict=True):
+        for agent, lr, c, d in zip(self.agents, self._local, contrib, dumping, strict=True):
             # (the operations of the reference's array expression, element by element)
             rew = ratio * (gp + lr * c + ap * d) + (1.0 - ratio) * glob
             if self.termination_reward:
                 rew = rew + bonus
                 rew = rew - malus
-            rewards[a] = rew
+            rewards[agent] = rew
         obs = self._observe()
         return self._finish(obs, rewards, success, timeout)
 
-    def _global_reward(self, remaining: int, pos: list) -> float:
+    def _global_reward(self, remaining: int, pos: list[list[int]]) -> float:
         if self.reward_name == "rf2":
             return -1.0 if remaining > 0 else 0.0
         if self.reward_name == "rf3":
@@ -274,7 +284,7 @@ class BaseEnv(PresetEnv):
             return delta - rf1_penalty_small(pos, self._is_p, self.comm_range)
         return delta - rf1_structure_penalty(self._pos, self.is_perception, self.comm_range)
 
-    def _progress(self) -> dict:
+    def _progress(self) -> dict[str, float]:
         return {
             "perception_complete": float(self.sensed.sum() / self.n_fires),
             "action_complete": float(self.pruned.sum() / self.n_fires),
@@ -302,7 +312,7 @@ class BaseEnv(PresetEnv):
         codes[self._pos[a, 0], self._pos[a, 1]] = 6
         return codes
 
-    def _observe(self) -> dict:
+    def _observe(self) -> dict[str, Any]:
         w, v = self.world_size, self.vision
         side = 2 * v + 1
         layers, inner = self._layers, self._inner
@@ -321,7 +331,7 @@ class BaseEnv(PresetEnv):
             else:
                 inner[4 + 2 * np_ + (i - np_), x, y] = 1.0
         fov = np.empty((self.n, self.n_channels, side, side), dtype=np.float32)
-        vec = []
+        vec: list[float] = []
         for i, (x, y) in enumerate(pos):
             fov[i] = layers[:, x : x + side, y : y + side]
             vec += (x / (w - 1), y / (w - 1), float(self._is_p[i]))

@@ -79,10 +79,19 @@ True
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from fcplan.env.presets.core import MOVES, PresetEnv, rf1_penalty_small, rf1_structure_penalty
+from fcplan.env.presets.core import (
+    MOVES,
+    PresetEnv,
+    StepResult,
+    rf1_penalty_small,
+    rf1_structure_penalty,
+)
 from fcplan.errors import EnvError
 
 __all__ = ["CmplxEnv", "WIND_DIRECTIONS"]
@@ -193,7 +202,9 @@ class CmplxEnv(PresetEnv):
         self._side_lut = (xs[:, None] * side + xs[None, :]).reshape(-1)
 
     # ------------------------------------------------------------------ episode
-    def reset(self, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
         """Draw fire regions, start the team; return ``(observations, infos)``."""
         from fcplan.fire import Fire
         from fcplan.scenario import FireRegion
@@ -235,7 +246,7 @@ class CmplxEnv(PresetEnv):
         self.agents = list(self.possible_agents)
         return self._observe(), {a: self._progress() for a in self.agents}
 
-    def step(self, actions: dict):
+    def step(self, actions: dict[str, Any]) -> StepResult:
         """One step with ``{agent: action}`` (missing agents take action 0)."""
         if not self.agents:
             raise EnvError("step: the episode is over; call reset()")
@@ -299,18 +310,20 @@ class CmplxEnv(PresetEnv):
         obs = self._observe()
         return self._finish(obs, dict.fromkeys(self.agents, r), success, timeout)
 
-    def _box_of(self, p: list, z: int) -> tuple[int, int, int, int]:
+    def _box_of(self, p: Sequence[int], z: int) -> tuple[int, int, int, int]:
         """The ``+-z`` box around position ``p`` (Python ints), clipped to the map."""
         x, y = p
         w = self.world_size
         return max(x - z, 0), min(x + z + 1, w), max(y - z, 0), min(y + z + 1, w)
 
-    def _box(self, i: int) -> tuple[int, int, int, int]:
+    def _box(self, i: int | np.integer[Any]) -> tuple[int, int, int, int]:
         x, y = self._pos[i]
         z, w = int(self._z[i]), self.world_size
         return max(x - z, 0), min(x + z + 1, w), max(y - z, 0), min(y + z + 1, w)
 
-    def _burning_in_box(self, box: tuple, state: np.ndarray, burning: int) -> np.ndarray:
+    def _burning_in_box(
+        self, box: tuple[int, int, int, int], state: np.ndarray, burning: int
+    ) -> np.ndarray:
         """Flat indices of the burning cells in the cell range ``box`` (``x0, x1, y0, y1``), in
         row-major order."""
         x0, x1, y0, y1 = box
@@ -323,7 +336,7 @@ class CmplxEnv(PresetEnv):
         bx, by = np.nonzero(state[x0:x1, y0:y1] == burning)
         return (bx + x0) * self.world_size + (by + y0)
 
-    def _reward(self, n_burn: int, n_pruned: int, pos: list) -> float:
+    def _reward(self, n_burn: int, n_pruned: int, pos: list[list[int]]) -> float:
         if self.reward_name == "rf2":
             return -1.0 if n_burn > 0 else 0.0
         if self.reward_name == "rf3":
@@ -335,7 +348,7 @@ class CmplxEnv(PresetEnv):
             return score - rf1_penalty_small(pos, self._is_p, self.comm_range)
         return score - rf1_structure_penalty(self._pos, self.is_perception, self.comm_range)
 
-    def _progress(self) -> dict:
+    def _progress(self) -> dict[str, float]:
         total = int(self.fire.n_burning) + int(self.fire.n_pruned)
         return {
             "perception_complete": self._n_sensed / total if total else 0.0,
@@ -359,14 +372,14 @@ class CmplxEnv(PresetEnv):
             for i in rows:
                 x0, x1, y0, y1 = self._box(i)
                 codes[x0:x1, y0:y1] = scope
-        for loc, rows in ((3, self.is_perception), (5, ~self.is_perception)):
-            codes[self._pos[rows, 0], self._pos[rows, 1]] = loc
+        for loc, mask in ((3, self.is_perception), (5, ~self.is_perception)):
+            codes[self._pos[mask, 0], self._pos[mask, 1]] = loc
         state = self.fire.state
         codes[(state == BURNING) & self.sensed] = 1
         codes[state == PRUNED] = 2
         return codes
 
-    def _observe(self) -> dict:
+    def _observe(self) -> dict[str, Any]:
         w, r = self.world_size, self.max_alt
         side = 2 * r + 1
         n = self.n
@@ -391,7 +404,7 @@ class CmplxEnv(PresetEnv):
         fov = self._windows_t[xs, ys]  # (one gather of the agents' windows, a fresh array)
         flat = fov.reshape(-1)
         area = side * side
-        vec = []
+        vec: list[float] = []
         dz = max(self.max_alt - self.min_alt, 1)
         for i, ((x, y), z) in enumerate(zip(pos, zs, strict=True)):
             bx0, bx1, by0, by1 = self._box_of((x, y), z)

@@ -21,12 +21,22 @@ Examples
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any, TypeAlias
+
 import numpy as np
 from pettingzoo import ParallelEnv
 
 from fcplan.errors import EnvError
 
-__all__ = ["MOVES", "PresetEnv", "rf1_structure_penalty", "rf1_penalty_small"]
+if TYPE_CHECKING:
+    from gymnasium import spaces
+
+__all__ = ["MOVES", "PresetEnv", "StepResult", "rf1_structure_penalty", "rf1_penalty_small"]
+
+#: What ``step`` returns: observations, rewards, terminations, truncations and infos per agent.
+StepResult: TypeAlias = tuple[
+    dict[str, Any], dict[str, float], dict[str, bool], dict[str, bool], dict[str, dict[str, Any]]
+]
 
 #: The reference presets' moves, by action 0-3: x-1, x+1, y-1, y+1 (spec section 6).
 MOVES = np.array([[-1, 0], [1, 0], [0, -1], [0, 1]], dtype=np.int64)
@@ -57,7 +67,7 @@ def rf1_structure_penalty(pos: np.ndarray, is_perception: np.ndarray, comm_range
     return float(lonely.sum() + 3 * unpaired.sum())
 
 
-def rf1_penalty_small(pos: list, is_perception: list, comm_range: float) -> float:
+def rf1_penalty_small(pos: list[list[int]], is_perception: list[bool], comm_range: float) -> float:
     """:func:`rf1_structure_penalty` for a small team, on Python lists (the same value; a
     double loop over the agents beats numpy's setup for a handful of them).
 
@@ -88,9 +98,30 @@ def rf1_penalty_small(pos: list, is_perception: list, comm_range: float) -> floa
 
 
 class PresetEnv(ParallelEnv):
-    """PettingZoo plumbing shared by the presets: agents, cached spaces, seeding, render."""
+    """PettingZoo plumbing shared by the presets: agents, cached spaces, seeding, render.
+
+    A preset's ``__init__`` calls :meth:`_setup_agents`, :meth:`_check_common` and
+    :meth:`_setup_spaces`, and sets ``_default_action`` (per agent), ``_palette`` (RGB per
+    render code), ``render_mode`` and ``render_size``; ``reset`` sets ``_pos``. It defines
+    ``reset``, ``step`` (ending with :meth:`_finish`), ``state``, :meth:`_progress` and
+    :meth:`_render_codes`.
+    """
 
     metadata = {"name": "fcplan_preset_v0", "render_modes": ["rgb_array"], "render_fps": 10}
+
+    render_mode: str | None
+    render_size: int
+    _default_action: np.ndarray  # (N,) int: the action of an agent missing from ``step``
+    _palette: np.ndarray  # (codes, 3) uint8 render colour per state code
+    _pos: np.ndarray  # (N, 2) int64 agent cells, set by ``reset``
+
+    def _progress(self) -> dict[str, float]:
+        """The ``infos`` entries of every agent (``perception_complete``, ...)."""
+        raise NotImplementedError
+
+    def _render_codes(self) -> np.ndarray:
+        """``(W, W)`` int state codes (rows of ``_palette``) of the grid to render."""
+        raise NotImplementedError
 
     def _setup_agents(self, n_perception: int, n_action: int) -> None:
         if n_perception < 1 or n_action < 1:
@@ -108,7 +139,11 @@ class PresetEnv(ParallelEnv):
         self._reseed: np.random.Generator | None = None
 
     def _setup_spaces(
-        self, n_actions: np.ndarray, fov_shape: tuple, agent_dim: int, state_space
+        self,
+        n_actions: np.ndarray,
+        fov_shape: tuple[int, ...],
+        agent_dim: int,
+        state_space: spaces.Box,
     ) -> None:
         """Cached ``Discrete`` action and ``Dict(fov, agent, action_mask)`` observation spaces
         (every action is always legal in the presets: moves are clipped, as in the reference)."""
@@ -141,7 +176,9 @@ class PresetEnv(ParallelEnv):
         if render_mode not in (None, "rgb_array"):
             raise EnvError(f"render_mode: must be None or 'rgb_array' (got {render_mode!r})")
 
-    def _finish(self, obs: dict, rewards: dict, success: bool, timeout: bool):
+    def _finish(
+        self, obs: dict[str, Any], rewards: dict[str, float], success: bool, timeout: bool
+    ) -> StepResult:
         """The step's five dicts; on success or timeout ``success`` goes into ``infos`` and
         the agents leave."""
         agents = self.agents
@@ -155,11 +192,11 @@ class PresetEnv(ParallelEnv):
             self.agents = []
         return obs, rewards, terms, truncs, infos
 
-    def observation_space(self, agent):
+    def observation_space(self, agent: str) -> spaces.Dict:
         """The observation space of ``agent`` (the same object every call)."""
         return self._obs_spaces[agent]
 
-    def action_space(self, agent):
+    def action_space(self, agent: str) -> spaces.Discrete:
         """The action space of ``agent`` (the same object every call)."""
         return self._action_spaces[agent]
 
@@ -172,7 +209,7 @@ class PresetEnv(ParallelEnv):
             self._reseed = np.random.default_rng()
         return np.random.SeedSequence(int(self._reseed.integers(2**63)))
 
-    def _actions(self, actions: dict) -> list[int]:
+    def _actions(self, actions: dict[str, Any]) -> list[int]:
         """Each agent's action from ``{agent: action}`` (missing agents take their default),
         checked, as Python ints in agent order."""
         defaults = self._default_list
@@ -186,7 +223,7 @@ class PresetEnv(ParallelEnv):
             acts.append(int(v))
         return acts
 
-    def render(self):
+    def render(self) -> np.ndarray | None:
         """An ``(H, W, 3)`` uint8 image of the state grid (``render_mode="rgb_array"``)."""
         if self.render_mode != "rgb_array" or not hasattr(self, "_pos"):
             return None
