@@ -15,7 +15,14 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["FcplanError", "ScenarioError", "PlanError", "UnknownNameError", "EnvError"]
+__all__ = [
+    "FcplanError",
+    "ScenarioError",
+    "PlanError",
+    "UnknownNameError",
+    "EnvError",
+    "LegacyError",
+]
 
 _MISSING = object()
 
@@ -74,3 +81,8 @@ class UnknownNameError(FcplanError, KeyError):
 class EnvError(FcplanError, ValueError):
     """Bad environment argument or action (the message names the argument/agent and the
     allowed range). Also importable as ``fcplan.env.EnvError``."""
+
+
+class LegacyError(FcplanError, ValueError):
+    """A legacy file (the 2020 GUI's pickles) is unsafe, missing, or does not have the documented
+    structure. Also importable as ``fcplan.legacy.LegacyError``."""
