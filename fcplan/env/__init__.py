@@ -9,12 +9,15 @@ Two levels of control over the same simulator:
 ``mode="motion"`` (:mod:`fcplan.env.motion`)
     One step is one tick: moves, altitude, dump, with local field-of-view observations.
     :class:`PlanFollower` (:mod:`fcplan.env.motion_expert`) drives it with any scheduler's plans.
+    The 2020 MARL package's grid environments (``base``, ``cmplx1``, ``cmplx2``) are its presets
+    (:mod:`fcplan.env.presets`).
 
 Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with a centralised
 joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any
 registered scheduler, stored as npz without pickle) and :mod:`fcplan.env.bc` (a small numpy
 behaviour-cloning baseline). Everything is imported lazily, so ``import fcplan.env`` is cheap
-and does not need PettingZoo until an environment is made.
+and does not need PettingZoo until an environment is made. :class:`~fcplan.errors.EnvError` is
+defined in :mod:`fcplan.errors` and exported here.
 
 Examples
 --------
