@@ -7,8 +7,8 @@ Examples
 >>> from fcplan.cli.util import Parser
 >>> p = Parser(prog="fcplan")
 >>> add_parser(p.add_subparsers(dest="command", parser_class=Parser))
->>> p.parse_args(["sweep", "study.toml", "--jobs", "2"]).jobs
-2
+>>> [p.parse_args([c, "x"]).run.__module__ for c in ("sweep", "report")]
+['fcplan.cli.sweep', 'fcplan.cli.report']
 """
 
 from __future__ import annotations

@@ -29,28 +29,20 @@ __all__ = ["load_scenario", "scenario_from_dict"]
 def scenario_from_dict(doc: Mapping[str, Any], source: str | None = None) -> Scenario:
     """Build and validate a :class:`Scenario` from a TOML document (:mod:`fcplan.scenario.document`).
 
-    The same as :meth:`Scenario.from_dict <fcplan.scenario.model.Scenario.from_dict>`.
-
-    Parameters
-    ----------
-    doc : mapping
-        The parsed TOML document.
-    source : str, optional
-        File name for error messages and :attr:`Scenario.source`.
-
-    Raises
-    ------
-    ScenarioError
-        On unknown keys, wrong types and invalid values.
+    The same as :meth:`Scenario.from_dict <fcplan.scenario.model.Scenario.from_dict>`: ``doc`` is
+    the parsed TOML document, ``source`` the file name for error messages and
+    :attr:`Scenario.source`; a :class:`~fcplan.errors.ScenarioError` names the field.
 
     Examples
     --------
-    >>> doc = {"name": "tiny", "world_size": 800, "fire": {"regions": [{"cell": "E-02"}]},
-    ...        "depot": {"cell": "A-01"}, "team": {"perception": {"count": 1},
-    ...        "action": {"count": 1}}}
-    >>> s = scenario_from_dict(doc)
-    >>> s.regions[0].center, s.regions[0].fronts, s.agent_ids
-    ((450.0, 150.0), 10, ('P1', 'A1'))
+    >>> doc = load_scenario("practice").to_dict()
+    >>> scenario_from_dict(doc, "copy.toml").source
+    'copy.toml'
+    >>> doc["duration_s"] = 0
+    >>> scenario_from_dict(doc, "copy.toml")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fcplan.errors.ScenarioError: copy.toml: duration_s: must be a number > 0 ...
     """
     return Scenario.from_dict(doc, source)
 
