@@ -14,7 +14,9 @@ solver did.
 
 Schedulers are found by name: built-ins and third-party packages register a factory in the
 ``fcplan.schedulers`` entry-point group (``name = "module:Factory"``); :func:`register_scheduler`
-adds one at run time (handy in notebooks).
+adds one at run time (handy in notebooks). The built-ins are listed once, in the entry-point table
+of fcplan's ``pyproject.toml``: an installed fcplan reads it from its package metadata, a source
+checkout without metadata (``PYTHONPATH=.``) from the ``pyproject.toml`` next to the package.
 
 Examples
 --------
@@ -27,10 +29,13 @@ True
 
 from __future__ import annotations
 
+import functools
 import time
+import tomllib
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
-from importlib.metadata import entry_points
+from importlib.metadata import EntryPoint, PackageNotFoundError, distribution, entry_points
+from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -53,16 +58,9 @@ __all__ = [
 #: Possible :attr:`SolveStats.status` values.
 STATUSES = ("optimal", "feasible", "time_limit", "fallback", "heuristic")
 
-#: Built-in schedulers, used when the package's entry points are not installed (source checkout).
-_BUILTIN = {
-    "greedy": "solvers.greedy:GreedyScheduler",
-    "idle": "solvers.baselines:IdleScheduler",
-    "random": "solvers.baselines:RandomScheduler",
-    "routing": "solvers.routing:RoutingScheduler",
-    "milp": "solvers.milp:MilpScheduler",
-    "milp-cvxpy": "solvers.milp_cvxpy:MilpCvxpyScheduler",
-    "cbba": "solvers.cbba:CBBAScheduler",
-}
+#: The entry-point group schedulers register in.
+GROUP = "fcplan.schedulers"
+_PYPROJECT = Path(__file__).resolve().parents[1] / "pyproject.toml"
 _RUNTIME: dict[str, Callable[..., Any]] = {}
 
 
@@ -118,25 +116,40 @@ class Scheduler(Protocol):
         ...
 
 
-def _entry_points() -> dict[str, Any]:
-    return {ep.name: ep for ep in entry_points(group="fcplan.schedulers")}
+@functools.cache
+def _source_table(pyproject: Path) -> dict[str, str]:
+    """The ``fcplan.schedulers`` entry-point table of a source checkout's ``pyproject.toml``
+    (empty when there is none)."""
+    try:
+        doc = tomllib.loads(pyproject.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return {}
+    return dict(doc.get("project", {}).get("entry-points", {}).get(GROUP, {}))
+
+
+def _entry_points() -> dict[str, EntryPoint]:
+    """Scheduler name -> entry point, for every entry point in :data:`GROUP`.
+
+    Without fcplan's package metadata (a source checkout on ``PYTHONPATH``) the built-ins come
+    from ``pyproject.toml``; installed third-party entry points are added either way.
+    """
+    table = {ep.name: ep for ep in entry_points(group=GROUP)}
+    try:
+        distribution("fcplan")
+    except PackageNotFoundError:
+        source = _source_table(_PYPROJECT)
+        table = {**{n: EntryPoint(n, v, GROUP) for n, v in source.items()}, **table}
+    return table
 
 
 def available_schedulers() -> list[str]:
     """Names of every known scheduler (entry points, built-ins and run-time registrations)."""
-    return sorted(set(_BUILTIN) | set(_entry_points()) | set(_RUNTIME))
+    return sorted(set(_entry_points()) | set(_RUNTIME))
 
 
 def register_scheduler(name: str, factory: Callable[..., Scheduler]) -> None:
     """Register ``factory(**settings) -> Scheduler`` under ``name`` for this process."""
     _RUNTIME[name] = factory
-
-
-def _load(target: str) -> Callable[..., Scheduler]:
-    from importlib import import_module
-
-    module, _, attr = target.partition(":")
-    return getattr(import_module(module), attr)
 
 
 def parse_scheduler_spec(spec: str) -> tuple[str, dict[str, Any]]:
@@ -194,14 +207,11 @@ def make_scheduler(name: str, **settings: Any) -> Scheduler:
         factory = _RUNTIME[name]
     else:
         eps = _entry_points()
-        if name in eps:
-            factory = eps[name].load()
-        elif name in _BUILTIN:
-            factory = _load(_BUILTIN[name])
-        else:
+        if name not in eps:
             raise UnknownNameError(
                 f"unknown scheduler {name!r}; known schedulers: {', '.join(available_schedulers())}"
             )
+        factory = eps[name].load()
     try:
         return factory(**settings)
     except TypeError as exc:

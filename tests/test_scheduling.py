@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import importlib
 import math
+import tomllib
 from functools import lru_cache
+from importlib.metadata import PackageNotFoundError
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -88,6 +92,36 @@ def test_make_scheduler_finds_builtins(name):
     assert s.name == name
     assert name in available_schedulers()
     assert fcplan.make_scheduler is make_scheduler
+
+
+def _pyproject_table() -> dict[str, str]:
+    doc = tomllib.loads((Path(scheduling.__file__).parents[1] / "pyproject.toml").read_text())
+    return doc["project"]["entry-points"][scheduling.GROUP]
+
+
+def test_source_checkout_reads_the_pyproject_table(monkeypatch):
+    """Without fcplan's package metadata (a source checkout on PYTHONPATH, nothing installed)
+    the registry is exactly pyproject.toml's entry-point table, and its names make schedulers."""
+
+    def no_metadata(name):
+        raise PackageNotFoundError(name)
+
+    monkeypatch.setattr(scheduling, "distribution", no_metadata)
+    monkeypatch.setattr(scheduling, "entry_points", lambda group: [])
+    monkeypatch.setattr(scheduling, "_RUNTIME", {})
+    table = _pyproject_table()
+    assert available_schedulers() == sorted(table)
+    assert {"greedy", "idle", "random", "routing", "milp", "cbba"} <= set(table)
+    for name in BUILTINS:
+        assert make_scheduler(name).name == name
+
+
+def test_every_table_entry_names_a_scheduler_factory():
+    """Each pyproject.toml entry point loads a factory whose scheduler has the entry's name."""
+    for name, target in _pyproject_table().items():
+        module, _, attr = target.partition(":")
+        factory = getattr(importlib.import_module(module), attr)
+        assert factory().name == name
 
 
 @pytest.mark.parametrize("name", BUILTINS)

@@ -9,12 +9,15 @@ Two levels of control over the same simulator:
 ``mode="motion"`` (:mod:`fcplan.env.motion`)
     One step is one tick: moves, altitude, dump, with local field-of-view observations.
     :class:`PlanFollower` (:mod:`fcplan.env.motion_expert`) drives it with any scheduler's plans.
+    The 2020 MARL package's grid environments (``base``, ``cmplx1``, ``cmplx2``) are its presets
+    (:mod:`fcplan.env.presets`).
 
 Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with a centralised
 joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any
 registered scheduler, stored as npz without pickle) and :mod:`fcplan.env.bc` (a small numpy
 behaviour-cloning baseline). Everything is imported lazily, so ``import fcplan.env`` is cheap
-and does not need PettingZoo until an environment is made.
+and does not need PettingZoo until an environment is made. :class:`~fcplan.errors.EnvError` is
+defined in :mod:`fcplan.errors` and exported here.
 
 Examples
 --------
@@ -30,9 +33,12 @@ Examples
 from __future__ import annotations
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from fcplan.errors import FcplanError
+from fcplan.errors import EnvError
+
+if TYPE_CHECKING:
+    from pettingzoo import AECEnv, ParallelEnv
 
 __all__ = [
     "EnvError",
@@ -51,11 +57,6 @@ __all__ = [
 
 #: Environment levels accepted by :func:`parallel_env`.
 MODES = ("task", "motion")
-
-
-class EnvError(FcplanError, ValueError):
-    """Bad environment argument or action (the message names the argument/agent and the
-    allowed range)."""
 
 
 _LAZY = {
@@ -78,7 +79,7 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'fcplan.env' has no attribute {name!r}")
 
 
-def parallel_env(scenario, mode: str = "task", **kwargs: Any):
+def parallel_env(scenario: Any, mode: str = "task", **kwargs: Any) -> ParallelEnv:
     """Make a PettingZoo ``ParallelEnv`` on ``scenario``.
 
     Parameters
@@ -107,7 +108,7 @@ def parallel_env(scenario, mode: str = "task", **kwargs: Any):
     raise EnvError(f"mode: must be one of {', '.join(MODES)} (got {mode!r})")
 
 
-def aec_env(scenario, mode: str = "task", **kwargs: Any):
+def aec_env(scenario: Any, mode: str = "task", **kwargs: Any) -> AECEnv:
     """The same environment as :func:`parallel_env`, as a PettingZoo ``AECEnv``
     (``pettingzoo.utils.parallel_to_aec``)."""
     from pettingzoo.utils import parallel_to_aec

@@ -1,12 +1,16 @@
 """Scenarios: what a FireCommander mission is, its TOML files, and their validation.
 
-* :mod:`~fcplan.scenario.model`: the frozen dataclasses (:class:`Scenario`, :class:`FireRegion`,
-  :class:`Facility`, :class:`Depot`, :class:`Lake`, :class:`AgentSpec`, :class:`Scoring`,
-  :class:`Role`).
+* :mod:`~fcplan.scenario.model`: the frozen, validated :class:`Scenario`.
+* :mod:`~fcplan.scenario.parts`: its parts (:class:`FireRegion`, :class:`Facility`,
+  :class:`Depot`, :class:`Lake`, :class:`AgentSpec`, :class:`Scoring`, :class:`Role`) and the
+  game's tables (facility kinds and sizes, depot slots, the action altitude).
 * :mod:`~fcplan.scenario.grid`: the chess-like 100-px grid (``"D-05"``) and object centres.
-* :mod:`~fcplan.scenario.io`: the TOML format, :func:`load_scenario`, :func:`dump_scenario`, the
-  shipped scenario names.
+* :mod:`~fcplan.scenario.document`: the TOML format and its conversion to and from a Scenario.
+* :mod:`~fcplan.scenario.read`: :func:`load_scenario` (by name or file), ``scenario_from_dict``.
+* :mod:`~fcplan.scenario.write`: :func:`dump_scenario`.
+* :mod:`~fcplan.scenario.catalogue`: the shipped scenarios' names and files.
 * :mod:`~fcplan.scenario.validate`: physical validity (errors) and the manual's GUI limits.
+* :mod:`~fcplan.scenario.io`: the file functions of read, write and catalogue under one name.
 
 The 25 shipped scenarios (practice and #1..#24) follow the FireCommander manual's tables for counts,
 team and fire parameters and the reference data for coordinates; each file notes where the 2020
@@ -25,8 +29,8 @@ Examples
 """
 
 from fcplan.errors import ScenarioError, UnknownNameError
+from fcplan.scenario.catalogue import list_scenarios, scenario_path
 from fcplan.scenario.grid import cell_center, cell_name
-from fcplan.scenario.io import dump_scenario, list_scenarios, load_scenario, scenario_path
 from fcplan.scenario.model import (
     AgentSpec,
     Depot,
@@ -37,6 +41,8 @@ from fcplan.scenario.model import (
     Scenario,
     Scoring,
 )
+from fcplan.scenario.read import load_scenario
+from fcplan.scenario.write import dump_scenario
 
 __all__ = [
     "Role",

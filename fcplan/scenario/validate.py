@@ -51,7 +51,7 @@ from fcplan.scenario.grid import (
     column_letters,
     parse_cell,
 )
-from fcplan.scenario.model import (
+from fcplan.scenario.parts import (
     ACTION_ALTITUDE,
     ACTION_GATES,
     DEFAULT_PENALTIES,
@@ -268,7 +268,9 @@ def _check_sites(s: Scenario) -> None:
     _check_cell("depot", depot, f"depot_{depot.orientation}", world)
     _non_negative("scoring.penalties.depot", depot.penalty)
 
-    placed: list[tuple[str, str, tuple[float, ...]]] = [("the depot", "depot", depot.footprint)]
+    placed: list[tuple[str, str, tuple[float, float, float, float]]] = [
+        ("the depot", "depot", depot.footprint)
+    ]
     last_kind = 0
     for i, f in enumerate(s.facilities):
         p = f"facilities[{i}]"

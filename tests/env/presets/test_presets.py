@@ -1,4 +1,4 @@
-"""Reference MARL presets base / cmplx1 / cmplx2 (fcplan.env.motion_base, motion_cmplx)."""
+"""Reference MARL presets base / cmplx1 / cmplx2 (fcplan.env.presets): rules, rewards, API."""
 
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ from hypothesis import strategies as st
 
 from fcplan.env import EnvError
 from fcplan.env.motion import parallel_env
-from fcplan.env.motion_base import STATIONARY_FIRE, BaseEnv
-from fcplan.env.motion_cmplx import CmplxEnv
-from fcplan.env.motion_presets import rf1_penalty_small, rf1_structure_penalty
+from fcplan.env.presets.base import STATIONARY_FIRE, BaseEnv
+from fcplan.env.presets.cmplx import CmplxEnv
+from fcplan.env.presets.core import rf1_penalty_small, rf1_structure_penalty
 from fcplan.fire import BURNING, PRUNED
 
 pettingzoo_test = pytest.importorskip("pettingzoo.test")
