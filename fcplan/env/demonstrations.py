@@ -70,6 +70,7 @@ from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import MappingCounts, plan_to_actions
 from fcplan.env.task_candidates import AGENT_FEATURES, TASK_FEATURES
 from fcplan.errors import FcplanError
+from fcplan.mission import as_scenario
 from fcplan.scheduling import make_scheduler, parse_scheduler_spec, solve
 
 __all__ = [
@@ -225,8 +226,6 @@ def demonstrations(
     -------
     Demonstrations
     """
-    from fcplan.env.task import _load
-
     sched, name, settings = _scheduler(scheduler)
     env_kwargs = dict(env_kwargs or {})
     env_kwargs.pop("render_mode", None)
@@ -237,7 +236,7 @@ def demonstrations(
     counts = MappingCounts()
     fallbacks = conflicts = 0
     for sc in scenarios:
-        scenario = _load(sc)
+        scenario = as_scenario(sc)
         doc = scenario.to_dict()
         key = scenario.name
         while key in scen_docs and scen_docs[key] != doc:  # same name, other content
