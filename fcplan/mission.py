@@ -312,15 +312,17 @@ class Mission:
         """
         world = self.world
         observers = self.observers
-        for o in observers:
-            o.on_commands(world.tick, commands)
+        if observers:
+            for o in observers:
+                o.on_commands(world.tick, commands)
         info = world.step(commands)
         if self.belief is not None:
             self.belief.update(info)
-        for o in observers:
-            o.on_step(world, info)
-        newly = info.newly_sensed
-        if newly.size and self.event_replans and self._tile is not None:
+        if observers:
+            for o in observers:
+                o.on_step(world, info)
+        if self.event_replans and self._tile is not None and info.newly_sensed.size:
+            newly = info.newly_sensed
             w = self.scenario.world_size
             xy = np.stack([newly // w, newly % w], axis=1)
             outside = ~np.isin(_tile_keys(xy, self._tile, w), self._fire_tiles)
