@@ -69,7 +69,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Mapping
-from typing import Any, Protocol, cast
+from typing import Any, Protocol, cast, runtime_checkable
 
 import numpy as np
 
@@ -95,6 +95,7 @@ Seed = int | np.integer | np.random.SeedSequence | np.random.Generator | None
 _NO_TILES = np.zeros(0, dtype=np.int64)
 
 
+@runtime_checkable
 class EpisodeObserver(Protocol):
     """What a mission tells its observers (module docstring: when)."""
 
