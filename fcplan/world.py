@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -44,7 +45,7 @@ from fcplan._fast.world import scan_box as _scan_box
 from fcplan._fast.world import step_info_builder
 from fcplan.fire import _BURNING8, Fire, _unique
 from fcplan.team import Command, Team
-from fcplan.trace import Trace
+from fcplan.trace import TRACE_FIELDS, Trace
 
 __all__ = ["World", "StepInfo"]
 
@@ -146,21 +147,10 @@ class World:
         return self
 
     def _alloc_trace(self, rows: int) -> None:
-        n, f = self.team.n, self.n_facilities
-        rows = max(rows, 1)
-        self._rows = {
-            "active": np.zeros(rows, np.int64),
-            "pruned": np.zeros(rows, np.int64),
-            "sensed_active": np.zeros(rows, np.int64),
-            "sensed_ever": np.zeros(rows, np.int64),
-            "facility_burning": np.zeros((rows, f), np.int64),
-            "facility_pruned": np.zeros((rows, f), np.int64),
-            "xyz": np.zeros((rows, n, 3), np.float64),
-            "battery": np.zeros((rows, n), np.float64),
-            "tank": np.zeros((rows, n), np.int16),
-            "mode": np.zeros((rows, n), np.int8),
-            "dumps": np.zeros((rows, n), np.int16),
-        }
+        """Allocate ``rows`` trace rows of every :data:`fcplan.trace.TRACE_FIELDS` array, by the
+        field's row name (agent fields without their ``agent_`` prefix)."""
+        dims = {"T": max(rows, 1), "N": self.team.n, "F": self.n_facilities}
+        self._rows: dict[str, np.ndarray] = {f.name: f.zeros(dims) for f in TRACE_FIELDS}
         self._n_recorded = 0  # trace rows recorded (ticks stepped since the reset)
         self._fac_rows = 0  # facility trace rows written so far (see _sync_facility_rows)
         self._record_views()
@@ -375,7 +365,7 @@ class World:
         """Cache the trace arrays :meth:`_record` writes every tick (the xy and z parts of ``xyz``
         apart; not the facility rows, see :meth:`_sync_facility_rows`)."""
         r = self._rows
-        self._row_views = (
+        self._row_views: tuple[Any, ...] = (
             len(r["active"]),
             r["active"],
             r["pruned"],
