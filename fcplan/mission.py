@@ -77,7 +77,7 @@ from fcplan.belief import Belief
 from fcplan.plan import Plan, plan_commands
 from fcplan.scenario import Scenario, load_scenario
 from fcplan.scheduling import Scheduler, SolveStats, solve
-from fcplan.taskgraph import TaskGraph, TaskGraphParams, TaskKind, build_task_graph
+from fcplan.taskgraph import TaskGraph, TaskGraphBuilder, TaskGraphParams, TaskKind
 from fcplan.team import Command
 from fcplan.world import StepInfo, World
 
@@ -195,6 +195,8 @@ class Mission:
         self.seed = seed
         self.world.reset(self.scenario, seed)
         self.belief: Belief | None = Belief(self.scenario) if self._keep_belief else None
+        #: builds this episode's task graphs (holds the scenario's and team's constants)
+        self.graph_builder = TaskGraphBuilder(self.scenario, self.graph_params)
         self.graph: TaskGraph | None = None
         self.plan: Plan | None = None
         self.solves: list[SolveStats] = []
@@ -302,7 +304,7 @@ class Mission:
         """Build the task graph of the current tick (the one place graphs are built)."""
         if self.belief is None:
             raise ValueError("this mission keeps no belief to plan from: call track_belief()")
-        return build_task_graph(self.scenario, self.world.team, self.belief, self.graph_params)
+        return self.graph_builder.build(self.world.team, self.belief)
 
     # ------------------------------------------------------------------ ticks
     def step(self, commands: Commands | None = None) -> StepInfo:

@@ -57,8 +57,6 @@ import numpy as np
 
 __all__ = ["Trace", "AgentTrace", "TraceField", "TRACE_FIELDS"]
 
-FACILITY_KINDS = ("house", "hospital", "power_station", "depot")
-
 #: an axis of a field: a dimension name (``"T"``, ``"N"``, ``"F"``, ...), a fixed length, or None
 #: for a free length
 Axis = str | int | None

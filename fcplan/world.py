@@ -36,9 +36,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from fcplan._fast.team import sensing_confidence_of
 from fcplan._fast.world import scan_box as _scan_box
@@ -46,6 +47,12 @@ from fcplan._fast.world import step_info_builder
 from fcplan.fire import _BURNING8, Fire, _unique
 from fcplan.team import Command, Team
 from fcplan.trace import TRACE_FIELDS, Trace
+
+if TYPE_CHECKING:
+    from fcplan.scenario import Scenario
+
+#: What seeds an episode: an int, a SeedSequence, a Generator, or None (fresh OS entropy).
+Seed = int | np.integer | np.random.SeedSequence | np.random.Generator | None
 
 __all__ = ["World", "StepInfo"]
 
@@ -101,18 +108,19 @@ class World:
         (the trace copies them lazily, from the last change on).
     """
 
-    def __init__(self, scenario=None, seed=None) -> None:
-        self.scenario = None
+    scenario: Scenario  # set by the first reset()
+
+    def __init__(self, scenario: Scenario | None = None, seed: Seed = None) -> None:
         if scenario is not None:
             self.reset(scenario, seed)
 
     # ------------------------------------------------------------------ setup
-    def reset(self, scenario=None, seed=None) -> World:
+    def reset(self, scenario: Scenario | None = None, seed: Seed = None) -> World:
         """Start a new episode (same scenario if none is given); return ``self``."""
         if scenario is None:
-            scenario = self.scenario
-            if scenario is None:
+            if "scenario" not in self.__dict__:
                 raise ValueError("World.reset needs a scenario the first time")
+            scenario = self.scenario
         self.scenario = scenario
         self.seed = seed
         streams = _spawn(seed, 4)
@@ -185,7 +193,7 @@ class World:
         self._sync_facility_rows()
         return self._rows[name][start:stop].sum(axis=0)
 
-    def ignite(self, xy) -> np.ndarray:
+    def ignite(self, xy: npt.ArrayLike) -> np.ndarray:
         """Set cells burning by hand (spot fires, tests); return the flat indices that ignited.
 
         Parameters
@@ -205,7 +213,7 @@ class World:
     # ------------------------------------------------------------------ dynamics
     def step(self, commands: Mapping[str | int, Command] | None = None) -> StepInfo:
         """Advance one tick with optional per-agent commands; return what happened."""
-        if self.scenario is None:
+        if "tick" not in self.__dict__:
             raise ValueError("World.step before World.reset")
         team, fire = self.team, self.fire
         if commands:  # (Team.apply does nothing without commands: the call is saved)
@@ -218,8 +226,8 @@ class World:
         rects = team.fov_rects_list()
         sensed, newly = self._sense(rects)
         if True in team.armed.tolist():  # (else _prune finds no dump: the call is saved)
-            pruned, dumped = self._prune(rects)
-            dumped = tuple(dumped)
+            pruned, dumped_rows = self._prune(rects)
+            dumped: tuple[int, ...] = tuple(dumped_rows)
         else:
             pruned, dumped = _EMPTY, ()
         self._record(tick - 1)
@@ -418,7 +426,7 @@ class World:
         self._n_recorded = k + 1
 
 
-def _spawn(seed, n: int) -> list[np.random.Generator]:
+def _spawn(seed: Seed, n: int) -> list[np.random.Generator]:
     """``n`` independent generators from an int, SeedSequence, Generator or None."""
     if isinstance(seed, np.random.Generator):
         return list(seed.spawn(n))

@@ -4,7 +4,7 @@
 :class:`fcplan.World`: every UAV of the scenario is an agent and chooses a discrete move every
 tick. ``parallel_env(preset="base" | "cmplx1" | "cmplx2")`` (or the preset name in place of the
 scenario) returns one of the reference MARL package's three environments instead
-(:mod:`fcplan.env.motion_presets`).
+(:mod:`fcplan.env.presets`).
 
 Agents
     The scenario's agent ids in team order (``"P1", "P2", "A1", ...``). All agents stay until the
@@ -109,10 +109,12 @@ from typing import Any
 import numpy as np
 from pettingzoo import ParallelEnv
 
-from fcplan.env import EnvError
 from fcplan.env.motion_grid import CoarseMaps
 from fcplan.env.motion_obs import N_AGENT_FEATURES, N_FOV, N_STATE, NEVER, MotionObs
+from fcplan.env.presets import PRESETS as _PRESET_REGISTRY
+from fcplan.env.presets import make_preset
 from fcplan.env.reward import PenaltyReward, RewardFn
+from fcplan.errors import EnvError
 from fcplan.mission import Mission, ScenarioLike, as_scenario
 from fcplan.team import CLIMB_PER_TICK
 from fcplan.world import StepInfo, World
@@ -120,7 +122,8 @@ from fcplan.world import StepInfo, World
 __all__ = ["MotionEnv", "parallel_env", "PRESETS", "ACTION_NAMES"]
 
 #: Preset names accepted by :func:`parallel_env`.
-PRESETS = ("base", "cmplx1", "cmplx2")
+#: names of the reference presets (:data:`fcplan.env.presets.PRESETS`)
+PRESETS = tuple(_PRESET_REGISTRY)
 
 #: Action names per role letter (``P`` perception, ``A`` action, ``H`` hybrid).
 ACTION_NAMES = {
@@ -160,7 +163,7 @@ def parallel_env(
         A scenario or a name/path for :func:`fcplan.load_scenario`; a preset name
         (``"base"``, ``"cmplx1"``, ``"cmplx2"``) selects that preset.
     preset : {"base", "cmplx1", "cmplx2"}, optional
-        The reference MARL environment to reproduce (:mod:`fcplan.env.motion_presets`).
+        The reference MARL environment to reproduce (:mod:`fcplan.env.presets`).
     **kwargs
         Arguments of :class:`MotionEnv` or of the preset.
 
@@ -179,8 +182,6 @@ def parallel_env(
     if preset is not None:
         if scenario is not None:
             raise EnvError("preset: give a scenario or a preset, not both")
-        from fcplan.env.motion_presets import make_preset
-
         return make_preset(preset, **kwargs)
     if scenario is None:
         raise EnvError("scenario: give a scenario (name, path or Scenario) or preset=")

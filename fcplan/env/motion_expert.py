@@ -44,8 +44,8 @@ from __future__ import annotations
 from typing import Any
 
 from fcplan.belief import Belief
-from fcplan.env import EnvError
 from fcplan.env.motion import ACTION_NAMES, MotionEnv
+from fcplan.errors import EnvError
 from fcplan.mission import Mission
 from fcplan.plan import Plan
 from fcplan.scheduling import Scheduler, make_scheduler
@@ -167,10 +167,11 @@ class PlanFollower:
                     done = route.pop(0)
                     if self._patrol[i]:  # a patrol loop goes round again
                         route.append(done)
-                if choice == "stay" and self._alt[i] is not None:  # altitude first
-                    if z_target[i] < self._alt[i] - 0.5 * climb and legal("climb"):
+                alt = self._alt[i]
+                if choice == "stay" and alt is not None:  # altitude first
+                    if z_target[i] < alt - 0.5 * climb and legal("climb"):
                         choice = "climb"
-                    elif z_target[i] > self._alt[i] + 0.5 * climb and legal("descend"):
+                    elif z_target[i] > alt + 0.5 * climb and legal("descend"):
                         choice = "descend"
                 if choice == "stay" and route:
                     dx, dy = route[0][0] - x, route[0][1] - y

@@ -113,7 +113,6 @@ import numpy as np
 from pettingzoo import ParallelEnv
 
 from fcplan.belief import Belief
-from fcplan.env import EnvError
 from fcplan.env.reward import PenaltyReward, RewardFn
 from fcplan.env.task_actions import actions_plan, decode_actions, rows_commands
 from fcplan.env.task_candidates import (
@@ -125,6 +124,7 @@ from fcplan.env.task_candidates import (
     rank_candidates,
     task_features,
 )
+from fcplan.errors import EnvError
 from fcplan.metrics import compute_all
 from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario
 from fcplan.plan import validate_plan
