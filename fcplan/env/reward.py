@@ -7,7 +7,8 @@ replan period in the task env). Per simulated second the manual charges the pena
     ``rate(t) = w |A(t)| + sum_f PC_f n_f(t)``
 
 (``w`` the scenario's propagation weight per active cell, ``PC_f`` each facility's penalty
-coefficient, ``n_f`` its active cells: the integrand of :func:`fcplan.metrics.negative_reward_rate`),
+coefficient, ``n_f`` its active cells: :func:`fcplan.metrics.penalty_rate`, the integrand of
+:func:`fcplan.metrics.negative_reward_rate`),
 so a step covering ticks ``start + 1 .. stop`` earns ``-(w sum|A| + sum_f PC_f sum n_f) / tps``.
 Summed over an episode the rewards are minus the manual total negative reward (up to float
 rounding). The counts are the world's trace rows, so the sum is exact integers until the one
@@ -37,9 +38,10 @@ from typing import Protocol
 
 import numpy as np
 
+from fcplan.metrics import facility_penalty, penalty_rate
 from fcplan.world import World
 
-__all__ = ["RewardFn", "PenaltyReward", "facility_penalty"]
+__all__ = ["RewardFn", "PenaltyReward"]
 
 
 class RewardFn(Protocol):
@@ -51,12 +53,6 @@ class RewardFn(Protocol):
     def __call__(self, world: World, start: int) -> float:
         """The reward of the ticks ``start + 1 .. world.tick`` (the step just played)."""
         ...
-
-
-def facility_penalty(in_facility: np.ndarray, penalties: np.ndarray) -> float:
-    """``sum_f PC_f n_f``: the facilities' part of the penalty rate for active cell counts
-    ``in_facility`` ((F,) ints) and penalty coefficients ``penalties`` ((F,) floats)."""
-    return float(in_facility @ penalties)
 
 
 class PenaltyReward:
@@ -91,9 +87,9 @@ class PenaltyReward:
             if fb != self._fb_last:  # (facility counts change rarely: reuse the penalty sum)
                 self._fb_last = fb
                 self._fb_penalty = facility_penalty(world.facility_burning, self._penalties)
-            rate = self._w * world.fire.n_burning + self._fb_penalty
+            rate = penalty_rate(world.fire.n_burning, self._fb_penalty, self._w)
         else:
             active = int(world.trace_sum("active", start, stop))
             in_fac = world.trace_sum("facility_burning", start, stop)
-            rate = self._w * active + facility_penalty(in_fac, self._penalties)
+            rate = penalty_rate(active, facility_penalty(in_fac, self._penalties), self._w)
         return -rate / self._tps

@@ -129,8 +129,10 @@ from fcplan.metrics.compute import (
     Metrics,
     compute_all,
     compute_metrics,
+    facility_penalty,
     grade,
     negative_reward_rate,
+    penalty_rate,
 )
 from fcplan.metrics.table import METRICS, MetricSpec, format_metrics, metric_spec
 
@@ -145,5 +147,7 @@ __all__ = [
     "format_metrics",
     "grade",
     "metric_spec",
+    "facility_penalty",
     "negative_reward_rate",
+    "penalty_rate",
 ]
