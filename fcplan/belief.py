@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from fcplan.scenario import Scenario
     from fcplan.world import StepInfo
 
-__all__ = ["Belief"]
+__all__ = ["Belief", "ClairvoyantBelief"]
 
 
 class Belief:
@@ -252,3 +252,40 @@ def _block_layout(w: int, c: int, nc: int, block_px: int) -> tuple[Any, ...]:
     for a in (key, counts, empty, centre_cells):
         a.flags.writeable = False
     return nb, key, counts, empty, centre_cells, perm
+
+
+class ClairvoyantBelief:
+    """The team's belief plus the true fire: what a clairvoyant planner (the ``oracle``
+    reference, never a legal policy) builds its task graphs from.
+
+    ``known`` holds every cell that is truly burning now (the team's known cells plus the ones it
+    has not sensed yet); ``last_seen`` and the coverage stay the team's own, so a fire nobody has
+    sensed has never been seen (its fire task is as stale as can be) and still has to be sensed
+    before a dump puts it out, as the world's rules require. A read-only view: it changes nothing.
+
+    Examples
+    --------
+    >>> from fcplan import World, load_scenario
+    >>> world = World().reset(load_scenario(1), seed=0)
+    >>> belief = Belief(world.scenario)
+    >>> for _ in range(30):
+    ...     belief.update(world.step())
+    >>> view = ClairvoyantBelief(belief, world.fire.state.reshape(-1))
+    >>> bool(view.known.size >= belief.known.size), view.tick == belief.tick
+    (True, True)
+    """
+
+    def __init__(self, belief: Belief, fire_state: np.ndarray) -> None:
+        from fcplan.fire import BURNING
+
+        self._belief = belief
+        self.tick = belief.tick
+        self.world_size = belief.world_size
+        self.last_seen = belief.last_seen
+        true = np.flatnonzero(fire_state == BURNING)
+        k = belief.known
+        self.known = np.concatenate([k, np.setdiff1d(true, k, assume_unique=True)])
+
+    def coverage_age_s(self, block_px: int) -> np.ndarray:
+        """The team's own coverage ages (:meth:`Belief.coverage_age_s`)."""
+        return self._belief.coverage_age_s(block_px)

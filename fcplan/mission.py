@@ -73,7 +73,7 @@ from typing import Any, Protocol, cast, runtime_checkable
 
 import numpy as np
 
-from fcplan.belief import Belief
+from fcplan.belief import Belief, ClairvoyantBelief
 from fcplan.plan import Plan, plan_commands
 from fcplan.scenario import Scenario, load_scenario
 from fcplan.scheduling import Scheduler, SolveStats, solve
@@ -259,9 +259,13 @@ class Mission:
         """Whether the replan rule (module docstring) asks for a replan at this tick."""
         return self.world.tick >= self._next_periodic or self._new_fire
 
-    def task_graph(self) -> TaskGraph:
-        """The task graph of the current tick, built from the belief (kept as :attr:`graph`)."""
-        self.graph = graph = self._build_graph()
+    def task_graph(self, *, clairvoyant: bool = False) -> TaskGraph:
+        """The task graph of the current tick, built from the belief (kept as :attr:`graph`).
+
+        ``clairvoyant=True`` builds it from the belief plus the true fire
+        (:class:`fcplan.belief.ClairvoyantBelief`): what the ``oracle`` reference plans on.
+        """
+        self.graph = graph = self._build_graph(clairvoyant)
         return graph
 
     def replan(
@@ -269,6 +273,9 @@ class Mission:
     ) -> tuple[TaskGraph, Plan]:
         """Plan now: build the task graph, run ``scheduler`` on it through
         :func:`fcplan.scheduling.solve`, record the solve statistics, tell the observers.
+
+        A scheduler whose ``clairvoyant`` attribute is true (the ``oracle`` reference) gets a
+        graph built from the true fire as well as the belief (:meth:`task_graph`).
 
         Parameters
         ----------
@@ -280,7 +287,7 @@ class Mission:
         -------
         (TaskGraph, Plan)
         """
-        graph = self.task_graph()
+        graph = self.task_graph(clairvoyant=bool(getattr(scheduler, "clairvoyant", False)))
         plan = solve(scheduler, graph, time_limit=time_limit, rng=self.world.controller_rng)
         tick = self.world.tick
         self.plan = plan
@@ -300,11 +307,14 @@ class Mission:
         """The commands that start ``plan`` (made on ``graph``): :func:`fcplan.plan_commands`."""
         return plan_commands(plan, graph)
 
-    def _build_graph(self) -> TaskGraph:
+    def _build_graph(self, clairvoyant: bool = False) -> TaskGraph:
         """Build the task graph of the current tick (the one place graphs are built)."""
         if self.belief is None:
             raise ValueError("this mission keeps no belief to plan from: call track_belief()")
-        return self.graph_builder.build(self.world.team, self.belief)
+        belief: Belief | ClairvoyantBelief = self.belief
+        if clairvoyant:
+            belief = ClairvoyantBelief(self.belief, self.world.fire.state.reshape(-1))
+        return self.graph_builder.build(self.world.team, belief)
 
     # ------------------------------------------------------------------ ticks
     def step(self, commands: Commands | None = None) -> StepInfo:

@@ -15,7 +15,7 @@ from tests.test_readme import README, python_block_after
 
 #: a spread of shipped scenarios for the default suite (all of them: the slow test below)
 SUBSET = ("practice", "1", "12", "24", "open_world_example", "scale_example")
-BUILTIN = ("greedy", "idle", "random", "routing", "milp", "milp-cvxpy", "cbba")
+BUILTIN = ("greedy", "idle", "random", "routing", "milp", "milp-cvxpy", "cbba", "oracle")
 #: settings that make a scheduler's plans independent of wall time and load
 DETERMINISTIC = {"routing": {"deterministic": True}}
 
