@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fcplan.metrics import Metrics, compute_all
+from fcplan.metrics import Metrics, Outcomes, compute_all, compute_outcomes
 from fcplan.mission import Mission, ScenarioLike, as_scenario
 from fcplan.scenario import Scenario
 from fcplan.scheduling import Scheduler, SolveStats, make_scheduler
@@ -78,6 +78,11 @@ class EpisodeResult:
         return np.array([s.wall_time_s for s in self.solves], dtype=np.float64)
 
     @property
+    def outcomes(self) -> Outcomes:
+        """Time to containment, burned area and facility damage (:mod:`fcplan.metrics.outcomes`)."""
+        return compute_outcomes(self.trace)
+
+    @property
     def fallbacks(self) -> int:
         """Number of replans where the scheduler failed and greedy stood in."""
         return sum(s.status == "fallback" for s in self.solves)
@@ -93,6 +98,8 @@ class EpisodeResult:
             for k, v in m.as_dict().items():
                 if k != "definition":
                     out[f"{name}.{k}"] = v
+        for k, v in self.outcomes.as_dict().items():
+            out[f"outcome.{k}"] = v
         st = self.solve_times_s
         statuses = [s.status for s in self.solves]
         rounds = [s.size["rounds"] for s in self.solves if "rounds" in s.size]

@@ -134,12 +134,14 @@ from fcplan.metrics.compute import (
     negative_reward_rate,
     penalty_rate,
 )
-from fcplan.metrics.table import METRICS, MetricSpec, format_metrics, metric_spec
+from fcplan.metrics.outcomes import Outcomes, compute_outcomes
+from fcplan.metrics.table import METRICS, OUTCOMES, MetricSpec, format_metrics, metric_spec
 
 __all__ = [
     "DEFINITIONS",
     "GRADES",
     "METRICS",
+    "OUTCOMES",
     "MetricSpec",
     "Metrics",
     "compute_all",
@@ -150,4 +152,6 @@ __all__ = [
     "facility_penalty",
     "negative_reward_rate",
     "penalty_rate",
+    "Outcomes",
+    "compute_outcomes",
 ]
