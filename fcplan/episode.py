@@ -129,6 +129,7 @@ def run_episode(
     graph_params: TaskGraphParams | None = None,
     event_replans: bool = True,
     record: str | os.PathLike[str] | None = None,
+    latency: str | None = None,
 ) -> EpisodeResult:
     """Play one episode of ``scenario`` with ``scheduler`` (a :class:`fcplan.mission.Mission`).
 
@@ -149,6 +150,10 @@ def run_episode(
         Also replan at once when fire is sensed outside every current fire task.
     record : str or os.PathLike, optional
         Write a complete recording of the episode to this ``.npz`` file (:mod:`fcplan.recording`).
+    latency : {None, "wall", "ticks:N"}
+        Planning takes time in the world: a plan applies that many ticks after its replan, the
+        team flying its last orders meanwhile (:meth:`fcplan.mission.Mission.run`). None (the
+        default) stops the world while the scheduler thinks, as the manual's game does.
 
     Returns
     -------
@@ -165,6 +170,7 @@ def run_episode(
             time_limit=time_limit,
             event_replans=event_replans,
             graph_params=graph_params,
+            latency=latency,
         )
         recorder = _recorder(scenario, scheduler, seed, settings)
     mission = Mission(
@@ -175,7 +181,7 @@ def run_episode(
         graph_params=graph_params,
         observers=() if recorder is None else (recorder,),
     )
-    mission.run(scheduler, time_limit=time_limit)
+    mission.run(scheduler, time_limit=time_limit, latency=latency)
     trace = mission.world.trace()
     if recorder is not None and record is not None:
         recorder.save(record)

@@ -67,13 +67,15 @@ Examples
 
 from __future__ import annotations
 
+import math
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any, Protocol, cast, runtime_checkable
 
 import numpy as np
 
 from fcplan.belief import Belief, ClairvoyantBelief
+from fcplan.errors import FcplanError
 from fcplan.plan import Plan, plan_commands
 from fcplan.scenario import Scenario, load_scenario
 from fcplan.scheduling import Scheduler, SolveStats, solve
@@ -351,14 +353,40 @@ class Mission:
             commands = None
         return max(n, 0)
 
-    def run(self, scheduler: Scheduler, *, time_limit: float | None = None) -> Mission:
+    def run(
+        self,
+        scheduler: Scheduler,
+        *,
+        time_limit: float | None = None,
+        latency: str | None = None,
+    ) -> Mission:
         """Play the rest of the episode with ``scheduler``, replanning by the rule; return
-        ``self``."""
+        ``self``.
+
+        ``latency`` makes planning take time in the world (default None: the world waits for
+        the scheduler, as in the manual's game):
+
+        * ``"ticks:N"``: a plan made at tick ``t`` applies from tick ``t + N``; deterministic,
+          so results stay reproducible;
+        * ``"wall"``: it applies ``ceil(wall seconds of the scheduler call x ticks per second)``
+          ticks later (what a real fleet would see; depends on the machine).
+
+        Meanwhile the team keeps flying its last orders, and no new replan starts until the
+        pending plan applies (one planner, busy while it thinks).
+        """
+        delay = latency_rule(latency, self.scenario.ticks_per_second)
+        pending: tuple[int, Commands] | None = None
         while not self.world.done:
-            commands = None
-            if self.replan_due():
+            commands: Commands | None = None
+            if pending is not None and self.world.tick >= pending[0]:
+                commands, pending = pending[1], None
+            if pending is None and self.replan_due():
                 graph, plan = self.replan(scheduler, time_limit=time_limit)
-                commands = self.commands_for(plan, graph)
+                ticks = delay(cast(SolveStats, plan.stats))
+                if ticks == 0:
+                    commands = self.commands_for(plan, graph)
+                else:
+                    pending = (self.world.tick + ticks, self.commands_for(plan, graph))
             self.step(commands)
         return self
 
@@ -373,3 +401,26 @@ def _tile_keys(xy: np.ndarray, tile: tuple[float, float], w: int) -> np.ndarray:
     ``w`` px map (one key per tile)."""
     ny = int(np.ceil(w / tile[1])) + 1
     return (xy[:, 0] // tile[0]).astype(np.int64) * ny + (xy[:, 1] // tile[1]).astype(np.int64)
+
+
+def latency_rule(latency: str | None, ticks_per_second: int) -> Callable[[SolveStats], int]:
+    """The ticks a plan waits before it applies, as a function of its solve statistics.
+
+    Examples
+    --------
+    >>> latency_rule("ticks:3", 10)(SolveStats())
+    3
+    >>> latency_rule("wall", 10)(SolveStats(wall_time_s=0.25))
+    3
+    >>> latency_rule(None, 10)(SolveStats(wall_time_s=5.0))
+    0
+    """
+    if latency is None:
+        return lambda stats: 0
+    if latency == "wall":
+        return lambda stats: max(math.ceil(stats.wall_time_s * ticks_per_second - 1e-9), 0)
+    kind, _, n = str(latency).partition(":")
+    if kind == "ticks" and n.isdigit():
+        ticks = int(n)
+        return lambda stats: ticks
+    raise FcplanError(f"latency: must be None, 'wall' or 'ticks:N' with N >= 0 (got {latency!r})")

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fcplan import load_scenario, make_scheduler, run_episode
+from fcplan.errors import FcplanError
 from fcplan.mission import BaseObserver, EpisodeObserver, Mission
 
 SHORT = load_scenario("practice").replace(duration_s=6)
@@ -174,3 +175,39 @@ def test_every_periodic_tick_is_a_replan(period, events, seed):
     assert periodic <= got
     if not events:
         assert got == periodic
+
+
+class _CommandTicks(BaseObserver):
+    """Records the ticks at which the mission hands commands to the world."""
+
+    def __init__(self) -> None:
+        self.ticks: list[int] = []
+
+    def on_commands(self, tick, commands) -> None:
+        if commands is not None:
+            self.ticks.append(tick)
+
+
+def test_latency_in_ticks_delays_every_plan_and_blocks_replans_meanwhile():
+    """With ``latency="ticks:N"`` each plan applies exactly N ticks after its replan, no replan
+    starts while one is pending, and N = 0 is the same episode as no latency."""
+    greedy = make_scheduler("greedy")
+    seen = _CommandTicks()
+    m = Mission("practice", seed=0, observers=[seen]).run(greedy, latency="ticks:4")
+    replans = m.replan_ticks.tolist()
+    assert seen.ticks == [t + 4 for t in replans if t + 4 < m.scenario.n_ticks]
+    assert all(b - a >= 4 for a, b in zip(replans, replans[1:], strict=False))
+    plain = Mission("practice", seed=0).run(greedy)
+    zero = Mission("practice", seed=0).run(greedy, latency="ticks:0")
+    assert np.array_equal(plain.world.trace().active, zero.world.trace().active)
+
+
+def test_latency_changes_the_outcome_and_wall_latency_runs():
+    """Planning that takes simulated time is not free: a 3-second latency changes the episode;
+    ``latency="wall"`` plays to the end; a bad value is a one-line error."""
+    fast = run_episode(24, "greedy", seed=0)
+    slow = run_episode(24, "greedy", seed=0, latency="ticks:30")
+    assert slow.metrics["manual"].final_score != fast.metrics["manual"].final_score
+    assert run_episode("practice", "greedy", seed=0, latency="wall").ticks == 1800
+    with pytest.raises(FcplanError, match=r"latency: must be None, 'wall' or 'ticks:N'"):
+        run_episode("practice", "greedy", seed=0, latency="ticks:-1")
