@@ -30,18 +30,20 @@ theta_avg``):
 Why the step is fixed rather than scaled to the tick: the terrain is independent from one 1-px cell
 to the next and a front reads it once per step, so the front's path has no continuous-time limit
 that keeps these statistics. Scaling each step by ``dt = 10 / r`` (fcplan before this rule) shrank
-the random walk's variance per second by ``dt``; scaling the random part by ``sqrt(dt)`` fixes the
-variance but not the drift, because fronts linger longer in low-fuel cells as steps shrink (drift
-after 180 s at 5/10/20/40 Hz: 255/158/108/60 px); and cells burn where fronts land, so the burnt
-area also depends on how finely the path is sampled (``bench/bench_tick_rate.py --alternatives``).
+the random walk's variance per second by ``dt``; scaling the random part by ``sqrt(dt)`` keeps the
+variance on constant fuel but not the drift, as fronts linger longer in low-fuel cells when steps
+shrink (drift after 180 s at 5/10/20/40 Hz: 252/172/103/67 px, against 173 px at every rate with
+the fixed step); and cells burn where fronts land, so the burnt area depends on how finely the
+path is sampled (``bench/bench_tick_rate.py --alternatives``).
 
 **Wind.** ``Scenario.wind_model`` (``[fire] wind_model``) picks how ``U`` and ``Theta`` are drawn
 (:mod:`fcplan.farsite`): ``"fresh"`` draws ``U ~ N(U_avg, 2)`` and ``Theta ~ N(theta_avg, 2 rad)``
 for every front every step; ``"tables"`` is the original's model: each region draws a table of
 ``W`` speeds and one of ``W`` directions (``W``: the map side) once per episode, and every step
 each front picks an entry of each. Both have the same mean drift, but the tables give each episode
-its own wind bias: the spread of the fronts' drift between episodes after 1,800 steps is
-about 1.3 times the fresh model's (``bench/bench_wind.py``; bench/README.md has the figures).
+its own wind bias: after 1,800 steps the spread between episodes of the fronts' drift along the
+wind is 1.51 times the fresh model's for scenario #1's region (1,000 seeds; 1.3 with 5 fronts, 2.1
+with 30: the bias does not average out over fronts; ``bench/bench_wind.py``).
 
 What fcplan keeps and fixes (ARCHITECTURE.md "Fire"):
 
@@ -399,11 +401,8 @@ class Fire:
             return self._fire_step()
         if stop == k:  # (no fire step in this tick: above 10 ticks per second)
             return _EMPTY
-        parts = [self._fire_step() for _ in range(stop - k)]
-        parts = [p for p in parts if p.size]
-        if len(parts) <= 1:
-            return parts[0] if parts else _EMPTY
-        return np.concatenate(parts)
+        parts = [p for p in (self._fire_step() for _ in range(stop - k)) if p.size]
+        return np.concatenate(parts) if len(parts) > 1 else (parts[0] if parts else _EMPTY)
 
     def _fire_step(self) -> np.ndarray:
         """Take one fire step (0.1 simulated second); return the flat indices of the cells that
@@ -585,8 +584,6 @@ class Fire:
 
 
 _EMPTY = np.zeros(0, dtype=np.int64)
-
-
 _ONE = np.uint32(1)
 _ONE32 = np.int32(1)
 _NEVER = 2**62
