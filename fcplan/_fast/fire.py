@@ -1,11 +1,12 @@
-"""Kernels of :class:`fcplan.fire.Fire`'s tick.
+"""Kernels of :class:`fcplan.fire.Fire`'s step.
 
 * :func:`draw_ahead` computes the position-free part of the FARSITE step (the two normal draws of
   every front, the wind speed ``U``, ``C/R`` of ``U``, ``sin`` and ``cos`` of ``Theta``) for a
-  block of ticks in a few numpy calls. The normals are drawn as one ``(T, 2, n)`` array, which
-  takes them from the generator in the order ``T`` per-tick draws of shape ``(2, n)`` would, and
-  element by element the arithmetic is the per-tick one (:func:`fcplan.fire.wind_draws`), so the
-  fronts move exactly as if everything were computed tick by tick.
+  block of steps in a few numpy calls. The normals are drawn as one ``(T, 2, n)`` array, which
+  takes them from the generator in the order ``T`` per-step draws of shape ``(2, n)`` would, and
+  element by element the arithmetic is the per-step one (:func:`fcplan.farsite.wind_draws`), so
+  the fronts move exactly as if everything were computed step by step. :func:`draw_ahead_tables`
+  is the same for the tables wind model (:func:`fcplan.farsite.wind_from_tables`).
 * :func:`advance_whole` is the FARSITE step over the whole ``(2, n)`` position array in place,
   without gathering the moving fronts: the fronts that do not move get a zero spread
   (``x + (+-0.0) == x``; positions are never ``-0.0``).
@@ -40,7 +41,7 @@ def draw_ahead(
     dir_sd: float,
     ratio_of: Callable[[np.ndarray], np.ndarray],
 ) -> None:
-    """Fill the wind of the next ``T`` ticks of ``n`` fronts in place.
+    """Fill the wind of the next ``T`` steps of ``n`` fronts in place (fresh wind model).
 
     Parameters
     ----------
@@ -126,7 +127,7 @@ def advance_whole(fire: Any, t: int, ratio: np.ndarray, all_moving: bool) -> np.
     t : int
         Row of the drawn-ahead wind to use.
     ratio : ndarray, (n,) float64
-        ``C/R`` of every front this tick.
+        ``C/R`` of every front this step.
     all_moving : bool
         Every front moves; otherwise the fronts that do not move (dead, frozen, region inactive)
         get a zero spread and dead ones, just off the map, read a clipped terrain cell.
