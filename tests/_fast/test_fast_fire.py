@@ -147,6 +147,24 @@ def test_small_fire_kernels_move_fronts_exactly_as_the_vector_rule(
     _run_pair(kernel, rule, 120, prune_every, small_b=0)
 
 
+def _assert_rows_are_the_per_step_rule(seed, fill, per_step_wind, ratio_of, ticks, n):
+    """Rows of the (T, 2, n) and (T, n) buffers that ``fill(rng, z, sc, ratio)`` fills are bit
+    for bit ``T`` successive ``per_step_wind(rng)`` (and ``ratio_of`` their U), and the two
+    streams stay in step."""
+    z, sc = np.empty((ticks, 2, n)), np.empty((ticks, 2, n))
+    ratio = np.empty((ticks, n))
+    rng = np.random.default_rng(seed)
+    fill(rng, z, sc, ratio)
+    per_step = np.random.default_rng(seed)
+    for t in range(ticks):
+        u, sin_t, cos_t = per_step_wind(per_step)
+        assert bits(z[t, 0]) == bits(u)
+        assert bits(sc[t, 0]) == bits(sin_t)
+        assert bits(sc[t, 1]) == bits(cos_t)
+        assert bits(ratio[t]) == bits(ratio_of(u))
+    assert bits(rng.random(3)) == bits(per_step.random(3))
+
+
 @settings(max_examples=100, deadline=None)
 @given(seed=_SEED, n=_FRONTS, ticks=st.integers(1, 70))
 def test_wind_drawn_ahead_is_the_per_tick_rule(seed, n, ticks):
@@ -154,18 +172,14 @@ def test_wind_drawn_ahead_is_the_per_tick_rule(seed, n, ticks):
     for bit what T successive calls of wind_draws (and the tabulated C/R of their U) give."""
     g = np.random.default_rng(seed + 1)
     wind, theta = g.uniform(0.0, 15.0, n), g.uniform(0.0, 2.0 * np.pi, n)
-    z, sc = np.empty((ticks, 2, n)), np.empty((ticks, 2, n))
-    ratio = np.empty((ticks, n))
-    rng = np.random.default_rng(seed)
-    draw_ahead(rng, z, sc, ratio, wind, theta, WIND_SPEED_SD, WIND_DIR_SD_RAD, interp_ratio)
-    per_tick = np.random.default_rng(seed)
-    for t in range(ticks):
-        u, sin_t, cos_t = wind_draws(per_tick, wind, theta)
-        assert bits(z[t, 0]) == bits(u)
-        assert bits(sc[t, 0]) == bits(sin_t)
-        assert bits(sc[t, 1]) == bits(cos_t)
-        assert bits(ratio[t]) == bits(interp_ratio(u))
-    assert bits(rng.random(3)) == bits(per_tick.random(3))  # the streams stay in step
+    sd = (WIND_SPEED_SD, WIND_DIR_SD_RAD)
+
+    def fill(rng, z, sc, ratio):
+        draw_ahead(rng, z, sc, ratio, wind, theta, *sd, interp_ratio)
+
+    _assert_rows_are_the_per_step_rule(
+        seed, fill, lambda rng: wind_draws(rng, wind, theta), interp_ratio, ticks, n
+    )
 
 
 @settings(max_examples=100, deadline=None)
@@ -184,18 +198,18 @@ def test_wind_drawn_ahead_from_tables_is_the_per_step_rule(seed, n, ticks, regio
     tab_u = np.ascontiguousarray(tables[:, 0]).reshape(-1)
     theta = np.ascontiguousarray(tables[:, 1]).reshape(-1)
     tab = (tab_u, np.sin(theta), np.cos(theta), spread_rate_ratio(tab_u))
-    z, sc = np.empty((ticks, 2, n)), np.empty((ticks, 2, n))
-    ratio = np.empty((ticks, n))
-    rng = np.random.default_rng(seed)
-    draw_ahead_tables(rng, z, sc, ratio, base, length, *tab)
-    per_step = np.random.default_rng(seed)
-    for t in range(ticks):
-        u, sin_t, cos_t = wind_from_tables(per_step, tables, region_of)
-        assert bits(z[t, 0]) == bits(u)
-        assert bits(sc[t, 0]) == bits(sin_t)
-        assert bits(sc[t, 1]) == bits(cos_t)
-        assert bits(ratio[t]) == bits(spread_rate_ratio(u))
-    assert bits(rng.random(3)) == bits(per_step.random(3))  # the streams stay in step
+
+    def fill(rng, z, sc, ratio):
+        draw_ahead_tables(rng, z, sc, ratio, base, length, *tab)
+
+    _assert_rows_are_the_per_step_rule(
+        seed,
+        fill,
+        lambda rng: wind_from_tables(rng, tables, region_of),
+        spread_rate_ratio,
+        ticks,
+        n,
+    )
 
 
 @settings(max_examples=50, deadline=None)
