@@ -17,10 +17,15 @@ seeds, and the script prints the mean over episodes (and its standard error) of:
   ``sqrt(dt)``, the diffusion scaling that keeps drift velocity and variance per second fixed for
   a front on constant fuel.
 
+``--team`` prints the seconds per leg of a perception agent patrolling a square at 200 px/s
+(the team's one rate-dependent effect: an agent snaps onto a goal within one step of it and starts
+the next leg on the next tick, so each leg takes ``ceil(leg / step)`` ticks).
+
 Usage::
 
     python bench/bench_tick_rate.py                      # 30 seeds x 180 s
     python bench/bench_tick_rate.py --alternatives --seeds 12
+    python bench/bench_tick_rate.py --team --seeds 0
 """
 
 from __future__ import annotations
@@ -33,7 +38,8 @@ import numpy as np
 
 from fcplan.farsite import WIND_DIR_SD_RAD, WIND_SPEED_SD, spread_rate_ratio
 from fcplan.fire import Fire
-from fcplan.scenario import FireRegion
+from fcplan.scenario import FireRegion, load_scenario
+from fcplan.team import Command, Team
 
 W, FRONTS, FUEL, WIND, DIR = 1200, 10, 10.0, 5.0, math.radians(45.0)
 AZIMUTH = np.array([math.sin(DIR), math.cos(DIR)])
@@ -106,12 +112,34 @@ def table(title: str, run, seeds: int, seconds: int) -> None:
         print(f"{tps:3d} {cols}  {time.perf_counter() - t0:4.0f}")
 
 
+def leg_seconds(tps: int, leg: float, legs: int = 16) -> float:
+    """Seconds per leg of P1 patrolling a square of side ``leg`` px from one of its corners."""
+    team = Team(load_scenario(1).replace(ticks_per_second=tps))
+    p, (x, y) = team.index("P1"), (300.0, 400.0)
+    team.pos[p] = (x, y)
+    square = ((x + leg, y), (x + leg, y + leg), (x, y + leg), (x, y))
+    team.apply({"P1": Command(route=square, patrol=True)})
+    ticks = arrivals = 0
+    while arrivals < legs:
+        ticks += 1
+        arrivals += p in team.move().tolist()
+    return ticks / tps / legs
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=30)
     ap.add_argument("--seconds", type=int, default=180)
     ap.add_argument("--alternatives", action="store_true")
+    ap.add_argument("--team", action="store_true")
     args = ap.parse_args()
+    if args.team:
+        print("seconds per leg, patrol at 200 px/s (ideal: leg / 200)")
+        for leg in (37.0, 100.0, 150.0):
+            row = "  ".join(f"{tps} Hz {leg_seconds(tps, leg):.3f}" for tps in (5, 10, 20, 40))
+            print(f"leg {leg:5.0f} px (ideal {leg / 200:.3f}):  {row}")
+    if args.seeds <= 0:
+        return
     print(f"{args.seeds} seeds x {args.seconds} s; mean and standard error over episodes")
     table("fcplan (a fire step every 0.1 s)", fcplan_episode, args.seeds, args.seconds)
     if args.alternatives:
