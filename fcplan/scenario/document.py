@@ -19,6 +19,8 @@ A scenario file is a TOML document::
     [fire]
     mode = "specific"           # uniform | specific (default specific)
     # action_gate = "sensed"    # sensed (manual rule) | reference (2020 code's looser gate)
+    # wind_model = "fresh"      # fresh (new draws every fire step) | tables (the original's
+    #                           #   per-episode sample tables); see fcplan.fire
     # fronts, delay_s, fuel, wind_speed, wind_dir_deg, half_width here are defaults for every
     # region (in uniform mode, write them here only)
 
@@ -89,6 +91,7 @@ from fcplan.scenario.grid import cell_center, format_cell, parse_cell
 from fcplan.scenario.parts import (
     ACTION_ALTITUDE,
     DEFAULT_PENALTIES,
+    DEFAULT_WIND_MODEL,
     FACILITY_KINDS,
     FACILITY_SIZES,
     FOOTPRINT_KINDS,
@@ -132,7 +135,7 @@ _TOP_KEYS = (
 )  # fmt: skip
 _REGION_PARAMS = tuple(REGION_DEFAULTS)
 _UNIFORM_PARAMS = ("fronts", "delay_s", "fuel", "wind_speed", "wind_dir_deg")
-_FIRE_KEYS = ("mode", "action_gate", *_REGION_PARAMS, "regions")
+_FIRE_KEYS = ("mode", "action_gate", "wind_model", *_REGION_PARAMS, "regions")
 _REGION_KEYS = ("cell", "center", *_REGION_PARAMS)
 _SCORING_KEYS = ("propagation_weight", "temporal_exponent", "penalties")
 _PENALTY_KEYS = FOOTPRINT_KINDS
@@ -342,6 +345,7 @@ def scenario_fields(doc: Any) -> dict[str, Any]:
         agents=_team(top, depot),
         scoring=scoring,
         action_gate=fire.get("action_gate", "str", "sensed"),
+        wind_model=fire.get("wind_model", "str", DEFAULT_WIND_MODEL),
         comm_range=top.get("comm_range", "number", None),
         notes=top.get("notes", "strings", ()),
     )
@@ -434,6 +438,8 @@ def scenario_to_dict(s: Scenario) -> dict[str, Any]:
     fire: dict[str, Any] = {"mode": s.fire_mode}
     if s.action_gate != "sensed":
         fire["action_gate"] = s.action_gate
+    if s.wind_model != DEFAULT_WIND_MODEL:
+        fire["wind_model"] = s.wind_model
     shared = _UNIFORM_PARAMS if s.fire_mode == "uniform" else ()
     fire.update({key: getattr(s.regions[0], key) for key in shared})
     regions = []

@@ -42,6 +42,7 @@ from fcplan.scenario.parts import (
     ACTION_ALTITUDE,
     ACTION_GATES,
     DEFAULT_PENALTIES,
+    DEFAULT_WIND_MODEL,
     DEPOT_SIZES,
     DEPOT_SLOTS,
     DIFFICULTIES,
@@ -49,6 +50,7 @@ from fcplan.scenario.parts import (
     FACILITY_SIZES,
     FIRE_MODES,
     FOOTPRINT_KINDS,
+    WIND_MODELS,
     AgentSpec,
     Depot,
     Facility,
@@ -81,6 +83,8 @@ __all__ = [
     "DIFFICULTIES",
     "FIRE_MODES",
     "ACTION_GATES",
+    "WIND_MODELS",
+    "DEFAULT_WIND_MODEL",
 ]
 
 
@@ -126,6 +130,11 @@ class Scenario:
         File the scenario was loaded from. Not part of equality.
     notes : tuple of str
         Free-text notes from the file (e.g. where the reference code differs from the manual).
+    wind_model : str
+        ``"fresh"``: every fire step draws each front's wind speed and direction afresh;
+        ``"tables"``: each region draws two tables of ``world_size`` samples once per episode and
+        every step picks entries from them, as the original does (see :mod:`fcplan.fire`).
+        Default :data:`~fcplan.scenario.parts.DEFAULT_WIND_MODEL`.
 
     Examples
     --------
@@ -156,6 +165,7 @@ class Scenario:
     comm_range: float | None = None
     source: str | None = field(default=None, compare=False)
     notes: tuple[str, ...] = ()
+    wind_model: str = DEFAULT_WIND_MODEL
 
     def __post_init__(self) -> None:
         for name in ("regions", "facilities", "lakes", "agents", "notes"):

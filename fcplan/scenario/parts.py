@@ -50,6 +50,8 @@ __all__ = [
     "DIFFICULTIES",
     "FIRE_MODES",
     "ACTION_GATES",
+    "WIND_MODELS",
+    "DEFAULT_WIND_MODEL",
 ]
 
 FACILITY_KINDS = ("house", "hospital", "power_station")
@@ -99,6 +101,11 @@ ACTION_ALTITUDE = 30.0
 DIFFICULTIES = ("practice", "easy", "moderate", "hard", "custom")
 FIRE_MODES = ("uniform", "specific")
 ACTION_GATES = ("sensed", "reference")
+WIND_MODELS = ("tables", "fresh")
+"""Wind models of the fire (:mod:`fcplan.fire`): the original's per-episode sample tables, or
+fresh draws every fire step."""
+DEFAULT_WIND_MODEL = "fresh"
+"""Wind model of scenarios that do not name one (``[fire] wind_model``)."""
 
 
 def _is_real(v: Any) -> bool:

@@ -59,6 +59,7 @@ from fcplan.scenario.parts import (
     FACILITY_KINDS,
     FACILITY_SIZES,
     FIRE_MODES,
+    WIND_MODELS,
     AgentSpec,
     Depot,
     Facility,
@@ -208,6 +209,7 @@ def _check_header(s: Scenario) -> None:
     _int_at_least("ticks_per_second", s.ticks_per_second, 1)
     _choice("fire.mode", s.fire_mode, FIRE_MODES)
     _choice("fire.action_gate", s.action_gate, ACTION_GATES)
+    _choice("fire.wind_model", s.wind_model, WIND_MODELS)
     if s.comm_range is not None:
         _positive("comm_range", s.comm_range, " (px), or absent for unlimited")
     _require(
