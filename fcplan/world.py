@@ -45,7 +45,7 @@ from fcplan._fast.team import sensing_confidence_of
 from fcplan._fast.world import scan_box as _scan_box
 from fcplan._fast.world import step_info_builder
 from fcplan.fire import _BURNING8, Fire, _unique
-from fcplan.team import Command, Team
+from fcplan.team import Command, Team, per_tick_probability
 from fcplan.trace import TRACE_FIELDS, Trace
 
 if TYPE_CHECKING:
@@ -127,7 +127,9 @@ class World:
         rng_fire, self.rng_sense, self.rng_prune, self.controller_rng = streams
         w = scenario.world_size
         self.world_size = w
-        self.fire = Fire(scenario.regions, w, scenario.ticks_per_second, rng_fire)
+        self.fire = Fire(
+            scenario.regions, w, scenario.ticks_per_second, rng_fire, wind_model=scenario.wind_model
+        )
         self.team = Team(scenario)
         self._tps = scenario.ticks_per_second
         self._sensing_rows = np.flatnonzero(self.team.can_sense).tolist()
@@ -277,7 +279,8 @@ class World:
             flat = self._cells(state[x0:x1, y0:y1] == _BURNING8, x0, y0)
             if flat.size == 0:
                 continue
-            keep = self.rng_sense.random(flat.size) < sensing_confidence_of(team, i)
+            p = per_tick_probability(sensing_confidence_of(team, i), self._tps)
+            keep = self.rng_sense.random(flat.size) < p
             if np.count_nonzero(keep):
                 parts.append(flat[keep])
         if not parts:

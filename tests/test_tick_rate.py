@@ -157,21 +157,7 @@ def test_sensing_probability_per_second_does_not_depend_on_rate(tps):
         assert per_tick_probability(c, 10) is c  # 10 Hz: the manual's confidence itself
 
 
-# The world draws with the 10 Hz confidence at every rate until fcplan/world.py's sensing uses
-# per_tick_probability (a change in a module this branch does not own); then these pass.
-_WORLD_SENSING = pytest.mark.xfail(
-    strict=True, reason="world.py must draw sensing with team.per_tick_probability"
-)
-
-
-@pytest.mark.parametrize(
-    "tps",
-    [
-        pytest.param(5, marks=_WORLD_SENSING),
-        10,
-        *(pytest.param(r, marks=_WORLD_SENSING) for r in (20, 40)),
-    ],
-)
+@pytest.mark.parametrize("tps", [5, 10, 20, 40])
 def test_world_senses_the_same_share_of_cells_per_second_at_any_rate(tps):
     """A perception agent hovering at its highest altitude (c = 0.4) over 2,400 burning cells has
     sensed 1 - 0.6^2 = 64 % of them after 0.2 s at any rate (within 4 percentage points)."""
