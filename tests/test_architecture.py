@@ -102,7 +102,10 @@ def test_no_import_cycles():
     assert cycles == [], f"import cycles: {cycles}"
 
 
-CORE = ("fcplan.scenario", "fcplan.fire", "fcplan.team", "fcplan.world", "fcplan.metrics")
+CORE = (
+    "fcplan.scenario", "fcplan.farsite", "fcplan.fire", "fcplan.team", "fcplan.world",
+    "fcplan.trace", "fcplan.metrics",
+)  # fmt: skip
 ABOVE_CORE = (
     "fcplan.belief", "fcplan.taskgraph", "fcplan.plan", "fcplan.scheduling", "fcplan.mission",
     "fcplan.episode", "fcplan.env", "fcplan.experiments", "fcplan.cli", "fcplan.game",
