@@ -13,15 +13,15 @@ machines (tests, CI) set ``SDL_VIDEODRIVER=dummy``.
 
 Examples
 --------
->>> import os
->>> os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # doctest: +ELLIPSIS
-'...'
+``SDL_VIDEODRIVER=dummy python -c "..."`` runs this headless:
+
 >>> import numpy as np
->>> window = HumanWindow("fcplan", fps=1000)
->>> window.show(np.zeros((40, 60, 3), dtype=np.uint8))
->>> window.size
+>>> window = HumanWindow("fcplan", fps=1000)  # doctest: +SKIP
+>>> window.show(np.zeros((40, 60, 3), dtype=np.uint8))  # doctest: +SKIP
+>>> window.size  # doctest: +SKIP
 (60, 40)
->>> window.close()
+>>> print(PYGAME_HINT)
+render_mode="human" needs pygame: pip install "fcplan[game]" (from a checkout: pip install -e ".[game]")
 """
 
 from __future__ import annotations
