@@ -16,7 +16,17 @@ Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with
 joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any
 registered scheduler, stored as npz without pickle) and :mod:`fcplan.env.bc` (a small numpy
 behaviour-cloning baseline). Everything is imported lazily, so ``import fcplan.env`` is cheap
-and does not need PettingZoo until an environment is made. :class:`~fcplan.errors.EnvError` is
+and does not need PettingZoo until an environment is made; it registers the Gymnasium ids
+``fcplan/Task-v0``, ``fcplan/Motion-v0``, ``fcplan/MotionBase-v0``, ``fcplan/MotionCmplx1-v0``
+and ``fcplan/MotionCmplx2-v0`` (:mod:`fcplan.env.registration`).
+
+Standard integrations: the versioned PettingZoo modules :mod:`~fcplan.env.task_v0`,
+:mod:`~fcplan.env.motion_v0`, :mod:`~fcplan.env.base_v0`, :mod:`~fcplan.env.cmplx1_v0` and
+:mod:`~fcplan.env.cmplx2_v0` (``env()``, ``parallel_env()``, ``raw_env``;
+:mod:`fcplan.env.versions`); the options ``obs_layout="flat"`` and ``pad_actions=True``
+(:mod:`fcplan.env.wrappers`), which give the ``{"observation", "action_mask"}`` layout and equal
+action spaces that SuperSuit's vector wrappers need; ``render_mode="human"``
+(:mod:`fcplan.env.human`). :class:`~fcplan.errors.EnvError` is
 defined in :mod:`fcplan.errors` and exported here.
 
 Examples
@@ -53,6 +63,7 @@ __all__ = [
     "Demonstrations",
     "replay_actions",
     "PlanFollower",
+    "VERSIONED",
 ]
 
 #: Environment levels accepted by :func:`parallel_env`.
@@ -71,7 +82,13 @@ _LAZY = {
 }
 
 
+#: the versioned PettingZoo modules, imported on first access as attributes
+VERSIONED = ("task_v0", "motion_v0", "base_v0", "cmplx1_v0", "cmplx2_v0")
+
+
 def __getattr__(name: str) -> Any:
+    if name in VERSIONED:
+        return import_module(f"fcplan.env.{name}")
     if name in _LAZY:
         value = getattr(import_module(_LAZY[name]), name)
         globals()[name] = value

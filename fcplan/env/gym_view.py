@@ -13,6 +13,9 @@ Episode end         ``truncated`` at the scenario's duration (or ``max_steps``);
                     ``terminated`` is always False
 Info                ``tick``; per-agent ``illegal``/``conflict`` arrays; at the end
                     ``metrics`` (manual and reference2020 as dicts) and ``return``
+Render modes        ``"rgb_array"`` (the task env's frame) and ``"human"`` (that frame in a
+                    pygame window, :mod:`fcplan.env.human`)
+Gymnasium id        ``fcplan/Task-v0`` (:mod:`fcplan.env.registration`)
 ==================  ==================================================================
 
 Masked-out actions (an unmasked ``action_space.sample()``, as ``check_env`` does) act as the
