@@ -40,7 +40,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from fcplan.env.human import HumanWindow
+from fcplan.env.human import HumanWindow, WindowedRender
 from fcplan.env.task import TaskEnv
 from fcplan.env.wrappers import split_options
 from fcplan.errors import EnvError
@@ -49,7 +49,7 @@ from fcplan.mission import ScenarioLike
 __all__ = ["TaskGymEnv", "gym_env"]
 
 
-class TaskGymEnv(gymnasium.Env):
+class TaskGymEnv(WindowedRender, gymnasium.Env):
     """Centralised Gymnasium view of :class:`TaskEnv` (see the module docstring).
 
     Parameters
@@ -115,22 +115,6 @@ class TaskGymEnv(gymnasium.Env):
             info["return"] = first["return"]
         self._show()
         return self._obs(), float(rew[ids[0]]), False, bool(trunc[ids[0]]), info
-
-    def _show(self) -> None:
-        if self.window is not None:
-            self.window.show(self.env.render())
-
-    def render(self) -> np.ndarray | None:
-        """The task env's ``rgb_array`` frame (or None); in human mode shows it, returns None."""
-        if self.window is not None:
-            self._show()
-            return None
-        return self.env.render()
-
-    def close(self) -> None:
-        """Close the window (human mode)."""
-        if self.window is not None:
-            self.window.close()
 
 
 def gym_env(scenario: ScenarioLike, **kwargs: Any) -> TaskGymEnv:

@@ -33,7 +33,7 @@ import numpy as np
 
 from fcplan.errors import EnvError
 
-__all__ = ["HumanWindow", "PYGAME_HINT", "import_pygame"]
+__all__ = ["HumanWindow", "WindowedRender", "PYGAME_HINT", "import_pygame"]
 
 #: The one-line error when pygame is missing.
 PYGAME_HINT = (
@@ -104,3 +104,32 @@ class HumanWindow:
             self._pygame.display.quit()
             self._screen = None
             self.size = None
+
+
+class WindowedRender:
+    """Render and close of the Gymnasium views over an inner env (``self.env``, made in
+    ``rgb_array`` mode when a frame is wanted) with an optional :class:`HumanWindow`
+    (``self.window``, set in ``render_mode="human"``)."""
+
+    env: Any
+    window: HumanWindow | None
+
+    def _show(self) -> None:
+        """Show the inner env's frame (human mode; otherwise nothing)."""
+        if self.window is not None:
+            self.window.show(self.env.render())
+
+    def render(self) -> np.ndarray | None:
+        """The inner env's ``rgb_array`` frame (or None); in human mode shows it, returns
+        None."""
+        if self.window is not None:
+            self._show()
+            return None
+        frame: np.ndarray | None = self.env.render()
+        return frame
+
+    def close(self) -> None:
+        """Close the window (human mode) and the inner env."""
+        if self.window is not None:
+            self.window.close()
+        self.env.close()

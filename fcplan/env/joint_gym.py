@@ -41,7 +41,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from fcplan.env.human import HumanWindow
+from fcplan.env.human import HumanWindow, WindowedRender
 from fcplan.env.wrappers import split_options
 from fcplan.errors import EnvError
 from fcplan.mission import ScenarioLike
@@ -55,7 +55,7 @@ def _stack(boxes: list[spaces.Box]) -> spaces.Box:
     return spaces.Box(lo, hi, dtype=boxes[0].dtype)
 
 
-class JointGymEnv(gymnasium.Env):
+class JointGymEnv(WindowedRender, gymnasium.Env):
     """Centralised Gymnasium view of a motion-level env (see the module docstring).
 
     Parameters
@@ -150,20 +150,3 @@ class JointGymEnv(gymnasium.Env):
             info["metrics"] = first["metrics"]
         self._show()
         return self._obs(obs), reward, any(term.values()), any(trunc.values()), info
-
-    def _show(self) -> None:
-        if self.window is not None:
-            self.window.show(self.env.render())
-
-    def render(self) -> np.ndarray | None:
-        """The env's ``rgb_array`` frame; in human mode shows it and returns None."""
-        if self.window is not None:
-            self._show()
-            return None
-        return self.env.render()
-
-    def close(self) -> None:
-        """Close the window (human mode)."""
-        if self.window is not None:
-            self.window.close()
-        self.env.close()
