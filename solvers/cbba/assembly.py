@@ -17,8 +17,8 @@ is *completed*, in index order: it builds a bundle exactly as in the auction (sa
 insertion and feasibility rules, at most its bundle limit) from the items nobody holds, each
 item it takes leaving the pool. ``completed`` counts the agents that got a route this way. After
 a converged auction nothing is completed: an empty route there is what CBBA decided. With a
-clock, completion gives up past the clock's hard deadline and raises
-:class:`~solvers.cbba.clock.CBBATimeLimitError`.
+clock, completion gives up as soon as what is left of it would end past the clock's hard deadline
+and raises :class:`~solvers.cbba.clock.CBBATimeLimitError` (:mod:`solvers.cbba.clock`).
 
 Examples
 --------
@@ -33,12 +33,13 @@ Examples
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from solvers.cbba.auction import Auction, StageResult, insertion_scores
-from solvers.cbba.clock import CBBATimeLimitError, Clock
+from solvers.cbba.clock import BUILD_OVERHEAD, CBBATimeLimitError, Clock
 
 __all__ = ["Assembly", "assemble"]
 
@@ -108,16 +109,16 @@ def _complete(
     for path in paths:
         free[path] = False
     bidders = np.flatnonzero(auc.eligible.any(axis=1)).tolist()
+    todo = [i for i in bidders if not paths[i]]
+    work = {i: int(auc.eligible[i].sum()) + BUILD_OVERHEAD for i in todo}
     completed = 0
-    for i in bidders:
-        if paths[i]:
-            continue
-        if clock is not None and clock.past_hard():
-            left = sum(1 for k in bidders if k >= i and not paths[k])
+    for n, i in enumerate(todo):
+        if clock is not None and clock.past_hard(sum(work[k] for k in todo[n:])):
             raise CBBATimeLimitError(
-                f"cbba: time limit {clock.limit:g} s ran out with {left} agent(s) still to "
-                "be given a route"
+                f"cbba: time limit {clock.limit:g} s too short to give {len(todo) - n} "
+                "agent(s) a route"
             )
+        t = time.perf_counter() if clock is not None else 0.0
         path, got = paths[i], bids[i]
         while len(path) < auc.limit[i]:
             cand = np.flatnonzero(auc.eligible[i] & free)
@@ -131,5 +132,7 @@ def _complete(
             path.insert(int(where[k]), j)
             got.insert(int(where[k]), float(score[k]))
             free[j] = False
+        if clock is not None:
+            clock.record(time.perf_counter() - t, work[i])
         completed += bool(path)
     return completed

@@ -86,7 +86,7 @@ from typing import cast
 
 import numpy as np
 
-from solvers.cbba.clock import Clock
+from solvers.cbba.clock import BUILD_OVERHEAD, Clock
 from solvers.cbba.comms import CommGraph
 
 __all__ = ["NO_WINNER", "STOPS", "Auction", "StageResult", "insertion_scores", "run_auction"]
@@ -368,7 +368,8 @@ def run_auction(
     dirty = bidders.copy()
     rounds = messages = last_change = 0
     stopped_by = "max_rounds"
-    pending = int(bidders.sum())  # bidders holding nothing (each would need completing)
+    work = np.array([c.size + BUILD_OVERHEAD for c in agents.cand], dtype=np.float64)
+    pending = float(work[bidders].sum())  # work of completing the bidders holding nothing
 
     def stop() -> bool:
         return clock is not None and clock.past(pending)
@@ -387,8 +388,9 @@ def run_auction(
             t = time.perf_counter() if clock is not None else 0.0
             changed |= agents.build(i)
             if clock is not None:
-                clock.record(time.perf_counter() - t)
-            pending -= was_empty and bool(agents.bundles[i])
+                clock.record(time.perf_counter() - t, work[i])
+            if was_empty and agents.bundles[i]:
+                pending -= work[i]
             dirty[i] = False
         if not cut and per_round:
             moved = agents.consensus(slots, rounds, stop if clock is not None else None)
@@ -399,7 +401,8 @@ def run_auction(
                 released = agents.release()
                 changed |= bool(moved.any() or released.any())
                 dirty |= moved | released
-                pending = sum(1 for i in np.flatnonzero(bidders).tolist() if not agents.bundles[i])
+                empty = np.array([not b for b in agents.bundles], dtype=bool)
+                pending = float(work[bidders & empty].sum())
         if changed:
             last_change = rounds
         if cut:

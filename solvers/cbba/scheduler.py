@@ -111,8 +111,10 @@ class CBBAResult:
         Agent row -> task rows in flying order, conflict-free (and completed when cut short).
     service : dict of int -> str
         Agent row -> ``"dump"`` or ``"sense"`` for every routed agent.
+    auctions : tuple of Auction
+        The dump auction, then the sense auction, as posed.
     stages : tuple of StageResult
-        The dump auction, then the sense auction.
+        How each ran.
     assemblies : tuple of Assembly
         Their conflict-free routes (item indices).
     comm : CommGraph
@@ -122,6 +124,7 @@ class CBBAResult:
 
     routes: dict[int, list[int]]
     service: dict[int, str]
+    auctions: tuple[Auction, ...]
     stages: tuple[StageResult, ...]
     assemblies: tuple[Assembly, ...]
     comm: CommGraph
@@ -309,6 +312,7 @@ class CBBAScheduler:
         return CBBAResult(
             routes=routes,
             service=service,
+            auctions=(dump, sense),
             stages=(s1, s2),
             assemblies=(a1, a2),
             comm=comm,
@@ -356,6 +360,8 @@ class CBBAScheduler:
         value = np.broadcast_to(np.where(is_fire, 0.0, graph.task_value), (a, graph.n_tasks)).copy()
         if fires.size and a:
             near = graph.start_task_distance[:, fires]  # px from each agent's start to each fire
+            if (winners == winners[0]).all():  # everyone agrees (a connected team): one row
+                winners = winners[:1]
             value[:, fires] = self._watch_values(graph, winners, near, fresh[fires])
         return Auction(
             value=value,
