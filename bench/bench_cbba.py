@@ -2,11 +2,15 @@
 
 Prints (the machine's load average first: the wall-clock figures depend on it):
 
+* **The reference check**: fcplan's CBBA on the static cases of ``tests/solvers/data/cbba/``
+  (``insertion="append"``, the reference's rule, and ``"anywhere"``, the scheduler's) against
+  the reference's assignments, scores, iterations and last change, per communication graph
+  kind; and both rules against the exact optimum on the small cases (no timing);
 * **Wall mode on the manual suite**: whole episodes of scenarios 1-24 (seed 0) with a time limit
   per replan; per limit, the ``plan()`` wall time p50 / p95 / p99 / max (ms) against the bound
-  ``limit * 1.1 + 5 ms``, how many calls exceeded it in wall time (``over``) and in this
-  process's CPU time (``o.cpu``: the calls that overran by their own work, not because the
-  operating system paused the process), how they ended (``heuristic``: converged,
+  ``limit * 1.1 + 5 ms``, the p99 of this process's CPU time per call, how many calls exceeded
+  the bound in wall time (``over``) and in CPU time (``o.cpu``: the calls that overran by their
+  own work, not because the operating system paused the process), how they ended (``heuristic``: converged,
   ``time_limit``: cut and completed, ``raised``: gave up, greedy fallback), agents completed
   greedily, and rounds / messages per replan;
 * **Wall mode on synthetic graphs** of 50 x 500 and 100 x 2000 (agents x tasks, unlimited range
@@ -42,6 +46,7 @@ import fcplan
 from fcplan.taskgraph import TaskGraph, synthetic_task_graph
 from solvers.cbba import CBBAScheduler
 from solvers.cbba.clock import CBBATimeLimitError
+from solvers.cbba.static import StaticInstance, solve_static
 
 SIZES = ((50, 500), (100, 2000))
 SYN_LIMITS = (0.05, 0.1, 0.2, 0.5)
@@ -92,6 +97,7 @@ def limit_row(label: str, limit: float | None, t: Timed, extra: str = "") -> Non
     print(
         f"{label:<16} {'none' if limit is None else f'{limit * 1e3:g}':>6} {len(ms):>6} "
         f"{pct(ms, 50):>7.2f} {pct(ms, 95):>7.2f} {pct(ms, 99):>7.2f} {ms.max():>8.2f} "
+        f"{pct(cpu, 99):>7.2f} "
         f"{'-' if bound is None else f'{bound:.1f}':>7} {over:>5} {over_cpu:>5} "
         f"{ends['heuristic']:>5} {ends['time_limit']:>5} {ends['raised']:>5} {completed:>6} "
         f"{int(np.median(rounds)):>6} {int(np.median(msgs)):>7}{extra}"
@@ -100,7 +106,7 @@ def limit_row(label: str, limit: float | None, t: Timed, extra: str = "") -> Non
 
 HEADER = (
     f"{'case':<16} {'lim ms':>6} {'calls':>6} {'p50 ms':>7} {'p95 ms':>7} {'p99 ms':>7} "
-    f"{'max ms':>8} {'bound':>7} {'over':>5} {'o.cpu':>5} {'conv':>5} {'cut':>5} {'raise':>5} {'compl':>6} "
+    f"{'max ms':>8} {'cpu p99':>7} {'bound':>7} {'over':>5} {'o.cpu':>5} {'conv':>5} {'cut':>5} {'raise':>5} {'compl':>6} "
     f"{'rounds':>6} {'msgs':>7}"
 )
 
@@ -180,6 +186,45 @@ def bench_deterministic(settings: dict, samples: int) -> None:
     print()
 
 
+def bench_reference() -> None:
+    """fcplan's static CBBA against the reference cases of tests/solvers/data/cbba/."""
+    from tests.solvers.test_cbba_reference import CASES, SMALL, instance, optimum
+
+    print("## Static cases against zehuilu/CBBA-Python (tests/solvers/data/cbba/), per graph kind")
+    print(
+        f"{'graph':<6} {'cases':>5} {'append=ref':>10} {'any>=ref':>8} {'any/ref mean':>12} "
+        f"{'min':>6} {'max':>6} {'rounds app/any/ref':>18} {'last change app/any/ref':>23}"
+    )
+    rows: dict[str, list] = {}
+    for case in CASES:
+        inst, ref = StaticInstance.from_dict(case), case["reference"]
+        app, anyw = solve_static(inst, insertion="append"), solve_static(inst)
+        rows.setdefault(case["comm"], []).append((case, ref, app, anyw))
+    for kind, got in rows.items():
+        ratio = [a.score / r["score"] for _, r, _, a in got]
+        mean = lambda xs: float(np.mean(xs))  # noqa: E731
+        print(
+            f"{kind:<6} {len(got):>5} {sum(p.paths == r['paths'] for _, r, p, _ in got):>10} "
+            f"{sum(x >= 1 - 1e-12 for x in ratio):>8} {mean(ratio):>12.4f} {min(ratio):>6.4f} "
+            f"{max(ratio):>6.4f} "
+            f"{mean([p.rounds for *_, p, _ in got]):>6.1f}/{mean([a.rounds for *_, a in got]):.1f}/"
+            f"{mean([r['iterations'] for _, r, *_ in got]):.1f}"
+            f"{mean([p.last_change for *_, p, _ in got]):>13.1f}/"
+            f"{mean([a.last_change for *_, a in got]):.1f}/{mean([r['last_change'] for _, r, *_ in got]):.1f}"
+        )
+    ratios = {"append": [], "anywhere": []}
+    for name in SMALL:
+        best = optimum(instance(name))
+        for rule, xs in ratios.items():
+            xs.append(solve_static(instance(name), insertion=rule).score / best)
+    for rule, xs in ratios.items():
+        print(
+            f"{rule:<8} / exact optimum on {len(xs)} small cases: min {min(xs):.4f} "
+            f"mean {np.mean(xs):.4f}, optimal on {sum(x > 1 - 1e-9 for x in xs)}"
+        )
+    print()
+
+
 def bench_episodes(settings: dict) -> None:
     print("## Episodes (seed 0, no limit): per-replan solve time, rounds and messages")
     print(
@@ -231,7 +276,9 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--quick", action="store_true", help="20 samples, scenarios 1-8")
     p.add_argument("--samples", type=int, default=50, help="plan() calls per synthetic row")
-    p.add_argument("--only", choices=("suite", "synthetic", "deterministic", "episodes"))
+    p.add_argument(
+        "--only", choices=("reference", "suite", "synthetic", "deterministic", "episodes")
+    )
     p.add_argument("--scores", action="store_true", help="also the 24-scenario score table")
     p.add_argument("--set", action="append", default=[], help="scheduler setting name=value")
     args = p.parse_args()
@@ -243,6 +290,8 @@ def main() -> None:
     scenarios = range(1, 9) if args.quick else range(1, 25)
     load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
     print(f"load average {load} on {os.cpu_count()} cores; settings {settings or 'defaults'}\n")
+    if args.only in (None, "reference"):
+        bench_reference()
     if args.only in (None, "suite"):
         bench_suite(settings, scenarios)
     if args.only in (None, "synthetic"):
