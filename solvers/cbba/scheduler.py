@@ -52,8 +52,13 @@ Limits and modes
   construction and every neighbour slot of a consensus round and stop in time to complete
   what is missing. The dump auction may use a share of the limit proportional to its size
   (dumpers x fires against cameras x tasks, between 20 % and 80 %), the sense auction what is
-  left. ``plan()`` returns within the limit + 10 % + 5 ms. Plans then depend on the machine's
-  speed and load.
+  left. ``plan()`` returns within the limit + 10 % + 5 ms of its own work, as long as the
+  limit is not shorter than setting up the auctions (reading the graph's views and scoring
+  the items, which is not interrupted: well under a millisecond on the manual's scenarios,
+  tens of milliseconds on 100 agents x 2,000 tasks); every other step between two looks at the
+  clock is one bundle construction or one neighbour slot (about a millisecond at most). Pauses
+  that the operating system imposes on a loaded machine come on top (``bench/README.md``).
+  Plans then depend on the machine's speed and load.
 * **Deterministic mode** (``deterministic=True``): the wall clock is never read; each auction
   stops at convergence or after ``max_rounds`` rounds, so the same graph gives the same plan in
   any process and under any load, whatever time limit is passed (use it for comparisons; the
