@@ -21,6 +21,7 @@ Examples
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -62,13 +63,16 @@ def _fmt(v: float) -> str:
 class _Writer:
     """The panel image and a text cursor moving down it line by line."""
 
-    def __init__(self, size: int) -> None:
+    def __init__(self, size: int, blank: np.ndarray | None = None) -> None:
         self.ts = ts = text_scale(size)
         self.px = font_px(size)
         self.width = pw = panel_width(size)
-        self.img = np.empty((size, pw, 3), dtype=np.uint8)
-        self.img[:] = COLORS["panel"]
-        self.img[:, 0:ts] = COLORS["panel_line"]
+        if blank is None:
+            self.img = np.empty((size, pw, 3), dtype=np.uint8)
+            self.img[:] = COLORS["panel"]
+            self.img[:, 0:ts] = COLORS["panel_line"]
+        else:
+            self.img = blank.copy()
         self.th = line_height(self.px)  # text box height
         self.lh = self.th + 2 * ts  # line height
         self.x0 = 6 * ts
@@ -102,7 +106,7 @@ def draw_panel(
 
     ``roles`` names each agent's role (``"perception"``, ``"action"`` or ``"hybrid"``).
     """
-    w = _Writer(size)
+    w = _Writer(size, _blank_panel(size, show_truth))
     title = scenario.name if scenario.number is None else f"Scenario {scenario.number}"
     w.line(f"{title} \u00b7 {scenario.difficulty}", COLORS["accent"], bold=True)
     w.text(f"t = {frame.time_s:.1f} / {scenario.duration_s:g} s", w.x0)
@@ -122,7 +126,15 @@ def draw_panel(
             w.y += w.lh
         w.rule()
     _agent_table(w, scenario, frame, roles, size)
+    return w.img
+
+
+@lru_cache(maxsize=16)
+def _blank_panel(size: int, show_truth: bool) -> np.ndarray:
+    """The panel's background with its legend (the same in every frame), read-only."""
+    w = _Writer(size)
     _legend(w, size, show_truth)
+    w.img.setflags(write=False)
     return w.img
 
 

@@ -104,15 +104,12 @@ def blit_alpha(img: np.ndarray, alpha: np.ndarray, x: int, y: int, color: Color)
     r1, c1 = min(y + h, ih), min(x + w, iw)
     if r1 <= r0 or c1 <= c0:
         return
-    a = alpha[r0 - y : r1 - y, c0 - x : c1 - x]
-    rows, cols = np.nonzero(a)
-    if rows.size == 0:
-        return
+    a = alpha[r0 - y : r1 - y, c0 - x : c1 - x, None].astype(np.uint16)
     region = img[r0:r1, c0:c1]
-    k = a[rows, cols].astype(np.float32)[:, None] * (1.0 / 255.0)
-    old = region[rows, cols].astype(np.float32)
-    col = np.asarray(color, dtype=np.float32)
-    region[rows, cols] = np.rint(old + (col - old) * k).astype(np.uint8)
+    old = region.astype(np.uint16)
+    col = np.asarray(color, dtype=np.uint16)
+    # integer blend, rounded: (old (255 - a) + c a + 127) // 255
+    region[:] = ((old * (255 - a) + col * a + 127) // 255).astype(np.uint8)
 
 
 def draw_text(
