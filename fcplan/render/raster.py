@@ -26,6 +26,7 @@ __all__ = [
     "ROLE_SHAPES",
     "blit_mask",
     "cell_pixels",
+    "clip_box",
     "font_px",
     "halo",
     "line",
@@ -87,16 +88,23 @@ def font_px(size: int) -> int:
     return 11 * text_scale(size)
 
 
+def clip_box(img: np.ndarray, x: int, y: int, h: int, w: int) -> tuple[int, int, int, int] | None:
+    """Rows ``r0:r1`` and columns ``c0:c1`` of the (h, w) box at (x, y) inside ``img`` as
+    ``(r0, r1, c0, c1)``, or None when none of it is."""
+    ih, iw = img.shape[:2]
+    r0, c0 = max(y, 0), max(x, 0)
+    r1, c1 = min(y + h, ih), min(x + w, iw)
+    return None if r1 <= r0 or c1 <= c0 else (r0, r1, c0, c1)
+
+
 def blit_mask(
     img: np.ndarray, mask: np.ndarray, x: int, y: int, color: Color, alpha: float = 1.0
 ) -> None:
     """Paint ``color`` where ``mask`` (h, w) is set, top-left at (x, y), clipped to ``img``."""
-    h, w = mask.shape
-    ih, iw = img.shape[:2]
-    r0, c0 = max(y, 0), max(x, 0)
-    r1, c1 = min(y + h, ih), min(x + w, iw)
-    if r1 <= r0 or c1 <= c0:
+    box = clip_box(img, x, y, *mask.shape)
+    if box is None:
         return
+    r0, r1, c0, c1 = box
     m = mask[r0 - y : r1 - y, c0 - x : c1 - x]
     region = img[r0:r1, c0:c1]
     if alpha >= 1.0:

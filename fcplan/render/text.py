@@ -35,6 +35,8 @@ from typing import Any
 
 import numpy as np
 
+from fcplan.render.raster import clip_box
+
 __all__ = [
     "FONT_FILES",
     "blit_alpha",
@@ -98,12 +100,10 @@ def text_size(text: str, px: int, bold: bool = False) -> tuple[int, int]:
 def blit_alpha(img: np.ndarray, alpha: np.ndarray, x: int, y: int, color: Color) -> None:
     """Blend ``color`` into ``img`` with the uint8 coverage ``alpha`` (h, w), top-left (x, y),
     clipped to the image."""
-    h, w = alpha.shape
-    ih, iw = img.shape[:2]
-    r0, c0 = max(y, 0), max(x, 0)
-    r1, c1 = min(y + h, ih), min(x + w, iw)
-    if r1 <= r0 or c1 <= c0:
+    box = clip_box(img, x, y, *alpha.shape)
+    if box is None:
         return
+    r0, r1, c0, c1 = box
     a = alpha[r0 - y : r1 - y, c0 - x : c1 - x, None].astype(np.uint16)
     region = img[r0:r1, c0:c1]
     old = region.astype(np.uint16)
