@@ -18,9 +18,11 @@
     of the two-sided Wilcoxon signed-rank test (:func:`scipy.stats.wilcoxon`, zero differences
     dropped; ``p = 1`` when every pair ties, NaN without pairs);
   - the failed episodes with their errors.
-* PNG plots (matplotlib, Agg backend): ``score_distribution.png`` (box plot and every episode per
-  scheduler), ``score_by_difficulty.png`` (means with CI bars per difficulty group),
-  ``score_per_scenario.png`` (mean and CI per scenario and scheduler), ``solve_time_vs_size.png``
+* plots (matplotlib, Agg backend), each as PNG and as PDF beside it
+  (:mod:`fcplan.experiments.plots`): ``score_distribution`` (box plot and every episode per
+  scheduler), ``score_by_difficulty`` (every episode, and the mean with its CI per difficulty
+  group), ``score_per_scenario`` (the same per scenario and scheduler; intervals far beyond the
+  episodes' range are cut at the axis and their half-width written), ``solve_time_vs_size``
   (time per scheduler call against the task graph's size, every replan, and the median against
   team size per episode).
 * ``report.html`` with ``html=True``: the same tables and the plots embedded.
@@ -295,6 +297,7 @@ def report(
     sections += [("img", image) for image in images]
     markdown = "\n\n".join(_markdown(kind, content) for kind, content in sections) + "\n"
     files = [out_dir / "report.md", *(p for _, p in images)]
+    files += [p.with_suffix(".pdf") for _, p in images]
     (out_dir / "report.md").write_text(markdown, encoding="utf-8")
     csvs = (
         ("per_scheduler", tables["per_scheduler"]),
@@ -350,7 +353,7 @@ def _tables(df: Any, diffs: list[str], metrics: list[str]) -> tuple[dict[str, An
 def _draw_plots(
     out_dir: Path, df: Any, names: list[str], diffs: list[str], scenarios: list[str], metric: str
 ) -> list[tuple[str, Path]]:
-    """Write the PNG plots; return (title, file) of each."""
+    """Write the plots (PNG, and PDF beside each); return (title, PNG file) of each."""
     mpl = require("matplotlib", "plot")
     if "matplotlib.pyplot" not in sys.modules:
         mpl.use("Agg")  # files only; a notebook keeps its own backend
@@ -366,7 +369,7 @@ def _draw_plots(
     ):
         p = out_dir / f"{name}.png"
         table = _group_table(df, [col, "scheduler"], [metric])
-        plot_grouped(table, col, groups, names, metric, label, p, colors, f"{label} {title}")
+        plot_grouped(ok, table, col, groups, names, metric, label, p, colors, f"{label} {title}")
         images.append((f"{label} {caption}", p))
     p = out_dir / "solve_time_vs_size.png"
     plot_solve_time(df, names, p, colors)
