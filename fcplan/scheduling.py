@@ -442,6 +442,8 @@ def _setting_error(name: str, settings: dict[str, Any], exc: Exception) -> Fcpla
         reason = reason[:197] + "..."
     if not settings:
         return FcplanError(f"scheduler {name!r} cannot be created: {type(exc).__name__}: {reason}")
+    if not isinstance(exc, (ValueError, TypeError)):  # say what kind of failure it was
+        reason = f"{type(exc).__name__}: {reason}"
     named = [k for k in settings if re.search(rf"(?<![\w]){re.escape(k)}(?![\w])", reason)]
     if named or len(settings) == 1:
         key = (named or list(settings))[0]

@@ -192,7 +192,7 @@ def test_failing_episode_is_recorded_and_others_complete(monkeypatch):
     real = compare_mod.run_episode
 
     def flaky(scenario, scheduler, *, seed, **kw):
-        if scheduler == "idle" and seed == 1:
+        if scheduler.name == "idle" and seed == 1:
             raise ValueError("boom\nsecond line")
         return real(scenario, scheduler, seed=seed, **kw)
 
@@ -272,8 +272,8 @@ def test_csv_round_trip(base, tmp_path):
     assert len(rows) == len(table) and list(rows[0]) == list(table[0])
     for got, want in zip(rows, table, strict=True):
         for k, v in want.items():
-            if isinstance(v, str):
-                assert got[k] == v
+            if isinstance(v, (str, bool)) or v is None:
+                assert got[k] == ("" if v is None else str(v))
             else:
                 assert float(got[k]) == pytest.approx(v, rel=1e-12, nan_ok=True), k
 
