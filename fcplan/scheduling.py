@@ -14,7 +14,9 @@ solver did.
 
 Schedulers are found by name: built-ins and third-party packages register a factory in the
 ``fcplan.schedulers`` entry-point group (``name = "module:Factory"``); :func:`register_scheduler`
-adds one at run time (handy in notebooks).
+adds one at run time (handy in notebooks). The built-ins are listed once, in the entry-point
+table of fcplan's ``pyproject.toml``: an installed fcplan reads it from its package metadata, a
+source checkout without metadata (``PYTHONPATH=.``) from the ``pyproject.toml`` next to the package.
 
 Settings. :func:`make_scheduler` is the one place where a scheduler spec (``"name:key=value"``
 or a name plus keyword settings) becomes a scheduler, for every command and API: an unknown
@@ -26,9 +28,7 @@ Factories check their settings at construction with :func:`int_setting`,
 raise :class:`SettingError`. A scheduler whose plans may depend on the wall clock offers a
 ``deterministic`` setting (work limits instead of time limits, fixed seeds, one worker);
 :func:`supports_deterministic` tells whether a factory takes it, which is how comparisons and
-sweeps turn it on by default. The built-ins are listed once, in the entry-point table
-of fcplan's ``pyproject.toml``: an installed fcplan reads it from its package metadata, a source
-checkout without metadata (``PYTHONPATH=.``) from the ``pyproject.toml`` next to the package.
+sweeps turn it on by default.
 
 Examples
 --------
