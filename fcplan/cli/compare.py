@@ -4,10 +4,13 @@
 
     fcplan compare --schedulers A,B [--scenarios 1-24] [--seeds 0-4] [--jobs N] [--time-limit S]
                    [--replan-period S] [--json PATH] [--csv PATH] [--by-difficulty] [--quiet]
+                   [--wall-time]
 
 Runs :func:`fcplan.experiments.compare.compare` and prints its table (and one per difficulty with
 ``--by-difficulty``); progress lines go to stderr unless ``--quiet``, and one warning line per
-failed episode follows the table.
+failed episode follows the table. Schedulers with a deterministic mode run in it, so the table
+does not depend on ``--jobs`` or machine load; ``--wall-time`` runs them with wall-clock limits
+instead (the table's ``mode`` column says which).
 
 Examples
 --------
@@ -78,6 +81,12 @@ def add_parser(sub: SubParsers) -> None:
     c.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
     c.add_argument("--by-difficulty", action="store_true", help="also print a table per difficulty")
     c.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
+    c.add_argument(
+        "--wall-time",
+        action="store_true",
+        help="let time limits bind on the wall clock (results depend on machine load); default: "
+        "schedulers with a deterministic mode run in it",
+    )
     c.set_defaults(run=run)
 
 
@@ -95,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
         time_limit=args.time_limit,
         replan_period=args.replan_period,
         progress=None if args.quiet else ProgressPrinter(sys.stderr),
+        deterministic=not args.wall_time,
     )
     print(result.format())
     if args.by_difficulty:

@@ -23,7 +23,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from fcplan.cli.util import SubParsers, check_output
+from fcplan.cli.util import SubParsers, check_input, check_output
 
 __all__ = ["add_parser", "run"]
 
@@ -45,6 +45,7 @@ def run(args: argparse.Namespace) -> int:
 
     out = args.out or f"{os.path.basename(os.path.normpath(args.folder)) or 'legacy'}.npz"
     check_output(out, "--out")
+    check_input(args.folder, "legacy recording", folder=True)
     rec = import_legacy(args.folder)
     rec.save(out)
     a = rec.arrays

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import argparse
 
-from fcplan.cli.util import SubParsers
+from fcplan.cli.util import SubParsers, check_input
 
 __all__ = ["add_parser", "run"]
 
@@ -36,7 +36,8 @@ def add_parser(sub: SubParsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Play or write the recording ``args.path``."""
+    """Play or write the recording ``args.path`` (a regular file: checked before it is opened)."""
     from fcplan.replay import run as run_replay
 
+    check_input(args.path, "recording")
     return run_replay(args)

@@ -3,12 +3,15 @@
 ::
 
     fcplan sweep CONFIG.toml [--results DIR] [--jobs N] [--dask ADDRESS|local] [--retry-failed]
-                             [--quiet]
+                             [--quiet] [--wall-time]
 
 Runs :func:`fcplan.experiments.sweep` (default results folder: ``results/<CONFIG stem>``, so
 re-running the same command resumes); it prints a summary, one warning line per failed episode,
 and exits 0 when every episode is stored (completed or failed) and 1 when some were lost (a worker
-died): re-run to play them.
+died): re-run to play them. A second sweep into a folder in use, or a full disk, stops with a
+one-line error (exit 2; the rows stored so far are kept); so does SIGTERM or Ctrl-C (exit 143 or
+130), after stopping the workers. ``--wall-time`` lets time limits bind on the wall clock
+(default: schedulers with a deterministic mode run in it).
 
 Examples
 --------
@@ -56,6 +59,11 @@ def add_parser(sub: SubParsers) -> None:
         "--retry-failed", action="store_true", help="also re-run episodes stored as failed"
     )
     s.add_argument("--quiet", "-q", action="store_true", help="no progress on stderr")
+    s.add_argument(
+        "--wall-time",
+        action="store_true",
+        help="let time limits bind on the wall clock (results depend on machine load)",
+    )
     s.set_defaults(run=run)
 
 
@@ -71,6 +79,7 @@ def run(args: argparse.Namespace) -> int:
         dask=args.dask,
         retry_failed=args.retry_failed,
         progress=not args.quiet,
+        deterministic=not args.wall_time,
     )
     print(summary.format())
     for e in summary.errors:

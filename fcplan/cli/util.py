@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+import stat
 from pathlib import Path
 from typing import NoReturn, TypeAlias
 
@@ -31,6 +33,7 @@ __all__ = [
     "CliError",
     "Parser",
     "SubParsers",
+    "check_input",
     "check_output",
     "name_list",
     "positive_float",
@@ -126,3 +129,26 @@ def check_output(path: str | None, option: str) -> None:
         raise CliError(f"{option} {path}: is a directory")
     if not p.parent.is_dir():
         raise CliError(f"{option} {path}: no such directory {str(p.parent)!r}")
+
+
+def check_input(path: str, what: str, *, folder: bool = False) -> None:
+    """Fail at once, without opening it, unless ``path`` is a regular file (or a folder if
+    ``folder``): a FIFO would block a reader, a device such as ``/dev/zero`` never ends.
+
+    Examples
+    --------
+    >>> check_input("/dev/zero", "recording")
+    Traceback (most recent call last):
+    ...
+    fcplan.cli.util.CliError: recording /dev/zero: not a regular file
+    """
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise CliError(f"{what} {path}: no such {'folder' if folder else 'file'}") from None
+    except OSError as exc:
+        raise CliError(f"{what} {path}: {exc.strerror or exc}") from None
+    if folder and not stat.S_ISDIR(mode):
+        raise CliError(f"{what} {path}: not a folder")
+    if not folder and not stat.S_ISREG(mode):
+        raise CliError(f"{what} {path}: not a regular file")

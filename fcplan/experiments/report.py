@@ -17,6 +17,9 @@
     of pairs, the mean difference of the metric ± its 95 % CI, wins/ties/losses, and the p-value
     of the two-sided Wilcoxon signed-rank test (:func:`scipy.stats.wilcoxon`, zero differences
     dropped; ``p = 1`` when every pair ties, NaN without pairs);
+  - the schedulers with episodes that fell back to greedy on more than half of their replans
+    (:func:`~fcplan.experiments.tables.fallback_majority`, from the ``fallbacks`` and ``replans``
+    columns): those episodes' scores are mostly greedy's;
   - the failed episodes with their errors.
 * plots (matplotlib, Agg backend), each as PNG and as PDF beside it
   (:mod:`fcplan.experiments.plots`): ``score_distribution`` (box plot and every episode per
@@ -68,7 +71,12 @@ from fcplan.experiments.plots import (
 )
 from fcplan.experiments.results import load_results
 from fcplan.experiments.stats import mean_ci
-from fcplan.experiments.tables import REPORT_COLUMNS, difficulty_key, higher_is_better
+from fcplan.experiments.tables import (
+    REPORT_COLUMNS,
+    difficulty_key,
+    fallback_majority,
+    higher_is_better,
+)
 
 __all__ = ["METRICS", "Report", "report"]
 
@@ -410,6 +418,7 @@ def _sections(
             ("table", _ci_cells(tables["per_setting"], ["scheduler", *setting_cols], metrics)),
         ]
     sections += _paired_sections(paired, metric)
+    sections += _fallback_sections(df[df["status"] == "ok"])
     failed = df[df["status"] != "ok"]
     if len(failed):
         rows = [
@@ -421,6 +430,24 @@ def _sections(
             ("table", (["scheduler", "scenario", "seed", "error"], rows)),
         ]
     return sections
+
+
+def _fallback_sections(ok: Any) -> list[Section]:
+    """A warning table of the schedulers whose episodes mostly fell back (none: nothing)."""
+    if not {"fallbacks", "replans"} <= set(ok.columns) or ok.empty:
+        return []
+    flags = ok.apply(lambda r: fallback_majority(r.to_dict()), axis=1).astype(bool)
+    counts = ok.assign(_f=flags).groupby("scheduler", sort=False)["_f"].agg(["sum", "size"])
+    rows = [[str(k), str(int(r["sum"])), str(int(r["size"]))] for k, r in counts.iterrows()]
+    rows = [r for r in rows if r[1] != "0"]
+    if not rows:
+        return []
+    note = (
+        "These episodes fell back to greedy on more than half of their replans: their scores "
+        "are mostly greedy's, not the scheduler's."
+    )
+    head = ["scheduler", "episodes mostly fallen back", "completed episodes"]
+    return [("h2", "Fallback warning"), ("p", note), ("table", (head, rows))]
 
 
 def _paired_sections(paired: Any, metric: str) -> list[Section]:

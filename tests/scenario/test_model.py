@@ -155,16 +155,29 @@ def test_scenario_modules_import_one_way():
     """The scenario package layers without cycles: parts and grid import no scenario module above
     them, validate and document import only those, model builds on all four, and read, write and
     catalogue sit on top; the package imports nothing of fcplan beyond fcplan.errors."""
-    from fcplan.scenario import catalogue, document, grid, model, parts, read, validate, write
+    from fcplan.scenario import (
+        bounds,
+        catalogue,
+        document,
+        fieldpaths,
+        grid,
+        model,
+        parts,
+        read,
+        validate,
+        write,
+    )
 
     layers = [
         (parts, set()),
         (grid, set()),
-        (validate, {"parts", "grid"}),
+        (bounds, set()),
+        (fieldpaths, {"parts"}),
+        (validate, {"parts", "grid", "bounds", "fieldpaths"}),
         (document, {"parts", "grid", "validate"}),
         (model, {"parts", "validate", "document"}),
         (catalogue, {"validate"}),
-        (read, {"catalogue", "model"}),
+        (read, {"catalogue", "model", "bounds"}),
         (write, {"document", "model"}),
     ]
     for module, allowed in layers:
