@@ -19,7 +19,7 @@ Usage::
 
 Examples
 --------
->>> _cells("motion #1   4   1800   13426 (14181)   74.5")
+>>> _cells("motion #1   4   1800   13426 ( 14181)   74.5")
 ('motion #1', [4.0, 1800.0, 13426.0, 14181.0, 74.5])
 """
 
@@ -39,7 +39,7 @@ _NUM = re.compile(r"^\(?[-+]?\d[\d,]*\.?\d*(e[-+]?\d+)?\)?%?x?$", re.IGNORECASE)
 
 def _cells(line: str) -> tuple[str, list[float]]:
     """Split a line into its label (the words before the first number) and its numbers."""
-    words = line.split()
+    words = line.replace("( ", "(").split()
     label: list[str] = []
     values: list[float] = []
     for w in words:

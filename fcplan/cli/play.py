@@ -125,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
     )
     if app.final is not None:
         m = app.final["manual"]
-        played = app.session.world.time_s
+        played = app.game.world.time_s
         print(f"played {played:g} of {app.scenario.duration_s:g} s: final score {m.final_score:.2f}"
               f" ({m.grade})")  # fmt: skip
     if app.recording_path is not None and app.recording_path.exists():

@@ -38,6 +38,7 @@ import numpy as np
 from gymnasium import spaces
 
 from fcplan.env.task import TaskEnv
+from fcplan.mission import ScenarioLike
 
 __all__ = ["TaskGymEnv", "gym_env"]
 
@@ -54,7 +55,7 @@ class TaskGymEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
 
-    def __init__(self, scenario, **kwargs: Any) -> None:
+    def __init__(self, scenario: ScenarioLike, **kwargs: Any) -> None:
         kwargs["illegal_action"] = "noop"
         self.env = TaskEnv(scenario, **kwargs)
         self.render_mode = self.env.render_mode
@@ -75,13 +76,15 @@ class TaskGymEnv(gymnasium.Env):
         e = self.env  # fresh arrays every step: no copies needed
         return {"agents": e._agent_obs, "tasks": e._task_obs, "action_mask": e._mask}
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         """Start an episode; ``seed`` as :meth:`TaskEnv.reset`."""
         super().reset(seed=seed)
         self.env.reset(seed=seed, options=options)
         return self._obs(), {"tick": 0}
 
-    def step(self, action):
+    def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         """Apply the joint action; return ``(obs, reward, terminated, truncated, info)``."""
         e = self.env
         ids = e.possible_agents
@@ -98,7 +101,7 @@ class TaskGymEnv(gymnasium.Env):
             info["return"] = first["return"]
         return self._obs(), float(rew[ids[0]]), False, bool(trunc[ids[0]]), info
 
-    def render(self):
+    def render(self) -> np.ndarray | None:
         """The task env's ``rgb_array`` frame (or None)."""
         return self.env.render()
 
@@ -106,6 +109,6 @@ class TaskGymEnv(gymnasium.Env):
         """Nothing to release."""
 
 
-def gym_env(scenario, **kwargs: Any) -> TaskGymEnv:
+def gym_env(scenario: ScenarioLike, **kwargs: Any) -> TaskGymEnv:
     """Make the Gymnasium view of the task level (keyword arguments as :class:`TaskEnv`)."""
     return TaskGymEnv(scenario, **kwargs)

@@ -11,6 +11,10 @@
 * :mod:`~fcplan.scenario.catalogue`: the shipped scenarios' names and files.
 * :mod:`~fcplan.scenario.validate`: physical validity (errors) and the manual's GUI limits.
 * :mod:`~fcplan.scenario.io`: the file functions of read, write and catalogue under one name.
+* :mod:`~fcplan.scenario.generate`: the seeded scenario generator (:class:`GeneratorConfig`, its
+  ``default``/``hard``/``scale`` presets, :func:`recipe_of`), with :mod:`~fcplan.scenario.placement`
+  (objects on the grid) and :mod:`~fcplan.scenario.knobs` (range-checked knobs). Call it as
+  ``fcplan.scenario.generate.generate(seed, **knobs)`` or ``GeneratorConfig(**knobs)(seed)``.
 
 The 25 shipped scenarios (practice and #1..#24) follow the FireCommander manual's tables for counts,
 team and fire parameters and the reference data for coordinates; each file notes where the 2020
@@ -30,6 +34,7 @@ Examples
 
 from fcplan.errors import ScenarioError, UnknownNameError
 from fcplan.scenario.catalogue import list_scenarios, scenario_path
+from fcplan.scenario.generate import PRESETS, GeneratorConfig, recipe_of
 from fcplan.scenario.grid import cell_center, cell_name
 from fcplan.scenario.model import (
     AgentSpec,
@@ -57,6 +62,9 @@ __all__ = [
     "list_scenarios",
     "scenario_path",
     "dump_scenario",
+    "GeneratorConfig",
+    "PRESETS",
+    "recipe_of",
     "cell_center",
     "cell_name",
     "ScenarioError",

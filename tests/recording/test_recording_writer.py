@@ -1,18 +1,17 @@
-"""Tests of episode recordings (fcplan.recording) and `run_episode(record=...)`."""
+"""Tests of fcplan.recording.writer: the Recorder observer, the in-memory Recording, its
+re-simulation and replay frames, and `run_episode(record=...)`."""
 
 from __future__ import annotations
 
-import io
 import json
 import os
-import zipfile
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fcplan import World, load_scenario, run_episode
+from fcplan import World, load_scenario
 from fcplan.belief import Belief
 from fcplan.cli import main
 from fcplan.recording import (
@@ -25,14 +24,6 @@ from fcplan.recording import (
 )
 from fcplan.render import snapshot
 from fcplan.team import Command
-
-
-@pytest.fixture(scope="module")
-def recorded(tmp_path_factory):
-    """Scenario #24 with greedy, seed 1, run once with a recording."""
-    path = tmp_path_factory.mktemp("rec") / "24.npz"
-    result = run_episode(24, "greedy", seed=1, record=path)
-    return result, path
 
 
 def _human_game(seed: int = 5, ticks: int = 400, picks=None) -> tuple[World, Recorder]:
@@ -186,94 +177,6 @@ def test_unseeded_recording_cannot_resimulate():
     rec.on_step(world, world.step())
     with pytest.raises(RecordingError, match="seed"):
         rec.recording().resimulate()
-
-
-def _write_npz(path, **entries):
-    with open(path, "wb") as f:
-        np.savez(f, **entries)
-
-
-@pytest.mark.parametrize(
-    "make, match",
-    [
-        (lambda p: p.write_bytes(b"not a zip file at all"), "not a readable npz"),
-        (lambda p: _write_npz(p, x=np.arange(3)), "no 'header'"),
-        (lambda p: _write_npz(p, header=np.array("{bad json")), "not valid JSON"),
-        (lambda p: _write_npz(p, header=np.array('{"format": "other"}')), "not an fcplan"),
-        (
-            lambda p: _write_npz(
-                p, header=np.array(json.dumps({"format": "fcplan-recording", "format_version": 99}))
-            ),
-            "format_version 99",
-        ),
-    ],
-)
-def test_foreign_files_are_refused(tmp_path, make, match):
-    """Foreign, non-npz and future-version files raise RecordingError naming the file."""
-    path = tmp_path / "bad.npz"
-    make(path)
-    with pytest.raises(RecordingError, match=match) as err:
-        load_recording(path)
-    assert str(path) in str(err.value)
-
-
-def test_missing_file(tmp_path):
-    """A missing file is a RecordingError, not an OSError traceback."""
-    with pytest.raises(RecordingError, match="cannot read"):
-        load_recording(tmp_path / "nope.npz")
-
-
-def test_corrupted_entries_are_refused(recorded, tmp_path):
-    """A truncated archive, an entry of the wrong dtype or shape, and inconsistent event counts
-    are each refused with the entry named."""
-    _, path = recorded
-    data = path.read_bytes()
-    (tmp_path / "cut.npz").write_bytes(data[: len(data) // 2])
-    with pytest.raises(RecordingError):
-        load_recording(tmp_path / "cut.npz")
-    with np.load(path, allow_pickle=False) as z:
-        entries = {k: z[k] for k in z.files}
-    for name, value, match in [
-        ("agent_tank", entries["agent_tank"].astype(np.float32), "agent_tank"),
-        ("active", entries["active"][:-1], "ticks"),
-        ("pruned_count", entries["pruned_count"] + 1, "pruned_count"),
-        ("sensed_cells", entries["sensed_cells"] + 10**8, "outside"),
-    ]:
-        bad = dict(entries, **{name: value})
-        p = tmp_path / f"{name}.npz"
-        _write_npz(p, **bad)
-        with pytest.raises(RecordingError, match=match):
-            load_recording(p)
-
-
-class _Boom:
-    """Unpickling this would create a file (a stand-in for os.system)."""
-
-    def __init__(self, path):
-        self.path = path
-
-    def __reduce__(self):
-        return (open, (self.path, "w"))
-
-
-def test_object_arrays_are_never_unpickled(recorded, tmp_path):
-    """An npz holding a pickled object array is refused, and the pickle's side effect never
-    happens."""
-    _, path = recorded
-    marker = tmp_path / "pwned"
-    with np.load(path, allow_pickle=False) as z:
-        entries = {k: z[k] for k in z.files}
-    evil = np.empty(1, dtype=object)
-    evil[0] = _Boom(str(marker))
-    entries["inputs"] = evil
-    p = tmp_path / "evil.npz"
-    buf = io.BytesIO()
-    np.savez(buf, **entries)
-    p.write_bytes(buf.getvalue())
-    assert b"pwned" in zipfile.ZipFile(p).read("inputs.npy")  # the payload is really there
-    with pytest.raises(RecordingError, match="pickle"):
-        load_recording(p)
-    assert not marker.exists()
 
 
 def test_cli_run_record(tmp_path, capsys):
