@@ -42,12 +42,8 @@ fcplan.errors.LegacyError: x.pkl: a value of ... elements exceeds the bound of 1
 
 from __future__ import annotations
 
-import codecs
 import io
-import pickletools
-import struct
-from collections.abc import Callable
-from typing import IO, Any
+from typing import Any
 
 import numpy as np
 
@@ -60,20 +56,29 @@ from fcplan.legacy.arrays import (
     set_dtype_state,
 )
 from fcplan.legacy.limits import DEFAULT_LIMITS, LegacyLimits
+from fcplan.legacy.opcodes import (
+    BINFLOAT,
+    BINGET,
+    BININT,
+    BININT1,
+    BINPUT,
+    F8,
+    GLOBALS,
+    I4,
+    INLINE_CODES,
+    LONG_BINGET,
+    MEMOIZE,
+    OPCODES,
+    PUT_CODES,
+    REFUSED_OPS,
+    SHORT_BINUNICODE,
+    U4,
+    MalformedError,
+    leaf_weight,
+)
 
-__all__ = ["GLOBALS", "RestrictedUnpickler"]
+__all__ = ["RestrictedUnpickler"]
 
-#: The only globals a pickle may name, and the builder each stands for.
-GLOBALS: dict[tuple[str, str], str] = {
-    ("numpy", "ndarray"): "ndarray",
-    ("numpy", "dtype"): "dtype",
-    ("_codecs", "encode"): "encode",
-    ("builtins", "bytes"): "bytes",
-    ("__builtin__", "bytes"): "bytes",
-    **{(f"numpy.{c}.multiarray", "_reconstruct"): "reconstruct" for c in ("core", "_core")},
-    **{(f"numpy.{c}.multiarray", "scalar"): "scalar" for c in ("core", "_core")},
-    **{(f"numpy.{c}.numeric", "_frombuffer"): "frombuffer" for c in ("core", "_core")},
-}
 _DATA, _ARGS, _CALL, _PENDING = "value", "argument tuple", "numpy constructor", "array in making"
 _KEY_INT = 2**61 - 1
 
@@ -92,56 +97,6 @@ class _Val:
             kind,
             False,
         )
-
-
-class _MalformedError(ValueError):
-    """The opcode stream is not a well-formed pickle."""
-
-
-def _leaf_weight(x: Any) -> int:
-    if isinstance(x, (str, bytes, bytearray)):
-        return 1 + len(x) // 8
-    if type(x) is int:
-        return 1 + x.bit_length() // 64
-    return 1
-
-
-def _read_stringnl_latin1(f: IO[bytes]) -> str:
-    """Protocol-0 ``STRING`` argument as latin-1 text (pickletools decodes it as ASCII only)."""
-    data = f.readline()
-    if not data.endswith(b"\n") or len(data) < 3 or data[0] not in b"'\"" or data[-2] != data[0]:
-        raise _MalformedError("STRING argument is not a quoted line")
-    return codecs.escape_decode(data[1:-2])[0].decode("latin1")
-
-
-def _opcode_table() -> dict[int, tuple[str, Callable[[IO[bytes]], Any] | None]]:
-    table: dict[int, tuple[str, Callable[[IO[bytes]], Any] | None]] = {}
-    for op in pickletools.opcodes:
-        reader = None if op.arg is None else op.arg.reader
-        if op.name == "STRING":
-            reader = _read_stringnl_latin1
-        table[ord(op.code)] = (op.name, reader)
-    return table
-
-
-_OPCODES = _opcode_table()
-_BINFLOAT, _BININT1, _BININT, _BINGET, _LONG_BINGET, _SBU, _SBB = b"GKJhj\x8cC"
-_BINPUT, _LONG_BINPUT, _MEMOIZE = b"qr\x94"
-_PUTS = frozenset((_BINPUT, _LONG_BINPUT, _MEMOIZE))
-_FAST = frozenset((_BINFLOAT, _BININT1, _BININT, _BINGET, _LONG_BINGET, _SBU, _SBB, *_PUTS))
-_F8, _I4, _U4 = struct.Struct(">d"), struct.Struct("<i"), struct.Struct("<I")
-_REFUSED_OPS = {
-    "PERSID": "a persistent reference",
-    "BINPERSID": "a persistent reference",
-    "OBJ": "an object construction (OBJ)",
-    "NEWOBJ": "an object construction (NEWOBJ)",
-    "NEWOBJ_EX": "an object construction (NEWOBJ_EX)",
-    "EXT1": "an extension-registry reference",
-    "EXT2": "an extension-registry reference",
-    "EXT4": "an extension-registry reference",
-    "NEXT_BUFFER": "an out-of-band buffer",
-    "READONLY_BUFFER": "an out-of-band buffer",
-}
 
 
 class RestrictedUnpickler:
@@ -194,53 +149,55 @@ class RestrictedUnpickler:
         f = io.BytesIO(data)
         handlers = {
             code: (reader, getattr(self, f"_op_{name.lower()}", None), name)
-            for code, (name, reader) in _OPCODES.items()
+            for code, (name, reader) in OPCODES.items()
         }
         pos, end = 0, len(data)
         while pos < end:
             code = data[pos]
             pos += 1
-            if code in _FAST:
+            if code in INLINE_CODES:
                 if self.built >= self.cap:
                     raise RefusedError(
                         f"more than {self.cap} values built (LegacyLimits.max_elements)"
                     )
-                if code == _BINFLOAT:
-                    stack.append(_F8.unpack_from(data, pos)[0])
+                if code == BINFLOAT:
+                    stack.append(F8.unpack_from(data, pos)[0])
                     pos += 8
-                elif code == _BININT1:
+                elif code == BININT1:
                     stack.append(data[pos])
                     pos += 1
-                elif code == _BININT:
-                    stack.append(_I4.unpack_from(data, pos)[0])
+                elif code == BININT:
+                    stack.append(I4.unpack_from(data, pos)[0])
                     pos += 4
-                elif code == _BINGET:
+                elif code == BINGET:
                     stack.append(memo[data[pos]])
                     pos += 1
-                elif code == _LONG_BINGET:
-                    stack.append(memo[_U4.unpack_from(data, pos)[0]])
+                elif code == LONG_BINGET:
+                    stack.append(memo[U4.unpack_from(data, pos)[0]])
                     pos += 4
-                elif code in _PUTS:
-                    if code == _MEMOIZE:
+                elif code in PUT_CODES:
+                    if code == MEMOIZE:
                         idx = len(memo)
-                    elif code == _BINPUT:
+                    elif code == BINPUT:
                         idx, pos = data[pos], pos + 1
                     else:
-                        idx, pos = _U4.unpack_from(data, pos)[0], pos + 4
+                        idx, pos = U4.unpack_from(data, pos)[0], pos + 4
                     self._op_put(idx)
                     continue
                 else:  # SHORT_BINUNICODE, SHORT_BINBYTES
                     n = data[pos]
                     if pos + 1 + n > end:
-                        raise _MalformedError("string argument runs past the end of the pickle")
+                        raise MalformedError("string argument runs past the end of the pickle")
                     raw = data[pos + 1 : pos + 1 + n]
-                    stack.append(raw.decode("utf-8", "surrogatepass") if code == _SBU else raw)
+                    stack.append(
+                        raw.decode("utf-8", "surrogatepass") if code == SHORT_BINUNICODE else raw
+                    )
                     pos += 1 + n
                 self.built += 1
                 continue
             entry = handlers.get(code)
             if entry is None:
-                raise _MalformedError(f"unknown opcode {bytes([code])!r} at byte {pos - 1}")
+                raise MalformedError(f"unknown opcode {bytes([code])!r} at byte {pos - 1}")
             reader, handler, name = entry
             if reader is not None:
                 f.seek(pos)
@@ -254,13 +211,13 @@ class RestrictedUnpickler:
                 return self._take(self._pop())
             else:
                 handler(arg)
-        raise _MalformedError("pickle exhausted before STOP")
+        raise MalformedError("pickle exhausted before STOP")
 
     def _refuse_op(self, name: str, arg: Any) -> None:
         if name == "INST":
             module, _, qual = str(arg).partition(" ")
             raise RefusedError(self._refused_global(module, qual))
-        raise RefusedError(f"refused {_REFUSED_OPS.get(name, name)} in the pickle")
+        raise RefusedError(f"refused {REFUSED_OPS.get(name, name)} in the pickle")
 
     @staticmethod
     def _refused_global(module: str, name: str) -> str:
@@ -278,17 +235,17 @@ class RestrictedUnpickler:
 
     def _pop(self) -> Any:
         if len(self.stack) <= (self.marks[-1] if self.marks else 0):
-            raise _MalformedError("stack underflow")
+            raise MalformedError("stack underflow")
         return self.stack.pop()
 
     def _top(self) -> Any:
         if len(self.stack) <= (self.marks[-1] if self.marks else 0):
-            raise _MalformedError("stack underflow")
+            raise MalformedError("stack underflow")
         return self.stack[-1]
 
     def _pop_mark(self) -> list[Any]:
         if not self.marks:
-            raise _MalformedError("MARK expected")
+            raise MalformedError("MARK expected")
         k = self.marks.pop()
         items = self.stack[k:]
         del self.stack[k:]
@@ -311,7 +268,7 @@ class RestrictedUnpickler:
 
     def _weighed(self, x: Any) -> tuple[Any, int, int]:
         if type(x) is not _Val:
-            return x, _leaf_weight(x), 0
+            return x, leaf_weight(x), 0
         if x.kind is not _DATA:
             raise RefusedError(f"a {x.kind} used as a value")
         x.sealed = True
@@ -320,7 +277,7 @@ class RestrictedUnpickler:
     def _target(self, kind: type) -> _Val:
         t = self._top()
         if type(t) is not _Val or t.kind is not _DATA or type(t.value) is not kind:
-            raise _MalformedError(f"expected a {kind.__name__} to add items to")
+            raise MalformedError(f"expected a {kind.__name__} to add items to")
         if t.sealed:
             raise RefusedError(f"a {kind.__name__} modified after it was used (a cycle?)")
         return t
@@ -333,7 +290,7 @@ class RestrictedUnpickler:
                 "dict keys and set members may only be strings, bytes, None, bools and ints "
                 f"below 2**61, got {type(x).__name__}"
             )
-        if _leaf_weight(x) > self.limits.max_key_weight:
+        if leaf_weight(x) > self.limits.max_key_weight:
             raise RefusedError(
                 f"a dict key of more than {8 * self.limits.max_key_weight} characters"
             )
@@ -370,7 +327,7 @@ class RestrictedUnpickler:
     # ----------------------------------------------------------------------------- stack, memo
     def _op_proto(self, arg: Any) -> None:
         if not 0 <= arg <= 5:
-            raise _MalformedError(f"unsupported pickle protocol {arg}")
+            raise MalformedError(f"unsupported pickle protocol {arg}")
 
     def _op_frame(self, arg: Any) -> None:
         pass
@@ -411,7 +368,7 @@ class RestrictedUnpickler:
         try:
             self._push(self.memo[int(arg)])
         except KeyError:
-            raise _MalformedError(f"memo index {arg} was never set") from None
+            raise MalformedError(f"memo index {arg} was never set") from None
 
     _op_binget = _op_long_binget = _op_get
 
@@ -425,7 +382,7 @@ class RestrictedUnpickler:
     def _op_stack_global(self, arg: Any) -> None:
         name, module = self._pop(), self._pop()
         if not (isinstance(module, str) and isinstance(name, str)):
-            raise _MalformedError("STACK_GLOBAL needs two strings")
+            raise MalformedError("STACK_GLOBAL needs two strings")
         self._op_global(f"{module} {name}")
 
     # ----------------------------------------------------------------------------- containers
@@ -466,7 +423,7 @@ class RestrictedUnpickler:
                     d = xd + 1
             else:
                 out.append(x)
-                w += 1 if type(x) is float else _leaf_weight(x)
+                w += 1 if type(x) is float else leaf_weight(x)
         self._check(w, d)
         t.value.extend(out)
         t.weight, t.depth = w, d
@@ -476,7 +433,7 @@ class RestrictedUnpickler:
         for x in items:
             if type(x) is not _Val:
                 out.append(x)
-                w += 1 if type(x) is float else _leaf_weight(x)
+                w += 1 if type(x) is float else leaf_weight(x)
             elif x.kind is not _DATA:
                 plain = False
                 out.append(x)  # a token in call arguments: kept as is, never data
@@ -521,7 +478,7 @@ class RestrictedUnpickler:
 
     def _set_items(self, items: list[Any]) -> None:
         if len(items) % 2:
-            raise _MalformedError("odd number of items for a dict")
+            raise MalformedError("odd number of items for a dict")
         t = self._target(dict)
         w, d, pairs = t.weight, t.depth, []
         for k, x in zip(items[::2], items[1::2], strict=True):
@@ -551,9 +508,9 @@ class RestrictedUnpickler:
     def _op_reduce(self, arg: Any) -> None:
         args, fn = self._pop(), self._pop()
         if type(fn) is not _Val or fn.kind is not _CALL:
-            raise _MalformedError("REDUCE needs a callable")
+            raise MalformedError("REDUCE needs a callable")
         if type(args) is not _Val or not isinstance(args.value, tuple):
-            raise _MalformedError("REDUCE needs an argument tuple")
+            raise MalformedError("REDUCE needs an argument tuple")
         a = args.value
         if fn.value == "reconstruct":
             if not (a and type(a[0]) is _Val and a[0].value == "ndarray"):
@@ -592,7 +549,7 @@ class RestrictedUnpickler:
         if type(t) is not _Val or t.sealed:
             raise RefusedError("BUILD on a value that is not a numpy array or dtype in making")
         if type(state) is not _Val or not isinstance(state.value, tuple):
-            raise _MalformedError("BUILD needs a state tuple")
+            raise MalformedError("BUILD needs a state tuple")
         s = state.value
         if t.kind is _PENDING:
             if len(s) == 5 and s[0] in (0, 1):
