@@ -184,7 +184,9 @@ def _recording(
     clock: np.ndarray | None,
 ) -> Recording:
     """The recording of the converted arrays (no commands or replans: the GUI has none)."""
-    from fcplan.recording import FORMAT, FORMAT_VERSION, Recording, _cast, _versions
+    from fcplan.recording import Recording
+    from fcplan.recording.reader import check_recording
+    from fcplan.recording.schema import FORMAT, FORMAT_VERSION, cast_entries, versions
 
     t_n = sc.n_ticks
     arrays.update(
@@ -210,9 +212,14 @@ def _recording(
             "frames": None if clock is None else int(len(clock)),
         },
         "ticks": t_n,
-        "versions": _versions(),
+        "versions": versions(),
     }
-    return Recording(header, _cast(arrays), [], inputs)
+    rec = Recording(header, cast_entries(arrays), [], inputs)
+    try:
+        check_recording(rec, f"{name} (converted)")  # what load_recording would refuse
+    except FcplanError as exc:
+        raise LegacyError(str(exc)) from None
+    return rec
 
 
 def _read_folder(folder: str, limits: LegacyLimits | None) -> tuple[list[str], dict[str, Any]]:

@@ -8,7 +8,7 @@ refused with :class:`~fcplan.errors.LegacyError` before it is looked up. Work an
 bounded by :class:`~fcplan.legacy.limits.LegacyLimits` (bytes per file, values built, tree size,
 nesting, memo), and every failure, malformed or hostile, is a ``LegacyError`` naming the file.
 
-:func:`read_regular_file` reads a file only if it is a regular file no larger than the bound (a
+:func:`restricted_load` reads a file only if it is a regular file no larger than the bound (a
 FIFO or device named ``*.pkl`` is refused without blocking).
 
 Examples
@@ -29,14 +29,14 @@ fcplan.errors.LegacyError: x.pkl: refused to load os.system: ...
 from __future__ import annotations
 
 import os
-import stat
 from typing import Any
 
 from fcplan.errors import LegacyError
 from fcplan.legacy.limits import DEFAULT_LIMITS, LegacyLimits
 from fcplan.legacy.machine import RestrictedUnpickler
+from fcplan.recording.reader import read_bytes
 
-__all__ = ["RestrictedUnpickler", "read_regular_file", "restricted_load", "restricted_loads"]
+__all__ = ["RestrictedUnpickler", "restricted_load", "restricted_loads"]
 
 
 def restricted_loads(
@@ -47,38 +47,9 @@ def restricted_loads(
     return RestrictedUnpickler(data, source=source, limits=limits).load()
 
 
-def read_regular_file(path: str, max_bytes: int, error: type[Exception] = LegacyError) -> bytes:
-    """The bytes of ``path`` if it is a regular file of at most ``max_bytes`` bytes.
-
-    The file is opened without blocking (a FIFO has no writer to wait for), checked with
-    ``fstat`` and read up to one byte past the bound, so neither a special file nor a huge one
-    costs time or memory. Failures raise ``error`` naming the file.
-    """
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except OSError as exc:
-        raise error(f"{path}: cannot read: {exc.strerror}") from None
-    try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise error(f"{path}: not a regular file")
-        if st.st_size > max_bytes:
-            raise error(f"{path}: {st.st_size} bytes exceeds the bound of {max_bytes}")
-        chunks, total = [], 0
-        while chunk := os.read(fd, min(1 << 20, max_bytes + 1 - total)):
-            chunks.append(chunk)
-            total += len(chunk)
-            if total > max_bytes:
-                raise error(f"{path}: grew past the bound of {max_bytes} bytes while read")
-        return b"".join(chunks)
-    except OSError as exc:
-        raise error(f"{path}: cannot read: {exc.strerror}") from None
-    finally:
-        os.close(fd)
-
-
 def restricted_load(path: str | os.PathLike[str], limits: LegacyLimits | None = None) -> Any:
     """Read one file with :func:`restricted_loads` (a regular file within ``limits.max_bytes``)."""
     path = os.fspath(path)
     limits = limits or DEFAULT_LIMITS
-    return restricted_loads(read_regular_file(path, limits.max_bytes), source=path, limits=limits)
+    data = read_bytes(path, LegacyError, limits.max_bytes)
+    return restricted_loads(data, source=path, limits=limits)
