@@ -79,10 +79,14 @@ def _row_of_ms(ms: np.ndarray | float, n_ticks: int) -> np.ndarray:
 
 @contextmanager
 def _about(path: str) -> Iterator[None]:
-    """Any failure while converting the content of ``path`` is a LegacyError naming it."""
+    """Any failure while converting the content of ``path`` is a LegacyError naming it (with its
+    folder)."""
     try:
         yield
-    except LegacyError:
+    except LegacyError as exc:
+        base, msg = os.path.basename(path), str(exc)
+        if msg.startswith(f"{base}:"):
+            raise LegacyError(f"{path}{msg[len(base) :]}") from None
         raise
     except (
         TypeError,
@@ -226,7 +230,7 @@ def _read_folder(folder: str, limits: LegacyLimits | None) -> tuple[list[str], d
     """The legacy files present in ``folder`` and their contents (restricted unpickler)."""
     if not os.path.isdir(folder):
         raise LegacyError(f"{folder}: not a folder")
-    present = [f for f in LEGACY_FILES if os.path.isfile(os.path.join(folder, f))]
+    present = [f for f in LEGACY_FILES if os.path.lexists(os.path.join(folder, f))]
     missing = [f for f in _REQUIRED if f not in present]
     if missing:
         raise LegacyError(

@@ -56,7 +56,6 @@ import math
 import os
 import stat
 import zipfile
-from collections.abc import Callable
 from typing import IO, Any
 
 import numpy as np
@@ -196,7 +195,7 @@ class _Archive:
             raise RecordingError(f"{self.path}: missing entries {', '.join(missing)}")
         sc = _scenario(header, self.path)
         a: dict[str, np.ndarray] = {}
-        a["active"] = self._array("active", lambda s: len(s) == 1 and s[0] <= sc.n_ticks)
+        a["active"] = self._array("active", _at_most(sc.n_ticks))
         dims = _dims(header, sc, len(a["active"]), self.path)
         t_n, n_agents, w = dims["T"], dims["N"], sc.world_size
         for name, f in SCHEMA.items():
@@ -253,18 +252,18 @@ class _Archive:
             )
         return f, shape, fortran, dtype
 
-    def _array(self, name: str, shape_ok: Callable[[tuple[int, ...]], bool]) -> np.ndarray:
-        """Entry ``name`` if its dtype is the schema's and ``shape_ok(shape)``; only then are its
-        bytes (charged to the budget) decompressed."""
-        f, shape, fortran, dtype = self._open(name)
+    def _array(self, name: str, shape: _Shape) -> np.ndarray:
+        """Entry ``name`` if its dtype is the schema's and its shape fits ``shape``; only then are
+        its bytes (charged to the budget) decompressed."""
+        f, declared, fortran, dtype = self._open(name)
         with f:
             want = np.dtype(SCHEMA[name].dtype)
-            if dtype != want or any(d < 0 for d in shape) or not shape_ok(shape):
+            if dtype != want or any(d < 0 for d in declared) or not shape.fits(declared):
                 raise RecordingError(
-                    f"{self.path}: entry {name!r} is declared {dtype}{list(shape)}, which this "
-                    f"recording's header does not allow (expected {want})"
+                    f"{self.path}: entry {name!r} is declared {dtype}{list(declared)}; this "
+                    f"recording's header allows {want}{shape}"
                 )
-            return self._read(f, name, shape, fortran, dtype)
+            return self._read(f, name, declared, fortran, dtype)
 
     def _read(
         self, f: IO[bytes], name: str, shape: tuple[int, ...], fortran: bool, dtype: np.dtype
@@ -309,14 +308,32 @@ class _Archive:
             ) from None
 
 
-def _exactly(want: tuple[int | None, ...]) -> Callable[[tuple[int, ...]], bool]:
-    return lambda s: (
-        len(s) == len(want) and all(w is None or w == d for w, d in zip(want, s, strict=True))
-    )
+class _Shape:
+    """The shapes an entry may declare: ``want`` (None: any length), its one length at most
+    ``most``."""
+
+    def __init__(self, want: tuple[int | None, ...], most: int | None = None) -> None:
+        self.want, self.most = want, most
+
+    def fits(self, s: tuple[int, ...]) -> bool:
+        if len(s) != len(self.want):
+            return False
+        if self.most is not None and s[0] > self.most:
+            return False
+        return all(w is None or w == d for w, d in zip(self.want, s, strict=True))
+
+    def __str__(self) -> str:
+        if self.most is not None:
+            return f"[<= {self.most}]"
+        return str(["*" if w is None else w for w in self.want])
 
 
-def _at_most(n: int) -> Callable[[tuple[int, ...]], bool]:
-    return lambda s: len(s) == 1 and s[0] <= n
+def _exactly(want: tuple[int | None, ...]) -> _Shape:
+    return _Shape(want)
+
+
+def _at_most(n: int) -> _Shape:
+    return _Shape((None,), n)
 
 
 def _nonneg_sum(a: np.ndarray, name: str, path: str) -> int:
