@@ -129,11 +129,14 @@ def _clean(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def build_array(raw: Any, dt: Any, shape: Any, fortran: Any, *, cap: int) -> np.ndarray:
+def build_array(
+    raw: Any, dt: Any, shape: Any, fortran: Any, *, cap: int, native: bool = False
+) -> np.ndarray:
     """The array of a pickled ``(shape, dtype, is_fortran, raw)`` state, checked before allocating.
 
     ``raw`` is the payload bytes for a plain dtype, or a list of built values for the object
-    dtype (in C order, as numpy writes it).
+    dtype (in C order, as numpy writes it). ``native``: convert to native byte order, as numpy's
+    ``__setstate__`` does (protocol 5's ``_frombuffer`` keeps the order).
     """
     if not isinstance(dt, np.dtype):
         raise RefusedError(f"array dtype must be a numpy dtype, got {type(dt).__name__}")
@@ -160,7 +163,10 @@ def build_array(raw: Any, dt: Any, shape: Any, fortran: Any, *, cap: int) -> np.
             f"array payload has {len(data)} bytes, shape {shape} of {dt} needs {size * dt.itemsize}"
         )
     flat = np.frombuffer(data, dtype=dt, count=size) if size else np.empty(0, dt)
-    return _clean(flat.reshape(shape, order="F" if fortran else "C").copy(order="K"))
+    out = flat.reshape(shape, order="F" if fortran else "C")
+    if native and not dt.isnative:
+        return _clean(out.astype(dt.newbyteorder("="), order="K"))
+    return _clean(out.copy(order="K"))
 
 
 def build_scalar(dt: Any, raw: Any) -> Any:

@@ -556,7 +556,9 @@ class RestrictedUnpickler:
                 s = s[1:]
             if len(s) != 4:
                 raise RefusedError(f"unexpected numpy array state of {len(s)} items")
-            self._array(t, build_array(s[3], s[1], s[0], s[2], cap=self.cap), state.weight)
+            self._array(
+                t, build_array(s[3], s[1], s[0], s[2], cap=self.cap, native=True), state.weight
+            )
         elif t.kind is _DATA and isinstance(t.value, np.dtype):
             t.value = set_dtype_state(t.value, s)
         else:
