@@ -32,6 +32,7 @@ fcplan.legacy.arrays.RefusedError: an object array from raw bytes (its bytes wou
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from typing import Any
@@ -63,7 +64,11 @@ def build_dtype(args: Any) -> np.dtype:
         raise RefusedError(
             f"numpy.dtype arguments must be (typestr, align, copy), got {args!r:.60}"
         )
-    typestr = args[0]
+    return _dtype_of(args[0])
+
+
+@functools.lru_cache(maxsize=64)
+def _dtype_of(typestr: str) -> np.dtype:
     if not DTYPE_RE.fullmatch(typestr):
         raise RefusedError(f"dtype {typestr!r:.40} is not a plain numeric, bool or string dtype")
     dt = np.dtype(typestr)
@@ -76,11 +81,18 @@ def set_dtype_state(dt: np.dtype, state: Any) -> np.dtype:
     """``dt`` with the byte order (and string width) of a dtype ``__setstate__`` tuple."""
     if not (isinstance(state, tuple) and len(state) in (8, 9) and state[0] in (3, 4)):
         raise RefusedError(f"unexpected dtype state {state!r:.60}")
+    if len(state) == 9 and state[8] not in (None, {}):
+        raise RefusedError("dtype metadata is refused")
+    if not all(v is None or type(v) in (int, str) for v in state[:8]):
+        raise RefusedError("structured and sub-array dtypes are refused")
+    return _with_state(dt, state[:8])
+
+
+@functools.lru_cache(maxsize=64)
+def _with_state(dt: np.dtype, state: tuple[Any, ...]) -> np.dtype:
     order, subarray, names, fields, elsize = state[1:6]
     if subarray is not None or names is not None or fields is not None:
         raise RefusedError("structured and sub-array dtypes are refused")
-    if len(state) == 9 and state[8] not in (None, {}):
-        raise RefusedError("dtype metadata is refused")
     if order not in ("<", ">", "|", "="):
         raise RefusedError(f"dtype byte order {order!r:.20}")
     if dt.kind in "US" and isinstance(elsize, int) and elsize > 0 and elsize != dt.itemsize:
@@ -176,4 +188,5 @@ def build_scalar(dt: Any, raw: Any) -> Any:
     data = _payload(raw, "scalar")
     if len(data) != dt.itemsize:
         raise RefusedError(f"scalar payload has {len(data)} bytes, {dt} needs {dt.itemsize}")
-    return _clean(np.frombuffer(data, dtype=dt, count=1).copy())[0]
+    one = np.frombuffer(data, dtype=dt, count=1)
+    return (_clean(one) if dt.kind in "bU" else one)[0]  # (a scalar: a copy)

@@ -72,6 +72,7 @@ from fcplan.legacy.opcodes import (
     PUT_CODES,
     REFUSED_OPS,
     SHORT_BINUNICODE,
+    SIZED_TYPES,
     U4,
     MalformedError,
     leaf_weight,
@@ -145,7 +146,7 @@ class RestrictedUnpickler:
     def _run(self) -> Any:
         """The opcode loop: the most frequent fixed-size opcodes inline, the rest through
         pickletools' argument readers and the ``_op_*`` handlers."""
-        data, stack, memo = self.data, self.stack, self.memo
+        data, stack, memo, marks = self.data, self.stack, self.memo, self.marks
         f = io.BytesIO(data)
         handlers = {
             code: (reader, getattr(self, f"_op_{name.lower()}", None), name)
@@ -182,7 +183,9 @@ class RestrictedUnpickler:
                         idx, pos = data[pos], pos + 1
                     else:
                         idx, pos = U4.unpack_from(data, pos)[0], pos + 4
-                    self._op_put(idx)
+                    if idx >= self.memo_cap or len(stack) <= (marks[-1] if marks else 0):
+                        self._op_put(idx)  # (raises the error)
+                    memo[idx] = stack[-1]
                     continue
                 else:  # SHORT_BINUNICODE, SHORT_BINBYTES
                     n = data[pos]
@@ -237,6 +240,13 @@ class RestrictedUnpickler:
         if len(self.stack) <= (self.marks[-1] if self.marks else 0):
             raise MalformedError("stack underflow")
         return self.stack.pop()
+
+    def _pop_n(self, n: int) -> list[Any]:
+        if len(self.stack) - n < (self.marks[-1] if self.marks else 0):
+            raise MalformedError("stack underflow")
+        items = self.stack[-n:]
+        del self.stack[-n:]
+        return items
 
     def _top(self) -> Any:
         if len(self.stack) <= (self.marks[-1] if self.marks else 0):
@@ -423,7 +433,7 @@ class RestrictedUnpickler:
                     d = xd + 1
             else:
                 out.append(x)
-                w += 1 if type(x) is float else leaf_weight(x)
+                w += leaf_weight(x) if type(x) in SIZED_TYPES else 1
         self._check(w, d)
         t.value.extend(out)
         t.weight, t.depth = w, d
@@ -433,7 +443,7 @@ class RestrictedUnpickler:
         for x in items:
             if type(x) is not _Val:
                 out.append(x)
-                w += 1 if type(x) is float else leaf_weight(x)
+                w += leaf_weight(x) if type(x) in SIZED_TYPES else 1
             elif x.kind is not _DATA:
                 plain = False
                 out.append(x)  # a token in call arguments: kept as is, never data
@@ -457,12 +467,10 @@ class RestrictedUnpickler:
         self._tuple([self._pop()])
 
     def _op_tuple2(self, arg: Any) -> None:
-        b, a = self._pop(), self._pop()
-        self._tuple([a, b])
+        self._tuple(self._pop_n(2))
 
     def _op_tuple3(self, arg: Any) -> None:
-        c, b, a = self._pop(), self._pop(), self._pop()
-        self._tuple([a, b, c])
+        self._tuple(self._pop_n(3))
 
     def _op_dict(self, arg: Any) -> None:
         items = self._pop_mark()

@@ -41,6 +41,10 @@ class MalformedError(ValueError):
     """The opcode stream is not a well-formed pickle."""
 
 
+#: leaf types whose weight depends on their size (every other leaf weighs 1)
+SIZED_TYPES = frozenset((str, bytes, bytearray, int))
+
+
 def leaf_weight(x: Any) -> int:
     if isinstance(x, (str, bytes, bytearray)):
         return 1 + len(x) // 8
