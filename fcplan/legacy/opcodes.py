@@ -19,6 +19,7 @@ from __future__ import annotations
 import codecs
 import pickletools
 import struct
+import warnings
 from collections.abc import Callable
 from typing import IO, Any
 
@@ -58,7 +59,9 @@ def _read_stringnl_latin1(f: IO[bytes]) -> str:
     data = f.readline()
     if not data.endswith(b"\n") or len(data) < 3 or data[0] not in b"'\"" or data[-2] != data[0]:
         raise MalformedError("STRING argument is not a quoted line")
-    return codecs.escape_decode(data[1:-2])[0].decode("latin1")
+    with warnings.catch_warnings():  # (invalid escapes warn; they decode as pickle decodes them)
+        warnings.simplefilter("ignore", DeprecationWarning)
+        return codecs.escape_decode(data[1:-2])[0].decode("latin1")
 
 
 def _opcode_table() -> dict[int, tuple[str, Callable[[IO[bytes]], Any] | None]]:

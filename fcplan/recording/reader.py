@@ -55,6 +55,7 @@ import json
 import math
 import os
 import stat
+import warnings
 import zipfile
 from typing import IO, Any
 
@@ -235,12 +236,14 @@ class _Archive:
         f = self.zf.open(info)
         try:
             version = np.lib.format.read_magic(f)
-            if version == (1, 0):
-                shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
-            elif version == (2, 0):
-                shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
-            else:
+            if version not in ((1, 0), (2, 0)):
                 raise RecordingError(f"{self.path}: entry {name!r} has .npy version {version}")
+            with warnings.catch_warnings():  # (odd headers warn; they are refused or read)
+                warnings.simplefilter("ignore")
+                read = np.lib.format.read_array_header_1_0
+                if version == (2, 0):
+                    read = np.lib.format.read_array_header_2_0
+                shape, fortran, dtype = read(f)
         except BaseException:
             f.close()
             raise
