@@ -228,6 +228,8 @@ def _row_files(directory: str | os.PathLike[str]) -> Iterator[Path]:
                 f"{p}: foreign file in a results folder (expected <key>.parquet episode files "
                 "and manifest-*.json); move it elsewhere"
             )
+        if not p.is_file():  # a FIFO, socket or device would block or never end: never opened
+            raise ResultsError(f"{p}: not a regular file (a FIFO, socket or device?); remove it")
         yield p
 
 

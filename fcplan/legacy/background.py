@@ -5,6 +5,12 @@ adv_setting, ...]``, section 3): map size, duration, fire regions (uniform or pe
 settings), depot, facilities, lakes, team and per-agent parameters; ``Battery_Info.pkl`` gives the
 capacities when present. The pruning gate is marked ``reference`` (the 2020 rule).
 
+Every number must be finite; the map side must be an integer in 100..4000 px (the GUI used 800,
+1000 and 1200), the duration in (0, 7200] s and each role's count in 0..50, so a hostile file
+cannot make the importer allocate a huge map or episode; at most 1000 fire regions,
+fronts per region, facilities of each kind and lakes. Any other layout problem is a
+:class:`~fcplan.errors.LegacyError` naming ``Background_Info.pkl``.
+
 Examples
 --------
 >>> bg = [[800, 60], [1, 1, 0], [[(450, 150)], [3, 0, 10, 5, 45, 1.25, 0.1, 90, 80, 0],
@@ -34,7 +40,7 @@ def _per_agent(entries: Any, i: int, pair: bool = False) -> Any:
         raise ValueError("empty adv_setting entry")
     item = seq[min(i, len(seq) - 1)]
     if pair:
-        return [float(v) for v in item]
+        return [_num(v, "altitude") for v in item]
     if isinstance(item, (list, tuple, np.ndarray)):
         return item[min(i, len(item) - 1)] if len(seq) == 1 else item[0]
     return item
@@ -43,42 +49,93 @@ def _per_agent(entries: Any, i: int, pair: bool = False) -> Any:
 def _num(x: Any, where: str) -> float:
     try:
         v = float(np.asarray(x).reshape(-1)[0]) if np.ndim(x) else float(x)
-    except (TypeError, ValueError, IndexError):
-        raise LegacyError(f"Background_Info.pkl: {where} must be a number, got {x!r}") from None
+    except (TypeError, ValueError, IndexError, OverflowError):
+        raise LegacyError(f"Background_Info.pkl: {where} must be a number, got {x!r:.80}") from None
+    if not np.isfinite(v):
+        raise LegacyError(f"Background_Info.pkl: {where} must be a finite number, got {v}")
     return v
+
+
+def _int_in(x: Any, where: str, lo: int, hi: int) -> int:
+    v = _num(x, where)
+    if v != int(v) or not lo <= v <= hi:
+        raise LegacyError(f"Background_Info.pkl: {where} must be an integer in {lo}..{hi}, got {v}")
+    return int(v)
+
+
+#: Bounds of the GUI's settings that size the imported episode.
+MAX_WORLD, MAX_DURATION_S, MAX_ROLE_COUNT, MAX_PLACES = 4000, 7200.0, 50, 1000
 
 
 def scenario_dict_from_background(bg: Any, batteries: Any = None, name: str = "legacy") -> dict:
     """The fcplan scenario document for a ``Background_Info.pkl`` list (section 3 layout)."""
     try:
-        env, team, loci, adv = bg[0], bg[1], bg[2], bg[3]
-        world, duration = int(_num(env[0], "W")), _num(env[1], "duration")
-        n_p, n_a, n_h = (int(_num(team[k], f"robo_team_para[{k}]")) for k in range(3))
-        centres, fs, depot = loci[0], loci[1], loci[2]
-        houses, hospitals, powers, lakes = loci[3], loci[4], loci[5], loci[6]
-    except (IndexError, TypeError, KeyError) as exc:
-        raise LegacyError(f"Background_Info.pkl: unexpected layout ({exc})") from None
-    specific = int(_num(fs[9], "fire setting mode")) == 1
+        return _scenario_dict(bg, batteries, name)
+    except LegacyError:
+        raise
+    except (IndexError, TypeError, KeyError, ValueError, OverflowError, AttributeError) as exc:
+        raise LegacyError(
+            f"Background_Info.pkl: unexpected layout ({type(exc).__name__}: {exc})"
+        ) from None
+
+
+def _bounded(group: Any, what: str) -> Any:
+    """A list of regions, facilities or lakes, refused beyond :data:`MAX_PLACES` entries."""
+    if len(group) > MAX_PLACES:
+        raise LegacyError(f"Background_Info.pkl: more than {MAX_PLACES} {what}")
+    return group
+
+
+def _regions(centres: Any, fs: Any, specific: bool) -> list[dict[str, Any]]:
+    """The fire regions: one setting for all (uniform) or one per region (specific)."""
 
     def region_param(k: int, r: int) -> float:
         v = fs[k]
         return _num(v[r] if specific and isinstance(v, (list, tuple)) else v, f"fire setting {k}")
 
-    regions = [
+    def fronts(r: int) -> int:
+        n = max(1, int(region_param(0, r)))
+        if n > MAX_PLACES:
+            raise LegacyError(f"Background_Info.pkl: more than {MAX_PLACES} fire fronts")
+        return n
+
+    return [
         {
-            "center": [float(c[0]), float(c[1])],
-            "fronts": max(1, int(region_param(0, r))),
+            "center": [_num(c[0], "fire centre"), _num(c[1], "fire centre")],
+            "fronts": fronts(r),
             "delay_s": region_param(1, r),
             "fuel": region_param(2, r),
             "wind_speed": region_param(3, r),
             "wind_dir_deg": region_param(4, r),
         }
-        for r, c in enumerate(centres)
+        for r, c in enumerate(_bounded(centres, "fire regions"))
     ]
+
+
+def _scenario_dict(bg: Any, batteries: Any, name: str) -> dict:
+    try:
+        env, team, loci, adv = bg[0], bg[1], bg[2], bg[3]
+        world = _int_in(env[0], "W", 100, MAX_WORLD)
+        duration = _num(env[1], "duration")
+        n_p, n_a, n_h = (
+            _int_in(team[k], f"robo_team_para[{k}]", 0, MAX_ROLE_COUNT) for k in range(3)
+        )
+        centres, fs, depot = loci[0], loci[1], loci[2]
+        houses, hospitals, powers, lakes = loci[3], loci[4], loci[5], loci[6]
+    except (IndexError, TypeError, KeyError) as exc:
+        raise LegacyError(f"Background_Info.pkl: unexpected layout ({exc})") from None
+    if not 0 < duration <= MAX_DURATION_S:
+        raise LegacyError(
+            f"Background_Info.pkl: duration must be in (0, {MAX_DURATION_S:g}] s, got {duration}"
+        )
+    specific = int(_num(fs[9], "fire setting mode")) == 1
+    regions = _regions(centres, fs, specific)
+    for what, group in (("lakes", lakes), ("houses", houses), ("hospitals", hospitals)):
+        _bounded(group, what)
     facilities = [
-        {"kind": kind, "center": [float(c[0]), float(c[1])]}
+        {"kind": kind, "center": [_num(c[0], kind), _num(c[1], kind)]}
         for kind, group in (("house", houses), ("hospital", hospitals), ("power_station", powers))
-        for c in group
+        for c in _bounded(group, kind)
     ]
     a_conf, h_conf = _num(fs[7], "action confidence"), _num(fs[8], "hybrid confidence")
 
@@ -98,10 +155,10 @@ def scenario_dict_from_background(bg: Any, batteries: Any = None, name: str = "l
         bats = [_per_agent(adv[batt_k], i) for i in idx]
         if batteries is not None:
             bats = [batteries[offset + i][0] for i in idx]
-        out["battery"] = [float(b) for b in bats]
-        out["speed"] = [float(_per_agent(adv[speed_k], i)) for i in idx]
+        out["battery"] = [_num(b, "battery") for b in bats]
+        out["speed"] = [_num(_per_agent(adv[speed_k], i), "speed") for i in idx]
         if tank_k is not None:
-            out["tank"] = [int(_per_agent(adv[tank_k], i)) for i in idx]
+            out["tank"] = [int(_num(_per_agent(adv[tank_k], i), "tank")) for i in idx]
             out["prune_confidence"] = (conf or 0.0) / 100.0  # (conf is given with a tank)
         return out
 
@@ -112,6 +169,8 @@ def scenario_dict_from_background(bg: Any, batteries: Any = None, name: str = "l
         }
         if n_h:
             team_doc["hybrid"] = role(n_h, 1, 4, 7, 9, n_p + n_a, h_conf)
+    except LegacyError:
+        raise
     except (IndexError, TypeError, ValueError) as exc:
         raise LegacyError(
             f"Background_Info.pkl: adv_setting has an unexpected layout ({exc})"
@@ -132,10 +191,10 @@ def scenario_dict_from_background(bg: Any, batteries: Any = None, name: str = "l
             "temporal_exponent": _num(fs[5], "temporal exponent"),
         },
         "depot": {
-            "center": [float(depot[0][0]), float(depot[0][1])],
+            "center": [_num(depot[0][0], "depot"), _num(depot[0][1], "depot")],
             "orientation": "vertical" if int(_num(depot[1], "depot orientation")) else "horizontal",
         },
         "facilities": facilities,
-        "lakes": [{"center": [float(c[0]), float(c[1])]} for c in lakes],
+        "lakes": [{"center": [_num(c[0], "lake"), _num(c[1], "lake")]} for c in lakes],
         "team": team_doc,
     }

@@ -28,12 +28,15 @@ Examples
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fcplan.errors import FcplanError, LegacyError
 from fcplan.legacy.background import scenario_dict_from_background
+from fcplan.legacy.limits import LegacyLimits
 from fcplan.legacy.unpickle import restricted_load
 
 if TYPE_CHECKING:
@@ -66,9 +69,38 @@ TICKS_PER_SECOND = 10
 
 def _row_of_ms(ms: np.ndarray | float, n_ticks: int) -> np.ndarray:
     """Trace row of an event at ``ms``: the first row whose time (``(k + 1) / 10`` s) is at or
-    after it, clipped to the episode."""
-    row = np.ceil(np.asarray(ms, dtype=np.float64) / (1000 / TICKS_PER_SECOND)).astype(np.int64) - 1
-    return np.clip(row, 0, n_ticks - 1)
+    after it, clipped to the episode. A non-finite time is a ``ValueError``."""
+    ms = np.asarray(ms, dtype=np.float64)
+    if not np.isfinite(ms).all():
+        raise ValueError("a time in ms is not a finite number")
+    row = np.ceil(ms / (1000 / TICKS_PER_SECOND)) - 1
+    return np.clip(row, 0, n_ticks - 1).astype(np.int64)
+
+
+@contextmanager
+def _about(path: str) -> Iterator[None]:
+    """Any failure while converting the content of ``path`` is a LegacyError naming it (with its
+    folder)."""
+    try:
+        yield
+    except LegacyError as exc:
+        base, msg = os.path.basename(path), str(exc)
+        if msg.startswith(f"{base}:"):
+            raise LegacyError(f"{path}{msg[len(base) :]}") from None
+        raise
+    except (
+        TypeError,
+        ValueError,
+        KeyError,
+        IndexError,
+        AttributeError,
+        OverflowError,
+        ZeroDivisionError,
+        MemoryError,
+    ) as exc:
+        raise LegacyError(
+            f"{path}: unexpected content ({type(exc).__name__}: {str(exc)[:200]})"
+        ) from None
 
 
 def _rows(x: Any, width: int, where: str) -> np.ndarray:
@@ -99,34 +131,68 @@ def _first_events(cells: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.n
     return cells[first], rows[first]
 
 
-def import_legacy(folder: str | os.PathLike[str]) -> Recording:
+def import_legacy(folder: str | os.PathLike[str], limits: LegacyLimits | None = None) -> Recording:
     """Convert a folder of the 2020 GUI's ``.pkl`` files into a :class:`fcplan.recording.Recording`.
 
-    Every file present is read with the restricted unpickler (so a malicious file is refused even
-    if its content is not needed). ``Background_Info.pkl``, ``Agent_States.pkl`` and
-    ``Fire_States.pkl`` are required.
+    Every file present is read with the restricted unpickler within ``limits`` (so a malicious
+    file is refused even if its content is not needed). ``Background_Info.pkl``,
+    ``Agent_States.pkl`` and ``Fire_States.pkl`` are required.
 
     Raises
     ------
     LegacyError
         Unsafe, missing or malformed files (the message names the file).
     """
-    from fcplan.recording import FORMAT, FORMAT_VERSION, Recording, _cast, _versions
+    folder = os.fspath(folder)
+    present, data = _read_folder(folder, limits)
+    name = os.path.basename(os.path.normpath(folder)) or "legacy"
+
+    def at(file: str) -> str:
+        return os.path.join(folder, file)
+
+    with _about(at("Background_Info.pkl")):
+        sc = _scenario(data, folder, name)
+        world = _world(sc)  # for the facility footprints only
+    t_n = sc.n_ticks
+    with _about(at("Agent_Base_Loci.pkl")):
+        clock = _frame_clock(data)
+    with _about(at("Fire_States.pkl")):
+        ign_c, ign_r, ign_row = _ignitions(data["Fire_States.pkl"], sc.world_size, t_n)
+    with _about(at("Pruned_Fire_Map.pkl")):
+        dump_rows, pru_c, pru_r, prune_row = _prunes(data, sc, ign_row)
+    with _about(at("Sensed_Fire_Map.pkl")):
+        sen_c, sen_r = _sensings(data, sc, clock, ign_row, prune_row)
+    with _about(folder):
+        arrays = _count_arrays(t_n, (ign_c, ign_r), (sen_c, sen_r), (pru_c, pru_r), prune_row)
+        arrays.update(_facility_arrays(world, t_n, (ign_c, ign_r), (pru_c, pru_r)))
+    with _about(at("Agent_States.pkl")):
+        arrays.update(_agent_arrays(data["Agent_States.pkl"], sc, world, dump_rows))
+    with _about(at("User_Data.pkl")):
+        inputs, input_ticks = _inputs(data.get("User_Data.pkl", []), sc, t_n)
+    return _recording(sc, arrays, inputs, input_ticks, name, present, clock)
+
+
+def _world(sc: Scenario) -> World:
     from fcplan.world import World
 
-    folder = os.fspath(folder)
-    present, data = _read_folder(folder)
-    name = os.path.basename(os.path.normpath(folder)) or "legacy"
-    sc = _scenario(data, folder, name)
+    return World().reset(sc, 0)
+
+
+def _recording(
+    sc: Scenario,
+    arrays: dict[str, np.ndarray],
+    inputs: list[dict[str, Any]],
+    input_ticks: list[int],
+    name: str,
+    present: list[str],
+    clock: np.ndarray | None,
+) -> Recording:
+    """The recording of the converted arrays (no commands or replans: the GUI has none)."""
+    from fcplan.recording import Recording
+    from fcplan.recording.reader import check_recording
+    from fcplan.recording.schema import FORMAT, FORMAT_VERSION, cast_entries, versions
+
     t_n = sc.n_ticks
-    world = World().reset(sc, 0)  # for the facility footprints only
-    clock = _frame_clock(data)
-    ign_c, ign_r, ign_row = _ignitions(data["Fire_States.pkl"], sc.world_size, t_n)
-    dump_rows, pru_c, pru_r, prune_row = _prunes(data, sc, ign_row)
-    sen_c, sen_r = _sensings(data, sc, clock, ign_row, prune_row)
-    arrays = _count_arrays(t_n, (ign_c, ign_r), (sen_c, sen_r), (pru_c, pru_r), prune_row)
-    arrays.update(_facility_arrays(world, t_n, (ign_c, ign_r), (pru_c, pru_r)))
-    arrays.update(_agent_arrays(data["Agent_States.pkl"], sc, world, dump_rows))
     arrays.update(
         command_tick=np.zeros(0),
         command_agent=np.zeros(0),
@@ -137,7 +203,6 @@ def import_legacy(folder: str | os.PathLike[str]) -> Recording:
         replan_tick=np.zeros(0),
         replan_wall_s=np.zeros(0),
     )
-    inputs, input_ticks = _inputs(data.get("User_Data.pkl", []), sc, t_n)
     arrays["input_tick"] = np.asarray(input_ticks, dtype=np.int64)
     header = {
         "format": FORMAT,
@@ -151,22 +216,27 @@ def import_legacy(folder: str | os.PathLike[str]) -> Recording:
             "frames": None if clock is None else int(len(clock)),
         },
         "ticks": t_n,
-        "versions": _versions(),
+        "versions": versions(),
     }
-    return Recording(header, _cast(arrays), [], inputs)
+    rec = Recording(header, cast_entries(arrays), [], inputs)
+    try:
+        check_recording(rec, f"{name} (converted)")  # what load_recording would refuse
+    except FcplanError as exc:
+        raise LegacyError(str(exc)) from None
+    return rec
 
 
-def _read_folder(folder: str) -> tuple[list[str], dict[str, Any]]:
+def _read_folder(folder: str, limits: LegacyLimits | None) -> tuple[list[str], dict[str, Any]]:
     """The legacy files present in ``folder`` and their contents (restricted unpickler)."""
     if not os.path.isdir(folder):
         raise LegacyError(f"{folder}: not a folder")
-    present = [f for f in LEGACY_FILES if os.path.isfile(os.path.join(folder, f))]
+    present = [f for f in LEGACY_FILES if os.path.lexists(os.path.join(folder, f))]
     missing = [f for f in _REQUIRED if f not in present]
     if missing:
         raise LegacyError(
             f"{folder}: missing {', '.join(missing)} (not a FireCommander recording?)"
         )
-    return present, {f: restricted_load(os.path.join(folder, f)) for f in present}
+    return present, {f: restricted_load(os.path.join(folder, f), limits) for f in present}
 
 
 def _scenario(data: dict[str, Any], folder: str, name: str) -> Scenario:
@@ -195,10 +265,11 @@ def _frame_clock(data: dict[str, Any]) -> np.ndarray | None:
 
 
 def _cells(x: np.ndarray, y: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
-    """Flat cells ``x * w + y`` of the points inside the map, and the mask of those points."""
-    xi, yi = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
-    ok = (xi >= 0) & (xi < w) & (yi >= 0) & (yi < w)
-    return xi[ok] * w + yi[ok], ok
+    """Flat cells ``x * w + y`` of the points inside the map, and the mask of those points
+    (NaN and infinite coordinates are outside)."""
+    ok = (x >= 0) & (x < w) & (y >= 0) & (y < w)
+    xi, yi = np.floor(x[ok]).astype(np.int64), np.floor(y[ok]).astype(np.int64)
+    return xi * w + yi, ok
 
 
 def _ignitions(fire_states: Any, w: int, t_n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -320,6 +391,19 @@ def _facility_arrays(
     return {"facility_burning": np.cumsum(fb, axis=0), "facility_pruned": np.cumsum(fp, axis=0)}
 
 
+#: The Agent_States.pkl values used: position, time, distance, hover frames, tank, move flag.
+_AGENT_COLUMNS = [0, 1, 2, 7, 10, 11, 12, 13]
+
+
+def _finite(a: np.ndarray, columns: Any, where: str) -> np.ndarray:
+    """``a`` if its ``columns`` hold finite numbers of magnitude below 1e15 (what the GUI wrote:
+    pixels, milliseconds, counts); LegacyError otherwise."""
+    v = a[:, columns]
+    if not (np.isfinite(v) & (np.abs(v) < 1e15)).all():
+        raise LegacyError(f"{where}: holds a non-finite or absurd value")
+    return a
+
+
 #: GUI move flag 0 / 1 / 2 -> fcplan.team.Mode returning / active / homing
 _MODE_OF_FLAG = np.array([2, 1, 3], dtype=np.int64)
 
@@ -343,7 +427,7 @@ def _agent_arrays(
             raise LegacyError(
                 f"Agent_States.pkl: agent {i} holds {a.size} values, not 16 per frame"
             )
-        a = a.reshape(-1, 16)
+        a = _finite(a.reshape(-1, 16), _AGENT_COLUMNS, f"Agent_States.pkl: agent {i}")
         a = a[np.argsort(a[:, 7], kind="stable")]
         k = np.clip(np.searchsorted(a[:, 7], tick_ms, side="right") - 1, 0, len(a) - 1)
         s = a[k]
@@ -374,7 +458,7 @@ def _inputs(user_data: Any, sc: Scenario, t_n: int) -> tuple[list[dict[str, Any]
     events: list[dict[str, Any]] = []
     ids = [a.id for a in sc.agents]
     for i, rows in enumerate(user_data):
-        a = _rows(rows, 5, "User_Data.pkl")
+        a = _finite(_rows(rows, 5, "User_Data.pkl"), slice(None), "User_Data.pkl")
         for x, y, ds, kind, goal in a:
             events.append(
                 {

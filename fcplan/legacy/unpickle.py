@@ -1,10 +1,15 @@
-"""The restricted unpickler: read the 2020 GUI's pickles without running code.
+"""Read the 2020 GUI's pickles without running code, within bounds: :func:`restricted_loads`.
 
-:class:`RestrictedUnpickler` builds lists, tuples, dicts, numbers and strings as usual and admits
-exactly the few numpy globals that rebuild arrays, dtypes and numpy scalars (and latin-1 bytes of
-protocol-2 pickles); any other global (``os.system``, ``builtins.eval``, a class) is refused with
-:class:`~fcplan.errors.LegacyError` before it is looked up, so it is never executed. Persistent
-references are refused too.
+Nothing here calls :mod:`pickle`: :class:`~fcplan.legacy.machine.RestrictedUnpickler` interprets
+the opcode stream itself and builds only ``None``, bools, numbers, strings, bytes, lists, tuples,
+dicts, sets and numeric/bool/string numpy arrays, dtypes and scalars (object arrays only element
+by element from built values). Any other global (``os.system``, ``builtins.eval``, a class) is
+refused with :class:`~fcplan.errors.LegacyError` before it is looked up. Work and memory are
+bounded by :class:`~fcplan.legacy.limits.LegacyLimits` (bytes per file, values built, tree size,
+nesting, memo), and every failure, malformed or hostile, is a ``LegacyError`` naming the file.
+
+:func:`restricted_load` reads a file only if it is a regular file no larger than the bound (a
+FIFO or device named ``*.pkl`` is refused without blocking).
 
 Examples
 --------
@@ -15,96 +20,36 @@ Examples
 Traceback (most recent call last):
 ...
 fcplan.errors.LegacyError: x.pkl: not a readable pickle (...)
+>>> restricted_loads(b"\\x80\\x02cos\\nsystem\\n.", source="x.pkl")  # doctest: +ELLIPSIS
+Traceback (most recent call last):
+...
+fcplan.errors.LegacyError: x.pkl: refused to load os.system: ...
 """
 
 from __future__ import annotations
 
-import io
 import os
-import pickle
 from typing import Any
 
-import numpy as np
-
 from fcplan.errors import LegacyError
+from fcplan.legacy.limits import DEFAULT_LIMITS, LegacyLimits
+from fcplan.legacy.machine import RestrictedUnpickler
+from fcplan.recording.reader import read_bytes
 
 __all__ = ["RestrictedUnpickler", "restricted_load", "restricted_loads"]
 
 
-def _numpy_globals() -> dict[tuple[str, str], Any]:
-    """The only globals a pickle may name: what numpy arrays, dtypes and scalars need."""
-    try:
-        from numpy._core import multiarray
-    except ImportError:  # pragma: no cover - numpy < 2
-        from numpy.core import multiarray  # type: ignore[no-redef]
-    allowed: dict[tuple[str, str], Any] = {
-        ("numpy", "ndarray"): np.ndarray,
-        ("numpy", "dtype"): np.dtype,
-        ("_codecs", "encode"): _latin1_encode,  # bytes in protocol-2 pickles
-        ("builtins", "bytes"): _small_bytes,  # b"" in protocol-2 pickles
-        ("__builtin__", "bytes"): _small_bytes,
-    }
-    for mod in ("numpy.core.multiarray", "numpy._core.multiarray"):
-        allowed[(mod, "_reconstruct")] = multiarray._reconstruct
-        allowed[(mod, "scalar")] = multiarray.scalar
-    return allowed
+def restricted_loads(
+    data: bytes, source: str = "<bytes>", limits: LegacyLimits | None = None
+) -> Any:
+    """The plain value pickled in ``data``, or :class:`~fcplan.errors.LegacyError` naming
+    ``source``."""
+    return RestrictedUnpickler(data, source=source, limits=limits).load()
 
 
-def _latin1_encode(text: str, encoding: str = "latin1") -> bytes:
-    if not isinstance(text, str) or encoding not in ("latin1", "latin-1"):
-        raise pickle.UnpicklingError("_codecs.encode is only admitted for latin1 text")
-    return text.encode("latin1")
-
-
-def _small_bytes(*args: Any) -> bytes:
-    if args:
-        raise pickle.UnpicklingError("bytes() is only admitted without arguments")
-    return b""
-
-
-_ALLOWED = _numpy_globals()
-
-
-class RestrictedUnpickler(pickle.Unpickler):
-    """An unpickler that admits only lists, tuples, dicts, numbers, strings and numpy arrays.
-
-    ``find_class`` is the only way a pickle reaches a callable; here it returns numpy's array,
-    dtype and scalar reconstructors and refuses every other name (without importing it).
-    Persistent ids are refused too.
-    """
-
-    source = "<bytes>"
-
-    def find_class(self, module: str, name: str) -> Any:
-        obj = _ALLOWED.get((module, name))
-        if obj is None:
-            raise LegacyError(
-                f"{self.source}: refused to load {module}.{name}: legacy files may only hold "
-                "lists, tuples, numbers, strings and numpy arrays"
-            )
-        return obj
-
-    def persistent_load(self, pid: Any) -> Any:
-        raise LegacyError(f"{self.source}: refused a persistent reference in the pickle")
-
-
-def restricted_loads(data: bytes, source: str = "<bytes>") -> Any:
-    """Unpickle ``data`` with :class:`RestrictedUnpickler`; refuse anything but plain data."""
-    up = RestrictedUnpickler(io.BytesIO(data), encoding="latin1")
-    up.source = source
-    try:
-        return up.load()
-    except LegacyError:
-        raise
-    except Exception as exc:  # truncated or malformed pickles raise many types
-        raise LegacyError(
-            f"{source}: not a readable pickle ({type(exc).__name__}: {exc})"
-        ) from None
-
-
-def restricted_load(path: str | os.PathLike) -> Any:
-    """Read one file with :func:`restricted_loads`."""
-    from fcplan.recording import _read_bytes
-
+def restricted_load(path: str | os.PathLike[str], limits: LegacyLimits | None = None) -> Any:
+    """Read one file with :func:`restricted_loads` (a regular file within ``limits.max_bytes``)."""
     path = os.fspath(path)
-    return restricted_loads(_read_bytes(path, LegacyError), source=path)
+    limits = limits or DEFAULT_LIMITS
+    data = read_bytes(path, LegacyError, limits.max_bytes)
+    return restricted_loads(data, source=path, limits=limits)

@@ -24,10 +24,13 @@ def dump_pickle(folder, name, obj):
         pickle.dump(obj, f, protocol=2)
 
 
-def write_legacy_folder(folder, scenario_name="practice", seed=0):
-    """Play ``scenario_name`` with greedy in fcplan and write it as the 13 files of the 2020 GUI
-    (FIRECOMMANDER.md section 7 layout; one frame per 100 ms). Returns the world."""
+def write_legacy_folder(folder, scenario_name="practice", seed=0, duration_s=None):
+    """Play ``scenario_name`` (for ``duration_s`` if given) with greedy in fcplan and write it as
+    the 13 files of the 2020 GUI (FIRECOMMANDER.md section 7 layout; one frame per 100 ms).
+    Returns the world."""
     sc = load_scenario(scenario_name)
+    if duration_s is not None:
+        sc = sc.replace(duration_s=duration_s)
     world, belief = World().reset(sc, seed), Belief(sc)
     sched = make_scheduler("greedy")
     w = sc.world_size
