@@ -490,5 +490,7 @@ def solve(
         stats = plan.stats if isinstance(plan.stats, SolveStats) else SolveStats()
     wall = time.perf_counter() - t0
     overrun = max(wall - time_limit, 0.0) if time_limit is not None else 0.0
-    stats = replace(stats, wall_time_s=wall, time_limit_s=time_limit, overrun_s=overrun)
+    # every replan records the graph's size (the scheduler's own size keys win)
+    size = {"agents": graph.n_agents, "tasks": graph.n_tasks, **stats.size}
+    stats = replace(stats, wall_time_s=wall, time_limit_s=time_limit, overrun_s=overrun, size=size)
     return plan.with_stats(stats)

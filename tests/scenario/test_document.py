@@ -175,7 +175,7 @@ def test_wrong_types_are_errors(tmp_path, old, new, field, problem):
             "[team.perception]\ncount = 1",
             "[team.perception]\ncount = -1",
             "team.perception.count",
-            "must be an integer >= 0",
+            "must be an integer in 0..10000",
         ),
         (
             'orientation = "vertical"',
