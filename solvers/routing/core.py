@@ -22,7 +22,8 @@ on at most one route) to
 with the route length ``l(r) = d[s, k_1] + ... + d[k_n, e]`` (the way to the end always counts
 against the budget ``B_v``, ``budgets``), the route cost ``c(r) = l(r)``, or ``l(r) - d[k_n, e]``
 with ``charge_return=False`` (the closing leg is free: a vehicle replans long before it flies
-home), and ``Q_v`` the most visits (``capacities``). The objective is the travel plus the prizes
+home), ``c(()) = 0`` for an empty route (the vehicle is not used), and ``Q_v`` the most visits
+(``capacities``). The objective is the travel plus the prizes
 left uncollected (a prize-collecting VRP / team orienteering problem with a budget per vehicle);
 with every prize infinite and one vehicle it is the TSP (``starts = ends``) or the shortest
 Hamiltonian path (``starts != ends``). A vehicle may always fly straight from its start to its
@@ -114,7 +115,7 @@ class RoutesResult:
         ``travel + dropped`` (see the model in :mod:`solvers.routing.core`).
     travel : float
         Cost of the routes in ``dist`` units (without the closing legs when
-        ``charge_return=False``).
+        ``charge_return=False``; an empty route costs nothing).
     dropped : float
         Prizes of the tasks left out (``inf`` never: required tasks are always served).
     bound : float
@@ -260,6 +261,8 @@ class RoutingInstance:
         travel = 0.0
         seen = np.zeros(self.n_tasks, dtype=bool)
         for v, r in enumerate(routes):
+            if not r:
+                continue  # an unused vehicle costs nothing
             legs = self.route_legs(v, r)
             travel += float(legs.sum() if self.charge_return else legs[:-1].sum())
             seen[list(r)] = True

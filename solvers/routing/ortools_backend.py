@@ -16,10 +16,13 @@ local-search metaheuristic (``metaheuristic``, default guided local search with 
 
 * in wall-clock mode at the time left before the deadline once the model is built, less
   ``reserve_s`` for reading and completing the routes (OR-Tools' own ``time_limit``);
-* in deterministic mode after ``solution_limit`` solutions (the LNS sub-searches' own wall-time
-  limit is made unreachable), never on the clock;
+* in deterministic mode after ``solution_limit`` solutions or ``branch_limit`` search branches,
+  whichever comes first (guided local search on a tiny model may find no new solution for
+  ever: the branches end it), never on the clock (the LNS sub-searches' own wall-time limit is
+  made unreachable);
 
-and in both modes after ``branch_limit`` search branches when given.
+and in wall-clock mode also after ``wall_branch_limit`` branches when given (ends the search of
+small models early).
 
 Measured choices (``bench/README.md``, "routing core"): ``PATH_CHEAPEST_ARC`` rather than
 ``PARALLEL_CHEAPEST_INSERTION`` as the first solution (the latter left TSPLIB tours 5-8 % above
@@ -68,10 +71,11 @@ class OrToolsOptions:
         ``FirstSolutionStrategy`` name.
     metaheuristic : str
         ``LocalSearchMetaheuristic`` name.
-    solution_limit : int, optional
-        Solutions before the search stops in deterministic mode.
-    branch_limit : int, optional
-        Search branches before the search stops (both modes; None: no such limit).
+    solution_limit, branch_limit : int
+        Solutions and search branches before the search stops in deterministic mode (whichever
+        comes first).
+    wall_branch_limit : int, optional
+        Search branches before the search stops in wall-clock mode (None: no such limit).
     gls_lambda : float
         Guided local search's penalty factor.
     scale : float
@@ -82,8 +86,9 @@ class OrToolsOptions:
 
     first_solution: str = "PATH_CHEAPEST_ARC"
     metaheuristic: str = "GUIDED_LOCAL_SEARCH"
-    solution_limit: int | None = 2000
-    branch_limit: int | None = None
+    solution_limit: int = 2000
+    branch_limit: int = 20_000
+    wall_branch_limit: int | None = None
     gls_lambda: float = 0.1
     scale: float = 10.0
     reserve_s: float = 0.001
@@ -96,8 +101,8 @@ class OrToolsOptions:
             names = list(enum.keys())
             if value not in names:
                 raise ValueError(f"unknown {what} {value!r}; one of {', '.join(names)}")
-        if self.solution_limit is None and self.branch_limit is None:
-            raise ValueError("deterministic mode needs solution_limit or branch_limit")
+        if self.solution_limit < 1 or self.branch_limit < 1:
+            raise ValueError("solution_limit and branch_limit must be >= 1")
         if not self.scale > 0:
             raise ValueError(f"scale must be > 0, got {self.scale!r}")
 
@@ -129,8 +134,9 @@ def solve_ortools(
                           warm_started=False, work={"branches": 0})  # fmt: skip
         params.time_limit.FromMicroseconds(max(int(time_left * 1e6), 1))
     model = rm.model
-    if opts.branch_limit is not None:
-        model.AddSearchMonitor(model.solver().BranchesLimit(int(opts.branch_limit)))
+    branches = opts.branch_limit if deadline is None else opts.wall_branch_limit
+    if branches is not None:
+        model.AddSearchMonitor(model.solver().BranchesLimit(int(branches)))
     model.CloseModelWithParameters(params)
     start = None
     if warm is not None:
@@ -161,8 +167,7 @@ def _parameters(opts: OrToolsOptions, deadline: float | None) -> Any:
     p.local_search_metaheuristic = METAHEURISTICS.Value(opts.metaheuristic)
     p.guided_local_search_lambda_coefficient = float(opts.gls_lambda)
     if deadline is None:
-        if opts.solution_limit is not None:
-            p.solution_limit = int(opts.solution_limit)
+        p.solution_limit = int(opts.solution_limit)
         # the completion searches of the LNS operators have a wall-time limit (0.1 s by
         # default): make it unreachable so that nothing depends on the machine's speed
         p.lns_time_limit.FromSeconds(3600)

@@ -98,7 +98,14 @@ def solve_pyvrp(
         init = pyvrp.Solution(
             data, [pyvrp.Route(data, r, v) for v, r in enumerate(warm) if r]
         )
-    res = pyvrp.solve(data, stop, seed=int(opts.seed), collect_stats=False, initial_solution=init)
+    # prizes may dwarf distances: PyVRP's penalties on excess duration or load must be able to
+    # outweigh a prize, else no penalty makes collecting it infeasible
+    max_prize = max((c.prize for c in data.clients()), default=0)
+    params = pyvrp.SolveParams(
+        penalty=pyvrp.PenaltyParams(max_penalty=max(pyvrp.PenaltyParams().max_penalty, 10.0 * max_prize))
+    )
+    res = pyvrp.solve(data, stop, seed=int(opts.seed), collect_stats=False, params=params,
+                      initial_solution=init)  # fmt: skip
     routes: list[list[int]] | None = None
     if res.best.is_feasible():
         routes = [[] for _ in range(inst.n_vehicles)]
@@ -141,7 +148,9 @@ def _data(inst: RoutingInstance, scale: float) -> Any:
     if inst.ok.all():
         dists, durs = [cost], [dur]
     else:
-        big = int(10 * (dur.max() + prize.max()) * (m + 1))
+        # a forbidden task costs more than any route and any prize (never worth a visit), and
+        # takes longer than any budget
+        big = int(dur.max()) * (m + 2) + int(prize.max()) + 1
         dists, durs = [], []
         for row in patterns:
             far = np.r_[np.zeros(n_d, bool), ~row]

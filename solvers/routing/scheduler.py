@@ -221,8 +221,9 @@ class RoutingScheduler:
         self._options: OrToolsOptions | PyVRPOptions = (
             OrToolsOptions(
                 first_solution=first_solution, metaheuristic=metaheuristic,
-                solution_limit=self.solution_limit, branch_limit=self.branch_limit,
-                scale=self.scale,
+                solution_limit=self.solution_limit,
+                branch_limit=self.branch_limit if self.branch_limit is not None else 1 << 62,
+                wall_branch_limit=self.branch_limit, scale=self.scale,
             )
             if backend == "ortools"
             else PyVRPOptions(iterations=self.iterations, seed=self.seed, scale=self.scale)
