@@ -76,7 +76,10 @@ def _arcs(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Every arc of every vehicle's path: (vehicle, insertion position in its route, from
     location, to location)."""
-    veh, pos, a, b = [], [], [], []
+    veh: list[int] = []
+    pos: list[int] = []
+    a: list[int] = []
+    b: list[int] = []
     for v, r in enumerate(routes):
         path = [int(inst.starts[v]), *(int(inst.tasks[k]) for k in r), int(inst.ends[v])]
         veh += [v] * (len(path) - 1)

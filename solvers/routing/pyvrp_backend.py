@@ -95,14 +95,14 @@ def solve_pyvrp(
         stop = MaxRuntime(time_left)
     init = None
     if warm is not None:
-        init = pyvrp.Solution(
-            data, [pyvrp.Route(data, r, v) for v, r in enumerate(warm) if r]
-        )
+        init = pyvrp.Solution(data, [pyvrp.Route(data, r, v) for v, r in enumerate(warm) if r])
     # prizes may dwarf distances: PyVRP's penalties on excess duration or load must be able to
     # outweigh a prize, else no penalty makes collecting it infeasible
     max_prize = max((c.prize for c in data.clients()), default=0)
     params = pyvrp.SolveParams(
-        penalty=pyvrp.PenaltyParams(max_penalty=max(pyvrp.PenaltyParams().max_penalty, 10.0 * max_prize))
+        penalty=pyvrp.PenaltyParams(
+            max_penalty=max(pyvrp.PenaltyParams().max_penalty, 10.0 * max_prize)
+        )
     )
     res = pyvrp.solve(data, stop, seed=int(opts.seed), collect_stats=False, params=params,
                       initial_solution=init)  # fmt: skip

@@ -84,9 +84,7 @@ def _section(lines: list[str], name: str) -> list[list[str]]:
 def read_coords(src: str | Path | IO[str]) -> tuple[np.ndarray, str]:
     """``(coords (n, 2), edge weight type)`` of a TSPLIB file (a path or a text stream)."""
     lines = _lines(src)
-    header = {
-        k.strip(): v.strip() for k, _, v in (ln.partition(":") for ln in lines) if _ and v
-    }
+    header = {k.strip(): v.strip() for k, _, v in (ln.partition(":") for ln in lines) if _ and v}
     kind = header.get("EDGE_WEIGHT_TYPE", "")
     if kind not in ("EUC_2D", "ATT", "GEO"):
         raise ValueError(f"only EUC_2D, ATT and GEO instances, got {kind!r}")

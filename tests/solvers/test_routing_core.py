@@ -232,7 +232,7 @@ def test_insertion_completes_routes_cut_short(seed):
         for v, r in enumerate(routes):
             for p in range(len(r) + 1):
                 longer = r[:p] + [k] + r[p:]
-                if inst.fit([[]] * v + [longer]) [v] != longer:
+                if inst.fit([[]] * v + [longer])[v] != longer:
                     continue  # infeasible
                 gain = sum(inst.evaluate(routes)) - sum(
                     inst.evaluate(routes[:v] + [longer] + routes[v + 1 :])
@@ -260,8 +260,9 @@ def test_deterministic_mode_is_identical_across_processes():
     """Deterministic mode gives the same routes and objective in two fresh processes and in
     this one (work limits and fixed seeds, nothing read from the clock)."""
     runs = [
-        subprocess.run([sys.executable, "-c", _SCRIPT], capture_output=True, text=True,
-                       check=True).stdout  # fmt: skip
+        subprocess.run(
+            [sys.executable, "-c", _SCRIPT], capture_output=True, text=True, check=True
+        ).stdout  # fmt: skip
         for _ in range(2)
     ]
     assert runs[0] == runs[1]
