@@ -9,7 +9,10 @@ task <= the vehicle's capacity). An optional task is a disjunction with penalty
 restricted. Distances are registered as matrices, never as Python callbacks, so the search never
 calls back into Python.
 
-Search: a first-solution heuristic (``first_solution``, an OR-Tools ``FirstSolutionStrategy``) or
+Search: a first-solution heuristic (``first_solution``, an OR-Tools ``FirstSolutionStrategy``
+name, or ``"auto"``: ``CHRISTOFIDES`` for a single vehicle through required tasks only, a TSP or
+shortest Hamiltonian path, else ``PARALLEL_CHEAPEST_INSERTION``, which weighs insertions against
+prizes) or
 the warm start (``ReadAssignmentFromRoutes`` then ``SolveFromAssignmentWithParameters``), then a
 local-search metaheuristic (``metaheuristic``, default guided local search with penalty factor
 ``gls_lambda``). It stops
@@ -27,9 +30,11 @@ local-search metaheuristic (``metaheuristic``, default guided local search with 
 and in wall-clock mode also after ``wall_branch_limit`` branches when given (ends the search of
 small models early).
 
-Measured choices (``bench/README.md``, "routing core"): ``PATH_CHEAPEST_ARC`` rather than
-``PARALLEL_CHEAPEST_INSERTION`` as the first solution (the latter left TSPLIB tours 5-8 % above
-the optimum for 76-130 cities), guided local search.
+Measured choices (``bench/README.md``, "routing core"): on TSPLIB tours ``CHRISTOFIDES`` was
+the most robust start (``PARALLEL_CHEAPEST_INSERTION`` stayed 4-8 % above the optimum on
+51-130 cities at 0.1 s); on the scheduler's prize-collecting models of the shipped scenarios
+``PARALLEL_CHEAPEST_INSERTION`` was (``PATH_CHEAPEST_ARC`` and ``CHRISTOFIDES`` ended up to 32 %
+and 52 % worse at the scheduler's deterministic budget).
 
 Examples
 --------
@@ -71,7 +76,7 @@ class OrToolsOptions:
     Parameters
     ----------
     first_solution : str
-        ``FirstSolutionStrategy`` name.
+        ``FirstSolutionStrategy`` name, or ``"auto"`` (see the module docstring).
     metaheuristic : str
         ``LocalSearchMetaheuristic`` name.
     solution_limit, branch_limit : int
@@ -89,7 +94,7 @@ class OrToolsOptions:
         Share of the time left (after ``reserve_s``) given to OR-Tools' own time limit.
     """
 
-    first_solution: str = "PATH_CHEAPEST_ARC"
+    first_solution: str = "auto"
     metaheuristic: str = "GUIDED_LOCAL_SEARCH"
     solution_limit: int = 2000
     branch_limit: int = 20_000
@@ -104,7 +109,7 @@ class OrToolsOptions:
             ("first_solution", self.first_solution, FIRST_SOLUTIONS),
             ("metaheuristic", self.metaheuristic, METAHEURISTICS),
         ):
-            names = list(enum.keys())
+            names = list(enum.keys()) + (["auto"] if what == "first_solution" else [])
             if value not in names:
                 raise ValueError(f"unknown {what} {value!r}; one of {', '.join(names)}")
         if self.solution_limit < 1 or self.branch_limit < 1:
@@ -133,7 +138,7 @@ def solve_ortools(
     """Search ``inst`` with OR-Tools until ``deadline`` (``perf_counter`` time; None:
     deterministic, on ``opts``' work limits), starting from ``warm`` (task positions) if given."""
     rm = _build(inst, opts)
-    params = _parameters(opts, deadline)
+    params = _parameters(opts, deadline, _first_solution(inst, opts))
     time_left = None
     if deadline is not None:
         time_left = deadline - time.perf_counter() - opts.reserve_s
@@ -168,10 +173,18 @@ def solve_ortools(
                   warm_started=start is not None, work=work)  # fmt: skip
 
 
-def _parameters(opts: OrToolsOptions, deadline: float | None) -> Any:
+def _first_solution(inst: RoutingInstance, opts: OrToolsOptions) -> str:
+    """The first-solution strategy for ``inst`` (resolves ``"auto"``)."""
+    if opts.first_solution != "auto":
+        return opts.first_solution
+    tsp = inst.n_vehicles == 1 and bool(inst.required.all()) and inst.visits[0] >= inst.n_tasks
+    return "CHRISTOFIDES" if tsp else "PARALLEL_CHEAPEST_INSERTION"
+
+
+def _parameters(opts: OrToolsOptions, deadline: float | None, first_solution: str) -> Any:
     """``RoutingSearchParameters`` of one search (the wall-time limit is set by the caller)."""
     p = pywrapcp.DefaultRoutingSearchParameters()
-    p.first_solution_strategy = FIRST_SOLUTIONS.Value(opts.first_solution)
+    p.first_solution_strategy = FIRST_SOLUTIONS.Value(first_solution)
     p.local_search_metaheuristic = METAHEURISTICS.Value(opts.metaheuristic)
     p.guided_local_search_lambda_coefficient = float(opts.gls_lambda)
     if deadline is None:

@@ -16,8 +16,9 @@ locally optimal), stopped
 
 * in deterministic mode after ``iterations`` iterations (``pyvrp.stop.MaxIterations``) with the
   fixed ``seed``: PyVRP is single-threaded, so the routes are the same in any process;
-* in wall-clock mode at the time left before the deadline once the data are built, less
-  ``reserve_s`` (``pyvrp.stop.MaxRuntime``).
+* in wall-clock mode at ``wall_fraction`` of the time left before the deadline once the data
+  are built, less ``reserve_s`` (``pyvrp.stop.MaxRuntime``; it is checked once an iteration, and
+  building the neighbourhoods and the first local optimum come before any check).
 
 PyVRP keeps the best *feasible* solution it found; if it found none (or, with forbidden tasks,
 one that breaks the input's rules), the search is treated as having found nothing.
@@ -62,16 +63,21 @@ class PyVRPOptions:
         Integer units per distance unit.
     reserve_s : float
         Seconds kept back from the deadline (wall-clock mode) for reading the routes.
+    wall_fraction : float
+        Share of the time left (after ``reserve_s``) given to ``MaxRuntime``.
     """
 
     iterations: int = 2000
     seed: int = 0
     scale: float = 10.0
     reserve_s: float = 0.001
+    wall_fraction: float = 0.9
 
     def __post_init__(self) -> None:
         if self.iterations < 0:
             raise ValueError(f"iterations must be >= 0, got {self.iterations!r}")
+        if not 0 < self.wall_fraction <= 1:
+            raise ValueError(f"wall_fraction must be in (0, 1], got {self.wall_fraction!r}")
         if not self.scale > 0:
             raise ValueError(f"scale must be > 0, got {self.scale!r}")
 
@@ -92,7 +98,7 @@ def solve_pyvrp(
         if time_left <= 0:
             return settle(inst, None, warm, backend="pyvrp", timed_out=True,
                           warm_started=False, work={"iterations": 0})  # fmt: skip
-        stop = MaxRuntime(time_left)
+        stop = MaxRuntime(opts.wall_fraction * time_left)
     init = None
     if warm is not None:
         init = pyvrp.Solution(data, [pyvrp.Route(data, r, v) for v, r in enumerate(warm) if r])
