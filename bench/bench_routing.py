@@ -8,19 +8,27 @@ Prints:
 * solve time, model size, task visits planned and status on synthetic graphs of 10 x 100, 50 x 500 and 100 x 2000
   (agents x tasks; several seeds; default settings, then deterministic mode);
 * the mean manual final score (and OFS) of ``routing`` and ``greedy`` over scenarios 1-24, seed 0,
-  played in a process pool of 2.
+  played in a process pool of 2;
+* with ``--time-limit``, whether ``plan()`` honours its wall-time limit (issue 15): on the task
+  graphs of greedy episodes of scenarios 1-24 (seed 0, every ``--every`` simulated seconds), each
+  backend plans every graph of a scenario in order (warm-started from its previous plan) at each
+  limit; prints the wall time of ``plan()`` as a multiple of the limit (p50 / p99 / max), the share
+  of calls within ``limit * 1.1 + 5 ms``, statuses and failures (RoutingFailedError: greedy stands
+  in), and the machine's load average.
 
 Usage::
 
     python bench/bench_routing.py                   # everything (~15 min on 2 cores)
     python bench/bench_routing.py --scores-only --set fire_value_px=1000
     python bench/bench_routing.py --no-scores --seeds 2
+    python bench/bench_routing.py --time-limit 0.1 0.02      # issue 15 only (~3 min)
 """
 
 from __future__ import annotations
 
 import argparse
 import collections
+import os
 import statistics
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -28,9 +36,9 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 import fcplan
-from fcplan.scheduling import solve
-from fcplan.taskgraph import synthetic_task_graph
-from solvers.routing import RoutingScheduler
+from fcplan.scheduling import make_scheduler, solve
+from fcplan.taskgraph import TaskGraph, build_task_graph, synthetic_task_graph
+from solvers.routing import RoutingFailedError, RoutingScheduler
 
 
 def pct(a, q) -> float:
@@ -109,6 +117,57 @@ def bench_scores(settings: dict) -> None:
     print(f"({time.perf_counter() - t0:.0f} s)")
 
 
+def suite_graphs(every_s: int) -> dict[int, list[TaskGraph]]:
+    """Task graphs of a greedy episode of each scenario 1-24 (seed 0), every ``every_s`` s."""
+    from fcplan import World, load_scenario
+    from fcplan.belief import Belief
+    from fcplan.plan import plan_commands
+
+    out = {}
+    for sc_id in range(1, 25):
+        sc = load_scenario(sc_id)
+        world, belief, greedy = World().reset(sc, seed=0), Belief(sc), make_scheduler("greedy")
+        graphs = []
+        while not world.done:
+            commands = None
+            if world.tick % sc.ticks_per_second == 0:
+                g = build_task_graph(sc, world.team, belief)
+                if world.tick % (every_s * sc.ticks_per_second) == 0:
+                    graphs.append(g)
+                plan = solve(greedy, g, time_limit=None, rng=world.controller_rng)
+                commands = plan_commands(plan, g)
+            belief.update(world.step(commands))
+        out[sc_id] = graphs
+    return out
+
+
+def bench_time_limit(settings: dict, limits: list[float], every_s: int) -> None:
+    graphs = suite_graphs(every_s)
+    n = sum(len(v) for v in graphs.values())
+    print(f"\n## plan() wall time against its limit: {n} graphs of scenarios 1-24 (seed 0, every "
+          f"{every_s} s), warm-started in order")  # fmt: skip
+    print(f"{'backend':<8} {'limit s':>7} {'p50 x':>6} {'p99 x':>6} {'max x':>6} "
+          f"{'within':>7} {'failed':>6}  statuses  (load)")  # fmt: skip
+    for backend in ("ortools", "pyvrp"):
+        for limit in limits:
+            walls, statuses, failed = [], collections.Counter(), 0
+            load0 = os.getloadavg()[0]
+            for sc_graphs in graphs.values():
+                sched = RoutingScheduler(**{**settings, "backend": backend})
+                for g in sc_graphs:
+                    t0 = time.perf_counter()
+                    try:
+                        statuses[sched.plan(g, time_limit=limit, rng=None).stats.status] += 1
+                    except RoutingFailedError:
+                        failed += 1
+                    walls.append(time.perf_counter() - t0)
+            w = np.array(walls)
+            within = float(np.mean(w <= 1.1 * limit + 0.005))
+            print(f"{backend:<8} {limit:>7g} {pct(w, 50) / limit:>6.2f} {pct(w, 99) / limit:>6.2f} "
+                  f"{w.max() / limit:>6.2f} {100 * within:>6.1f}% {failed:>6}  {dict(statuses)}  "
+                  f"({load0:.1f}-{os.getloadavg()[0]:.1f})", flush=True)  # fmt: skip
+
+
 def _parse(v: str):
     if v in ("True", "False", "None"):
         return {"True": True, "False": False, "None": None}[v]
@@ -126,11 +185,22 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=3, help="synthetic graphs per size")
     ap.add_argument("--scores-only", action="store_true")
     ap.add_argument("--no-scores", action="store_true")
+    ap.add_argument(
+        "--time-limit",
+        type=float,
+        nargs="+",
+        default=None,
+        help="only check plan() against these wall-time limits (s)",
+    )
+    ap.add_argument("--every", type=int, default=5, help="seconds between graphs (--time-limit)")
     args = ap.parse_args()
     settings = {}
     for kv in args.set:
         k, _, v = kv.partition("=")
         settings[k] = _parse(v)
+    if args.time_limit:
+        bench_time_limit(settings, args.time_limit, args.every)
+        return
     if not args.scores_only:
         bench_episodes(settings)
         bench_synthetic(settings, args.seeds)
