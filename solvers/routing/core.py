@@ -62,6 +62,7 @@ Examples
 A 4-city tour from city 0 (every city required; the closing leg is charged by default):
 
 >>> import numpy as np
+>>> from solvers.routing import solve_routes
 >>> xy = np.array([[0, 0], [0, 10], [10, 10], [10, 0]], dtype=float)
 >>> dist = np.linalg.norm(xy[:, None] - xy[None], axis=2)
 >>> res = solve_routes(dist, starts=[0], deterministic=True)
@@ -89,7 +90,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BACKENDS", "RoutesResult", "RoutingFailedError", "RoutingInstance", "solve_routes"]
+__all__ = ["BACKENDS", "RoutesResult", "RoutingFailedError", "RoutingInstance"]
 
 #: The backends of :func:`solve_routes`.
 BACKENDS = ("ortools", "pyvrp")
@@ -313,95 +314,3 @@ def _index_vector(name: str, x: Any, n_loc: int) -> np.ndarray:
     if arr.size and (arr.min() < 0 or arr.max() >= n_loc):
         raise ValueError(f"{name} must be location indices in [0, {n_loc}), got {arr.tolist()}")
     return arr
-
-
-def solve_routes(
-    dist: Any,
-    *,
-    starts: Any,
-    ends: Any = None,
-    prizes: Any = None,
-    budgets: Any = None,
-    capacities: Any = None,
-    allowed: Any = None,
-    charge_return: bool = True,
-    time_limit: float | None = 0.1,
-    deterministic: bool = False,
-    warm_start: Sequence[Sequence[int]] | None = None,
-    backend: str = "ortools",
-    options: Any = None,
-) -> RoutesResult:
-    """Solve one prize-collecting routing problem on a distance matrix (see the module
-    docstring for the model and the time-limit rule).
-
-    Parameters
-    ----------
-    dist : array_like, (L, L)
-        Travel between locations (>= 0; need not be symmetric).
-    starts : array_like of int, (V,)
-        Start location of each vehicle.
-    ends : array_like of int, (V,), optional
-        End location of each vehicle (default: its start, closed tours). Locations that are no
-        vehicle's start or end are the tasks.
-    prizes : array_like, (L,), optional
-        Prize of visiting each task location (``inf``: required; entries of start and end
-        locations are ignored). Default: every task is required.
-    budgets : array_like, (V,), optional
-        Most route length of each vehicle, the leg to its end included (default: none).
-    capacities : array_like of int, (V,), optional
-        Most visits of each vehicle (default: none).
-    allowed : array_like of bool, (V, L), optional
-        Which vehicle may visit which task location (default: any).
-    charge_return : bool
-        Count the closing leg into the end in the objective (it always counts for the budget).
-    time_limit : float, optional
-        Wall seconds for the whole call (ignored when ``deterministic``; None: only the work
-        limits of ``options``).
-    deterministic : bool
-        Stop on the backend's work limit only (identical routes in any process, any load).
-    warm_start : sequence of sequence of int, optional
-        Routes to start from, as task locations per vehicle (e.g. the previous replan's). Tasks
-        that are not in this problem or not allowed are skipped, routes are cut to fit.
-    backend : {"ortools", "pyvrp"}
-    options : OrToolsOptions or PyVRPOptions, optional
-        The backend's search settings (default: its defaults).
-
-    Returns
-    -------
-    RoutesResult
-
-    Raises
-    ------
-    ValueError
-        On malformed input or an unknown backend.
-    RoutingFailedError
-        If a required task cannot be served, or the search found nothing within its limit and
-        there is no usable warm start.
-    """
-    if backend not in BACKENDS:
-        raise ValueError(f"unknown backend {backend!r}; one of {', '.join(BACKENDS)}")
-    if time_limit is not None and not time_limit >= 0:
-        raise ValueError(f"time_limit must be >= 0 s or None, got {time_limit!r}")
-    import time
-
-    t0 = time.perf_counter()
-    deadline = None if deterministic or time_limit is None else t0 + float(time_limit)
-    inst = RoutingInstance.of(
-        dist, starts, ends, prizes, budgets, capacities, allowed, charge_return
-    )
-    warm = inst.warm_routes(warm_start)
-    if inst.n_tasks == 0 or inst.n_vehicles == 0:
-        return inst.result([[] for _ in range(inst.n_vehicles)], "feasible", backend)
-    if backend == "ortools":
-        from solvers.routing.ortools_backend import OrToolsOptions, solve_ortools
-
-        opts = options if options is not None else OrToolsOptions()
-        if not isinstance(opts, OrToolsOptions):
-            raise ValueError(f"backend 'ortools' takes OrToolsOptions, got {type(opts).__name__}")
-        return solve_ortools(inst, opts, deadline, warm)
-    from solvers.routing.pyvrp_backend import PyVRPOptions, solve_pyvrp
-
-    popts = options if options is not None else PyVRPOptions()
-    if not isinstance(popts, PyVRPOptions):
-        raise ValueError(f"backend 'pyvrp' takes PyVRPOptions, got {type(popts).__name__}")
-    return solve_pyvrp(inst, popts, deadline, warm)
