@@ -6,6 +6,7 @@ Prints
   written as the GUI's 13 pickles): per file, its size, ``pickle.loads`` vs
   :func:`fcplan.legacy.restricted_loads` (best of ``--repeats``), and whether both build equal
   values when the file is re-pickled in protocols 0-5; then the whole :func:`import_legacy`;
+  times are CPU seconds (``time.process_time``), best of ``--repeats``;
 * for a 180-s recording of #24 with greedy: :func:`fcplan.recording.load_recording` vs a bare
   ``numpy.load`` of every entry (what the reader did before, without its checks).
 
@@ -37,11 +38,12 @@ from fcplan.recording import load_recording  # noqa: E402
 
 
 def _best(fn: Callable[[], Any], repeats: int) -> float:
+    """Best CPU time of ``repeats`` calls (CPU, not wall: robust on a shared machine)."""
     times = []
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         fn()
-        times.append(time.perf_counter() - t0)
+        times.append(time.process_time() - t0)
     return min(times)
 
 
@@ -88,7 +90,7 @@ def legacy_table(scenario: str, repeats: int, tmp: str) -> None:
         )
     print(f"| all | | {1e3 * total_p:.0f} | {1e3 * total_r:.0f} | {total_r / total_p:.0f}x | |")
     t = _best(lambda: import_legacy(folder), repeats)
-    print(f"\nimport_legacy({scenario}): {t:.2f} s")
+    print(f"\nimport_legacy({scenario}): {t:.2f} s CPU")
 
 
 def recording_table(repeats: int, tmp: str) -> None:

@@ -4,7 +4,7 @@ A recording may come from outside (a colleague, a download), so the reader trust
 
 1. **The file.** Only a regular file is read (a FIFO or device is refused without blocking), and
    at most ``max_bytes`` of it.
-2. **The archive.** Only the documented entries (:data:`~fcplan.recording.schema.SCHEMA` and the
+2. **The archive.** At most :data:`MAX_ENTRIES` listed entries; only the documented entries (:data:`~fcplan.recording.schema.SCHEMA` and the
    JSON entries) are opened; any other entry is never decompressed. Each entry must be stored or
    deflated, unencrypted, and start with an ``.npy`` header (format 1.0 or 2.0) whose dtype is the
    schema's (an object dtype, i.e. a pickle, is refused without being read).
@@ -73,11 +73,21 @@ from fcplan.recording.schema import (
 from fcplan.recording.writer import Recording
 from fcplan.scenario import Scenario
 
-__all__ = ["MAX_BYTES", "MAX_HEADER_CHARS", "check_recording", "load_recording", "read_bytes"]
+__all__ = [
+    "MAX_BYTES",
+    "MAX_ENTRIES",
+    "MAX_HEADER_CHARS",
+    "check_recording",
+    "load_recording",
+    "read_bytes",
+]
 
 #: Default bound on a recording file and on its decompressed entries (a 180-s episode of #24 is
-#: about 0.1 MB on disk and 1 MB decompressed).
-MAX_BYTES = 512 * 2**20
+#: about 0.1 MB on disk and 1 MB decompressed; 600 s of a 30-agent 2000-px world about 20 MB).
+MAX_BYTES = 256 * 2**20
+#: Bound on the entries an archive may list (a recording has 30; each listed entry costs memory
+#: when the archive's directory is parsed, even if it is never read).
+MAX_ENTRIES = 1024
 #: Bound on the JSON header's length (a scenario with a thousand facilities is ~100 k).
 MAX_HEADER_CHARS = 4 * 2**20
 _ZIP_METHODS = (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED)
@@ -139,6 +149,8 @@ def load_recording(path: str | os.PathLike[str], *, max_bytes: int = MAX_BYTES) 
     data = read_bytes(path, RecordingError, max_bytes)
     if not data.startswith(b"PK"):
         raise RecordingError(f"{path}: not a readable npz archive (not a zip file)")
+    if _listed_entries(data) > MAX_ENTRIES:
+        raise RecordingError(f"{path}: the archive lists more than {MAX_ENTRIES} entries")
     try:
         with zipfile.ZipFile(io.BytesIO(data)) as zf:
             return _Archive(zf, path, max_bytes).recording()
@@ -148,6 +160,20 @@ def load_recording(path: str | os.PathLike[str], *, max_bytes: int = MAX_BYTES) 
         raise RecordingError(
             f"{path}: not a readable npz archive ({type(exc).__name__}: {str(exc)[:200]})"
         ) from None
+
+
+def _listed_entries(data: bytes) -> int:
+    """The entry count the archive's end record declares (0 when there is none: the zip reader
+    then refuses the file), read before the directory is parsed."""
+    end = data.rfind(b"PK\x05\x06", max(0, len(data) - 65_557))
+    if end < 0 or end + 22 > len(data):
+        return 0
+    count = int.from_bytes(data[end + 10 : end + 12], "little")
+    if count == 0xFFFF:  # zip64: the count is in the zip64 end record
+        z64 = data.rfind(b"PK\x06\x06", 0, end)
+        if z64 >= 0 and z64 + 40 <= len(data):
+            count = int.from_bytes(data[z64 + 32 : z64 + 40], "little")
+    return count
 
 
 def check_recording(rec: Recording, source: str = "<recording>") -> None:

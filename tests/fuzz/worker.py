@@ -26,7 +26,6 @@ import argparse
 import contextlib
 import json
 import os
-import resource
 import select
 import signal
 import sys
@@ -48,6 +47,8 @@ def _alarm(signum: int, frame: Any) -> None:
 
 
 def _child(target: str, path: str, timeout: float, memory_mb: int) -> dict[str, Any]:
+    import resource  # (POSIX only: imported here so that the module imports everywhere)
+
     with open("/proc/self/statm") as f:
         vm = int(f.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
     limit = vm + memory_mb * 2**20

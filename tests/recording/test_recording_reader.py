@@ -229,7 +229,8 @@ def test_header_fields_are_checked(recorded, tmp_path, edit, match):
 
 def test_damaged_archives_are_recording_errors(recorded, tmp_path):
     """Flipping any bit of the file, deeply nested header JSON, an unknown compression method or
-    an encrypted entry gives a value or a RecordingError, never another exception."""
+    an archive listing thousands of entries gives a value or a RecordingError, never another
+    exception."""
     _, path = recorded
     data = path.read_bytes()
     p = tmp_path / "d.npz"
@@ -248,6 +249,9 @@ def test_damaged_archives_are_recording_errors(recorded, tmp_path):
     p.write_bytes(bytes(raw))
     with pytest.raises(RecordingError, match="compression method 99"):
         load_recording(p)
+    many = dict(base, **{f"x{i}": b"" for i in range(2000)})
+    with pytest.raises(RecordingError, match="more than 1024 entries"):
+        load_recording(_npz(tmp_path / "many.npz", many))
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
