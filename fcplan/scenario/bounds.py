@@ -278,7 +278,8 @@ def check_document(doc: Any) -> None:
     """Refuse a parsed scenario document that is too deep or too big to read safely.
 
     Checks, without recursion: nesting of tables and arrays at most :data:`MAX_DEPTH` levels;
-    team ``count`` values of at most :data:`MAX_AGENTS` that add up to at most :data:`MAX_AGENTS`; at most :data:`MAX_REGIONS` regions, :data:`MAX_FACILITIES` facilities and
+    team ``count`` values that are integers within 0..:data:`MAX_AGENTS` and add up to at most
+    :data:`MAX_AGENTS`; at most :data:`MAX_REGIONS` regions, :data:`MAX_FACILITIES` facilities and
     :data:`MAX_LAKES` lakes. Types and everything else are left to the reader.
 
     Examples
@@ -310,8 +311,8 @@ def check_document(doc: Any) -> None:
     total = 0
     for role, t in team.items():
         count = t.get("count") if isinstance(t, Mapping) else None
-        if isinstance(count, int) and not isinstance(count, bool) and count >= 0:
-            if count > MAX_AGENTS:  # (a negative count is the reader's to report)
+        if isinstance(count, int) and not isinstance(count, bool):
+            if not 0 <= count <= MAX_AGENTS:
                 raise ScenarioError(
                     f"team.{role}.count", f"must be an integer in 0..{MAX_AGENTS}", got=count
                 )
