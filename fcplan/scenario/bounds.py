@@ -38,11 +38,11 @@ agents                          at most 10,000
 =============================== ====================== =========================================
 
 Memory. :func:`estimate_bytes` estimates the peak memory of an episode from the scenario's
-size (conservatively; measured peaks are 0.5-0.9 of it, ``bench/README.md``)::
+size, conservatively (measured peaks are 0.4-0.9 of it: ``bench/bench_memory_estimate.py``)::
 
     bytes = 128 MiB                                   interpreter, numpy, solvers
           + 24 (world_size + 1)^2                     fire, world and belief grids
-          + ticks (48 agents + 16 (facilities + 1) + 64)          the trace
+          + ticks (96 agents + 32 (facilities + 1) + 128)         the trace (and its copy)
           + 2,200 fronts                              per-front buffers
           + 64 agents (ceil(world_size / 100)^2 + 1,000)          a replan's agent x task arrays
 
@@ -59,7 +59,7 @@ Examples
 >>> from fcplan.scenario import load_scenario
 >>> s = load_scenario(12)
 >>> f"{estimate_bytes(s) / 2**20:.0f} MiB"
-'162 MiB'
+'163 MiB'
 >>> s.replace(world_size=30_000)  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
@@ -217,7 +217,7 @@ def _parts(s: Scenario) -> dict[str, float]:
     blocks = math.ceil(w / 100) ** 2
     return {
         "grid": 24.0 * (w + 1) ** 2,
-        "trace": float(s.n_ticks) * (48 * n + 16 * (len(s.facilities) + 1) + 64),
+        "trace": float(s.n_ticks) * (96 * n + 32 * (len(s.facilities) + 1) + 128),
         "fronts": 2_200.0 * sum(r.fronts for r in s.regions),
         "task graph": 64.0 * n * (blocks + 1_000),
     }
