@@ -111,6 +111,9 @@ class World:
     scenario: Scenario  # set by the first reset()
 
     def __init__(self, scenario: Scenario | None = None, seed: Seed = None) -> None:
+        # (a flag, not a look into __dict__: reading an instance's __dict__ makes Python 3.11+
+        # materialise it, and every attribute access of the per-tick path gets slower)
+        self._started = False
         if scenario is not None:
             self.reset(scenario, seed)
 
@@ -118,7 +121,7 @@ class World:
     def reset(self, scenario: Scenario | None = None, seed: Seed = None) -> World:
         """Start a new episode (same scenario if none is given); return ``self``."""
         if scenario is None:
-            if "scenario" not in self.__dict__:
+            if not self._started:
                 raise ValueError("World.reset needs a scenario the first time")
             scenario = self.scenario
         self.scenario = scenario
@@ -154,6 +157,7 @@ class World:
         self.n_sensed_ever = 0
         self.tick = 0
         self._alloc_trace(scenario.n_ticks)
+        self._started = True
         return self
 
     def _alloc_trace(self, rows: int) -> None:
@@ -215,7 +219,7 @@ class World:
     # ------------------------------------------------------------------ dynamics
     def step(self, commands: Mapping[str | int, Command] | None = None) -> StepInfo:
         """Advance one tick with optional per-agent commands; return what happened."""
-        if "tick" not in self.__dict__:
+        if not self._started:
             raise ValueError("World.step before World.reset")
         team, fire = self.team, self.fire
         if commands:  # (Team.apply does nothing without commands: the call is saved)
