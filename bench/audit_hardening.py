@@ -23,6 +23,7 @@ Categories:
 Usage::
 
     PYTHONPATH=$PWD nice python bench/audit_hardening.py --mutants 600 --seed 0
+    PYTHONPATH=$PWD nice python bench/audit_hardening.py --only arguments,sweeps
 """
 
 from __future__ import annotations
@@ -292,17 +293,22 @@ def main() -> None:
     ap.add_argument("--mutants", type=int, default=600)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--timeout", type=float, default=180.0)
+    ap.add_argument("--only", default="mutants,files,arguments,sweeps")
     args = ap.parse_args()
     libc = ctypes.CDLL(None)
     libc.prctl(_PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
+    runs = {
+        "mutants": lambda d: mutants(args.mutants, args.seed, d, args.timeout),
+        "files": lambda d: special_files(d, args.timeout),
+        "arguments": lambda d: arguments(d, args.timeout),
+        "sweeps": lambda d: sweep_abuse(d, args.timeout),
+    }
     rows = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        folder = Path(tmp)
-        t0 = time.time()
-        rows["mutants"] = mutants(args.mutants, args.seed, folder, args.timeout)
-        rows["files"] = special_files(folder, args.timeout)
-        rows["arguments"] = arguments(folder, args.timeout)
-        rows["sweeps"] = sweep_abuse(folder, args.timeout)
+    t0 = time.time()
+    for name in args.only.split(","):
+        with tempfile.TemporaryDirectory() as tmp:
+            rows[name] = runs[name](Path(tmp))
+        print(f"{name}: " + ", ".join(f"{o} {rows[name][o]}" for o in Outcome.ALL), flush=True)
     print(f"\n{'category':<10} {'tried':>6} " + " ".join(f"{o:>12}" for o in Outcome.ALL))
     for name, c in rows.items():
         print(f"{name:<10} {sum(c.values()):>6} " + " ".join(f"{c[o]:>12}" for o in Outcome.ALL))

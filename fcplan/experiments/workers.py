@@ -5,8 +5,8 @@ Episodes run in worker processes that ignore Ctrl-C (the parent handles it and s
 know the schedulers registered at run time in the parent (:func:`fcplan.register_scheduler`),
 which a fresh process would not, and that die with their parent: on Linux the kernel sends them
 SIGKILL when it dies (``prctl(PR_SET_PDEATHSIG)``), and everywhere a watchdog thread ends the
-worker within :data:`WATCHDOG_PERIOD_S` of its parent's death (its parent pid changes or stops
-existing). So ``kill -9`` of a sweep or a comparison leaves no worker holding its pipes.
+worker within :data:`WATCHDOG_PERIOD_S` of its parent's death (the parent pid stops existing or
+the worker is re-parented). So ``kill -9`` of a sweep or a comparison leaves no worker holding its pipes.
 
 Examples
 --------
@@ -91,9 +91,10 @@ def die_with_parent(parent: int) -> None:
 
     On Linux, ``prctl(PR_SET_PDEATHSIG, SIGKILL)`` asks the kernel to kill this process when the
     thread that forked it exits; and a daemon thread checks every :data:`WATCHDOG_PERIOD_S` that
-    this process's parent is still ``parent`` and alive, and else ends it with ``os._exit(1)``
-    (the portable fallback, which also covers a parent whose forking thread ended early). If
-    ``parent`` is already gone, this process ends at once.
+    ``parent`` is alive and this process was not re-parented, and else ends it with
+    ``os._exit(1)`` (the portable fallback, which also covers a parent whose forking thread ended
+    early). The process that forked this one may be ``parent`` itself or a fork server it started
+    (the ``forkserver`` start method). If ``parent`` is already gone, this process ends at once.
     """
     if sys.platform.startswith("linux"):
         try:
@@ -101,15 +102,17 @@ def die_with_parent(parent: int) -> None:
             libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
         except (OSError, AttributeError):  # pragma: no cover - no usable libc: the thread acts
             pass
-    if not _parent_alive(parent):
+    ppid = os.getppid()  # ``parent`` itself, or a fork server it started
+    if not _parent_alive(parent, ppid):
         os._exit(1)
     threading.Thread(
-        target=_watch, args=(parent,), name="fcplan-parent-watchdog", daemon=True
+        target=_watch, args=(parent, ppid), name="fcplan-parent-watchdog", daemon=True
     ).start()
 
 
-def _parent_alive(parent: int) -> bool:
-    if os.getppid() != parent:
+def _parent_alive(parent: int, ppid: int) -> bool:
+    """``parent`` exists and this process was not re-parented (``ppid``, its parent, lives)."""
+    if os.getppid() != ppid:
         return False
     try:
         os.kill(parent, 0)
@@ -120,8 +123,8 @@ def _parent_alive(parent: int) -> bool:
     return True
 
 
-def _watch(parent: int) -> None:  # pragma: no cover - runs in pool workers
-    while _parent_alive(parent):
+def _watch(parent: int, ppid: int) -> None:  # pragma: no cover - runs in pool workers
+    while _parent_alive(parent, ppid):
         time.sleep(WATCHDOG_PERIOD_S)
     os._exit(1)
 

@@ -125,15 +125,28 @@ def _finish(trial: Trial, config: Path, results: Path, workers: list[int]) -> Tr
     return trial
 
 
+def _communicate(proc: subprocess.Popen, workers: list[int], timeout: float) -> tuple[str, list]:
+    """stderr of ``proc`` once it ended; if its pipe stays open past ``timeout`` (workers that
+    outlived it hold it), those workers are the orphans: they are killed and returned."""
+    try:
+        return proc.communicate(timeout=timeout)[1], []
+    except subprocess.TimeoutExpired:
+        orphans = [w for w in workers if alive(w)]
+        for w in orphans:
+            os.kill(w, signal.SIGKILL)
+        return proc.communicate()[1], orphans
+
+
 def kill_parent(folder: Path, sig: int = signal.SIGKILL) -> Trial:
     """Kill (or terminate) a running sweep's parent process, then resume."""
     config, results = write_config(folder), folder / "results"
     proc = start_sweep(config, results)
     workers = _running(proc, results)
     proc.send_signal(sig)
-    _, err = proc.communicate(timeout=60)
-    trial = Trial(status=proc.returncode, stderr=err)
-    return _finish(trial, config, results, workers)
+    err, held = _communicate(proc, workers, 60)
+    trial = _finish(Trial(status=proc.returncode, stderr=err), config, results, workers)
+    trial.orphans += held
+    return trial
 
 
 def kill_worker(folder: Path) -> Trial:
