@@ -103,7 +103,8 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers.routing.core import BACKENDS, RoutesResult, solve_routes
+from solvers.routing.core import solve_routes
+from solvers.routing.instance import BACKENDS, RoutesResult
 from solvers.routing.ortools_backend import OrToolsOptions
 from solvers.routing.pyvrp_backend import PyVRPOptions
 
