@@ -44,11 +44,11 @@ The core on a plain distance matrix (a 4-city tour from city 0, every city requi
 (40.0, [1, 2, 3])
 """
 
-from solvers.routing.core import solve_routes
-from solvers.routing.instance import BACKENDS, RoutesResult, RoutingFailedError
+from solvers.routing.core import BACKENDS, RoutesResult, RoutingFailedError
 from solvers.routing.ortools_backend import OrToolsOptions
 from solvers.routing.pyvrp_backend import PyVRPOptions
 from solvers.routing.scheduler import PyVRPRoutingScheduler, RoutingScheduler
+from solvers.routing.solve import solve_routes
 
 __all__ = [
     "BACKENDS",

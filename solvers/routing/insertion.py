@@ -11,7 +11,7 @@ for single insertions, which a route cut short by a time-out is not.
 Examples
 --------
 >>> import numpy as np
->>> from solvers.routing.instance import RoutingInstance
+>>> from solvers.routing.core import RoutingInstance
 >>> xy = np.array([[0, 0], [0, 10], [10, 10], [10, 0]], dtype=float)
 >>> dist = np.linalg.norm(xy[:, None] - xy[None], axis=2)
 >>> inst = RoutingInstance.of(dist, starts=[0], ends=[3])  # tasks: locations 1 and 2
@@ -25,7 +25,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from solvers.routing.instance import TOL, RoutesResult, RoutingFailedError, RoutingInstance
+from solvers.routing.core import TOL, RoutesResult, RoutingFailedError, RoutingInstance
 
 __all__ = ["complete_by_insertion", "settle"]
 
@@ -102,7 +102,7 @@ def settle(
     """The result of a search that ended with ``routes`` (task positions; None: nothing found),
     by the time-limit rule of :mod:`solvers.routing.core`: a search cut by the clock is completed
     by insertion, or replaced by the warm start ``warm`` when that is better or the search found
-    nothing; with neither, :class:`~solvers.routing.instance.RoutingFailedError` is raised."""
+    nothing; with neither, :class:`~solvers.routing.core.RoutingFailedError` is raised."""
     status = "time_limit" if timed_out else "feasible"
     flags = {"warm_started": warm_started, "work": work}
     if routes is None:

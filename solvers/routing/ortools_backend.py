@@ -39,7 +39,7 @@ and 52 % worse at the scheduler's deterministic budget).
 Examples
 --------
 >>> import numpy as np
->>> from solvers.routing.instance import RoutingInstance
+>>> from solvers.routing.core import RoutingInstance
 >>> xy = np.array([[0, 0], [0, 10], [10, 10], [10, 0]], dtype=float)
 >>> inst = RoutingInstance.of(np.linalg.norm(xy[:, None] - xy[None], axis=2), [0], [3])
 >>> solve_ortools(inst, OrToolsOptions(solution_limit=10), None, None).routes
@@ -55,8 +55,8 @@ from typing import Any
 import numpy as np
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
+from solvers.routing.core import RoutesResult, RoutingFailedError, RoutingInstance
 from solvers.routing.insertion import settle
-from solvers.routing.instance import RoutesResult, RoutingFailedError, RoutingInstance
 
 __all__ = ["FIRST_SOLUTIONS", "METAHEURISTICS", "OrToolsOptions", "solve_ortools"]
 

@@ -26,7 +26,7 @@ one that breaks the input's rules), the search is treated as having found nothin
 Examples
 --------
 >>> import numpy as np
->>> from solvers.routing.instance import RoutingInstance
+>>> from solvers.routing.core import RoutingInstance
 >>> xy = np.array([[0, 0], [0, 10], [10, 10], [10, 0]], dtype=float)
 >>> inst = RoutingInstance.of(np.linalg.norm(xy[:, None] - xy[None], axis=2), [0])
 >>> sorted(solve_pyvrp(inst, PyVRPOptions(iterations=50), None, None).routes[0])
@@ -43,8 +43,8 @@ import numpy as np
 import pyvrp
 from pyvrp.stop import MaxIterations, MaxRuntime
 
+from solvers.routing.core import RoutesResult, RoutingInstance
 from solvers.routing.insertion import settle
-from solvers.routing.instance import RoutesResult, RoutingInstance
 
 __all__ = ["PyVRPOptions", "solve_pyvrp"]
 

@@ -77,9 +77,9 @@ order, cut to fit its tank, visits and battery. ``warm_start="fallback"`` (defau
 only as the answer when the clock ends a search before it found anything;
 ``warm_start="search"`` also starts each search from them; ``"off"`` never uses them. The
 memory is dropped when the graph's time does not advance (a new episode) or the agents change.
-Starting the search from the last plan cost score: paired over scenarios 1-24 x seeds 0-2 it was
--11.5 [-19.2, -3.8] points against the previous scheduler (``bench/README.md``), so it is not
-the default.
+Starting the search from the last plan scored -11.5 [-19.2, -3.8] points against the previous
+scheduler, paired over scenarios 1-24 x seeds 0-2 (wall-clock mode on a loaded machine; see
+``bench/README.md``), so it is not the default.
 
 **Time limit**: a search cut by the clock is never handed back as a decision
 (:mod:`solvers.routing.core`): if it found nothing, the warm start is kept; unfinished routes
@@ -107,10 +107,10 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers.routing.core import solve_routes
-from solvers.routing.instance import BACKENDS, RoutesResult
+from solvers.routing.core import BACKENDS, RoutesResult
 from solvers.routing.ortools_backend import OrToolsOptions
 from solvers.routing.pyvrp_backend import PyVRPOptions
+from solvers.routing.solve import solve_routes
 
 __all__ = ["WARM_STARTS", "PyVRPRoutingScheduler", "RoutingScheduler"]
 

@@ -17,8 +17,8 @@ from solvers.routing import (
     RoutingFailedError,
     solve_routes,
 )
+from solvers.routing.core import RoutingInstance
 from solvers.routing.insertion import complete_by_insertion
-from solvers.routing.instance import RoutingInstance
 
 BACKENDS = ["ortools", "pyvrp"]
 
