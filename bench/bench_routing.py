@@ -14,7 +14,15 @@ Prints:
   backend plans every graph of a scenario in order (warm-started from its previous plan) at each
   limit; prints the wall time of ``plan()`` as a multiple of the limit (p50 / p99 / max), the share
   of calls within ``limit * 1.1 + 5 ms``, statuses and failures (RoutingFailedError: greedy stands
-  in), and the machine's load average.
+  in), and the machine's load average;
+* with ``--first-solutions``, the objective of each OR-Tools first-solution strategy on the
+  scheduler's own models (graphs of greedy episodes of scenarios 2, 4, 12, 21, 24 and the
+  open-world example at 10, 30, 60, 90, 120 s, and three 10 x 100 synthetic graphs;
+  deterministic mode, no warm start), relative to the best strategy on each graph;
+* with ``--paired BEFORE.json AFTER.json`` (two ``fcplan compare --json`` files over the same
+  scenarios and seeds), the paired difference AFTER - BEFORE of each scheduler's manual final
+  score, and of routing - greedy within each file: mean and 95 % t-interval over the
+  (scenario, seed) pairs.
 
 Usage::
 
@@ -22,6 +30,8 @@ Usage::
     python bench/bench_routing.py --scores-only --set fire_value_px=1000
     python bench/bench_routing.py --no-scores --seeds 2
     python bench/bench_routing.py --time-limit 0.1 0.02      # issue 15 only (~3 min)
+    python bench/bench_routing.py --first-solutions          # ~2 min
+    python bench/bench_routing.py --paired before.json after.json
 """
 
 from __future__ import annotations
@@ -168,6 +178,75 @@ def bench_time_limit(settings: dict, limits: list[float], every_s: int) -> None:
                   f"({load0:.1f}-{os.getloadavg()[0]:.1f})", flush=True)  # fmt: skip
 
 
+FIRST_SOLUTIONS = (
+    "PATH_CHEAPEST_ARC",
+    "PARALLEL_CHEAPEST_INSERTION",
+    "CHRISTOFIDES",
+    "SAVINGS",
+    "LOCAL_CHEAPEST_INSERTION",
+    "GLOBAL_CHEAPEST_ARC",
+)
+
+
+def bench_first_solutions(settings: dict) -> None:
+    from tests.solvers.graphs import episode_graphs
+
+    graphs = [
+        g
+        for sc in (2, 4, 12, 21, 24, "open_world_example")
+        for g in episode_graphs(sc, (100, 300, 600, 900, 1200))
+    ]
+    graphs += [synthetic_task_graph(10, 100, np.random.default_rng(s)) for s in range(3)]
+    objective = np.array([
+        [
+            RoutingScheduler(**{**settings, "first_solution": fs, "deterministic": True,
+                                "warm_start": False})
+            .plan(g, time_limit=None, rng=None).stats.objective
+            for g in graphs
+        ]
+        for fs in FIRST_SOLUTIONS
+    ])  # fmt: skip
+    best = objective.min(axis=0)
+    print(f"\n## First solutions on the scheduler's models ({len(graphs)} graphs, deterministic)")
+    print(f"{'first solution':<28} {'mean above best':>15} {'max above best':>14} {'best on':>8}")
+    for fs, row in zip(FIRST_SOLUTIONS, objective, strict=True):
+        rel = 100 * (row / best - 1)
+        print(f"{fs:<28} {rel.mean():>14.2f}% {rel.max():>13.2f}% "
+              f"{int(np.sum(row <= best + 1e-6)):>4}/{len(best)}")  # fmt: skip
+
+
+def _scores(path: str, metric: str) -> dict[tuple[str, int, str], float]:
+    import json
+    from pathlib import Path
+
+    doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    return {
+        (str(e["scenario"]), int(e["seed"]), e["scheduler"]): float(e[metric])
+        for e in doc["episodes"]
+        if e.get(metric) is not None and not e.get("error")
+    }
+
+
+def _mean_ci(d: np.ndarray) -> str:
+    from scipy import stats
+
+    half = stats.t.ppf(0.975, len(d) - 1) * d.std(ddof=1) / np.sqrt(len(d))
+    return f"{d.mean():+7.2f} [{d.mean() - half:+.2f}, {d.mean() + half:+.2f}] (n={len(d)})"
+
+
+def bench_paired(before: str, after: str, metric: str = "manual.final_score") -> None:
+    b, a = _scores(before, metric), _scores(after, metric)
+    print(f"\n## Paired differences of {metric} (mean, 95 % t-interval)")
+    for sched in sorted({k[2] for k in a}):
+        keys = sorted(k for k in a if k[2] == sched and k in b)
+        d = np.array([a[k] - b[k] for k in keys])
+        print(f"{sched:<10} after - before  {_mean_ci(d)}")
+    for name, sc in (("before", b), ("after", a)):
+        keys = sorted(k for k in sc if k[2] == "routing" and (k[0], k[1], "greedy") in sc)
+        d = np.array([sc[k] - sc[(k[0], k[1], "greedy")] for k in keys])
+        print(f"routing - greedy ({name}) {_mean_ci(d)}")
+
+
 def _parse(v: str):
     if v in ("True", "False", "None"):
         return {"True": True, "False": False, "None": None}[v]
@@ -193,11 +272,19 @@ def main() -> None:
         help="only check plan() against these wall-time limits (s)",
     )
     ap.add_argument("--every", type=int, default=5, help="seconds between graphs (--time-limit)")
+    ap.add_argument("--first-solutions", action="store_true")
+    ap.add_argument("--paired", nargs=2, metavar=("BEFORE", "AFTER"))
     args = ap.parse_args()
     settings = {}
     for kv in args.set:
         k, _, v = kv.partition("=")
         settings[k] = _parse(v)
+    if args.paired:
+        bench_paired(*args.paired)
+        return
+    if args.first_solutions:
+        bench_first_solutions(settings)
+        return
     if args.time_limit:
         bench_time_limit(settings, args.time_limit, args.every)
         return

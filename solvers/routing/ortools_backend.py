@@ -134,9 +134,11 @@ def solve_ortools(
     opts: OrToolsOptions,
     deadline: float | None,
     warm: list[list[int]] | None,
+    from_warm: bool = True,
 ) -> RoutesResult:
     """Search ``inst`` with OR-Tools until ``deadline`` (``perf_counter`` time; None:
-    deterministic, on ``opts``' work limits), starting from ``warm`` (task positions) if given."""
+    deterministic, on ``opts``' work limits), starting from ``warm`` (task positions) if given
+    and ``from_warm``."""
     rm = _build(inst, opts)
     params = _parameters(opts, deadline, _first_solution(inst, opts))
     time_left = None
@@ -152,7 +154,7 @@ def solve_ortools(
         model.AddSearchMonitor(model.solver().BranchesLimit(int(branches)))
     model.CloseModelWithParameters(params)
     start = None
-    if warm is not None:
+    if warm is not None and from_warm:
         idx = [[rm.manager.NodeToIndex(rm.n_depots + k) for k in r] for r in warm]
         start = model.ReadAssignmentFromRoutes(idx, True)
     t0 = time.perf_counter()

@@ -87,9 +87,11 @@ def solve_pyvrp(
     opts: PyVRPOptions,
     deadline: float | None,
     warm: list[list[int]] | None,
+    from_warm: bool = True,
 ) -> RoutesResult:
     """Search ``inst`` with PyVRP until ``deadline`` (``perf_counter`` time; None:
-    deterministic, ``opts.iterations``), starting from ``warm`` (task positions) if given."""
+    deterministic, ``opts.iterations``), starting from ``warm`` (task positions) if given and
+    ``from_warm``."""
     data = _data(inst, opts.scale)
     if deadline is None:
         stop: Any = MaxIterations(int(opts.iterations))
@@ -100,7 +102,7 @@ def solve_pyvrp(
                           warm_started=False, work={"iterations": 0})  # fmt: skip
         stop = MaxRuntime(opts.wall_fraction * time_left)
     init = None
-    if warm is not None:
+    if warm is not None and from_warm:
         init = pyvrp.Solution(data, [pyvrp.Route(data, r, v) for v, r in enumerate(warm) if r])
     # prizes may dwarf distances: PyVRP's penalties on excess duration or load must be able to
     # outweigh a prize, else no penalty makes collecting it infeasible

@@ -39,6 +39,7 @@ def solve_routes(
     time_limit: float | None = 0.1,
     deterministic: bool = False,
     warm_start: Sequence[Sequence[int]] | None = None,
+    search_from_warm: bool = True,
     backend: str = "ortools",
     options: Any = None,
 ) -> RoutesResult:
@@ -73,6 +74,9 @@ def solve_routes(
     warm_start : sequence of sequence of int, optional
         Routes to start from, as task locations per vehicle (e.g. the previous replan's). Tasks
         that are not in this problem or not allowed are skipped, routes are cut to fit.
+    search_from_warm : bool
+        Start the search from the warm start (else from the backend's own start; the warm start
+        is then only the answer when the clock ends the search before anything better).
     backend : {"ortools", "pyvrp"}
     options : OrToolsOptions or PyVRPOptions, optional
         The backend's search settings (default: its defaults).
@@ -105,8 +109,8 @@ def solve_routes(
         opts = options if options is not None else OrToolsOptions()
         if not isinstance(opts, OrToolsOptions):
             raise ValueError(f"backend 'ortools' takes OrToolsOptions, got {type(opts).__name__}")
-        return solve_ortools(inst, opts, deadline, warm)
+        return solve_ortools(inst, opts, deadline, warm, search_from_warm)
     popts = options if options is not None else PyVRPOptions()
     if not isinstance(popts, PyVRPOptions):
         raise ValueError(f"backend 'pyvrp' takes PyVRPOptions, got {type(popts).__name__}")
-    return solve_pyvrp(inst, popts, deadline, warm)
+    return solve_pyvrp(inst, popts, deadline, warm, search_from_warm)

@@ -185,17 +185,20 @@ def test_deterministic_episode_replans_are_identical(backend):
 
 # ---------------------------------------------------------------------------- warm start
 def test_warm_start_from_the_last_plan_and_reset_on_a_new_episode():
-    """From the second replan on, each model's search starts from the scheduler's last plan
-    (said in the message); a graph whose time does not advance (a new episode) drops that
-    memory, and ``warm_start=False`` never uses it."""
+    """With ``warm_start="search"``, from the second replan on each model's search starts from
+    the scheduler's last plan (said in the message); a graph whose time does not advance (a new
+    episode) drops that memory; the default ``"fallback"`` and ``"off"`` never start from it."""
     g0, g1 = episode_graphs(21, CONSECUTIVE)
-    sched = RoutingScheduler(**FAST)
+    sched = RoutingScheduler(warm_start="search", **FAST)
     assert "warm start" not in sched.plan(g0, time_limit=None, rng=None).stats.message
     assert "from the warm start" in sched.plan(g1, time_limit=None, rng=None).stats.message
     assert "warm start" not in sched.plan(g0, time_limit=None, rng=None).stats.message
-    cold = RoutingScheduler(warm_start=False, **FAST)
-    for g in (g0, g1):
-        assert "warm start" not in cold.plan(g, time_limit=None, rng=None).stats.message
+    for mode in ("fallback", "off"):
+        cold = RoutingScheduler(warm_start=mode, **FAST)
+        for g in (g0, g1):
+            assert "warm start" not in cold.plan(g, time_limit=None, rng=None).stats.message
+    with pytest.raises(ValueError, match="warm_start"):
+        RoutingScheduler(warm_start="nope")
 
 
 # ---------------------------------------------------------------------------- time limit
