@@ -48,7 +48,7 @@ def test_every_command_has_its_module_in_help_order(capsys):
     in COMMAND_MODULES order."""
     sub = parser.build_parser()._subparsers._group_actions[0]
     assert list(sub.choices) == [
-        "scenarios", "scenario", "run", "compare", "play", "sweep", "report", "replay",
+        "scenarios", "scenario", "schedulers", "run", "compare", "play", "sweep", "report", "replay",
         "import-legacy",
     ]  # fmt: skip
     assert tuple(m.__name__ for m in parser.COMMANDS) == COMMAND_MODULES
@@ -63,6 +63,7 @@ def test_run_defaults_point_at_the_command_modules():
     cases = {
         ("scenarios",): "fcplan.cli.scenarios",
         ("scenario", "validate", "1"): "fcplan.cli.scenario",
+        ("schedulers",): "fcplan.cli.schedulers",
         ("run", "1"): "fcplan.cli.run",
         ("compare", "--schedulers", "greedy"): "fcplan.cli.compare",
         ("play",): "fcplan.cli.play",
