@@ -373,3 +373,87 @@ def test_notebooks_paragraph_names_every_notebook():
     paragraph = text[text.index("Notebooks in `notebooks/`") :].split("\n\n")[0]
     for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
         assert f"`{path.stem}`" in paragraph, path.stem
+
+
+def _caption_commands() -> list[str]:
+    text = _prose()
+    made = text[text.index("*Made with `fcplan run 20") :].split("*", 2)[1]
+    return re.findall(r"`(fcplan [^`]+)`", made)
+
+
+@pytest.mark.slow
+def test_replay_gif_is_what_its_caption_makes(tmp_path):
+    """docs/replay_20_greedy.gif is, frame for frame, what the caption's two commands write, and
+    the episode does what the caption says: a fire unseen for about 40 s, out at about 90 s."""
+    from PIL import Image, ImageSequence
+
+    from fcplan.fire import BURNING
+    from fcplan.recording import load_recording
+
+    record, replay = _caption_commands()
+    assert _run_cli(record, tmp_path).returncode == 0
+    (tmp_path / "docs").mkdir()
+    assert _run_cli(replay, tmp_path).returncode == 0
+    made, shipped = (Image.open(d / "docs/replay_20_greedy.gif") for d in (tmp_path, ROOT))
+    assert made.n_frames == shipped.n_frames
+    for a, b in zip(ImageSequence.Iterator(made), ImageSequence.Iterator(shipped), strict=True):
+        np.testing.assert_array_equal(np.asarray(a.convert("RGB")), np.asarray(b.convert("RGB")))
+    frames = list(load_recording(tmp_path / "run.npz").frames(1, None, 10))
+    burning = [f.tick for f in frames if (f.fire == BURNING).any()]
+    run, longest = 0, 0  # longest stretch of seconds with fire burning and none of it known
+    for f in frames:
+        run = run + 1 if (f.fire == BURNING).any() and not f.known.any() else 0
+        longest = max(longest, run)
+    assert 35 <= longest <= 45 and 850 <= burning[-1] <= 950, (longest, burning[-1])
+
+
+def test_caption_matches_the_gif():
+    """The caption's command and alt text give the GIF's length: ``--end S`` at ``--speed 10``
+    and 10 fps is S frames; the GIF's width is the map size plus the panel."""
+    from PIL import Image
+
+    from fcplan.render import panel_width
+
+    replay = _caption_commands()[1]
+    end, size = (int(re.search(rf"--{k} (\d+)", replay).group(1)) for k in ("end", "size"))
+    assert re.search(rf"first {end} s at 10x speed", _prose())
+    im = Image.open(ROOT / "docs/replay_20_greedy.gif")
+    assert im.n_frames == end and im.size == (size + panel_width(size), size)
+
+
+def test_random_motion_score_in_the_comment():
+    """The random-legal-moves score the PlanFollower block's comment quotes is that of random
+    legal moves (seeded as the motion block above it) on the same scenario and seed."""
+    from fcplan.env.motion import MotionEnv
+
+    (block,) = [b for b in PYTHON if "PlanFollower(env" in b.code]
+    shown = float(re.search(r"random legal moves: (-?[\d.]+)", block.code).group(1))
+    env = MotionEnv(1)
+    obs, infos = env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    while env.agents:
+        actions = {a: rng.choice(np.flatnonzero(obs[a]["action_mask"])) for a in env.agents}
+        obs, rewards, terms, truncs, infos = env.step(actions)
+    assert claim_holds(str(infos["P1"]["metrics"]["manual"]["final_score"]), f"{shown}")
+
+
+def test_simulation_facts_are_the_code_s():
+    """The numbers of "Simulation in brief" and "Play it yourself" are the code's: 10 Hz,
+    sensing confidence 100 % to 40 %, 90 % pruning for action agents, 3 s before an idle action
+    agent goes home, 5 m per altitude step, a patrol closed within 100 px at 20 px per tick."""
+    from fcplan import load_scenario
+    from fcplan.game.controls import ALTITUDE_STEP, PATROL_RADIUS_STEPS
+    from fcplan.scenario import Role
+    from fcplan.team import ACTION_IDLE_LIMIT_S, sensing_confidence
+
+    text = _prose()
+    for fact in ("fixed tick of 10 Hz", "100% at the lowest altitude and 40% at the",
+                 "(90% for action agents, 80% for hybrids)", "hovering 3 s at its last goal",
+                 "altitude by 5 m", "within 100 px of the route's first goal"):  # fmt: skip
+        assert fact in " ".join(text.split()), fact
+    assert load_scenario(12).ticks_per_second == 10
+    assert sensing_confidence(np.array([10.0, 100.0]), 10.0, 100.0).round(6).tolist() == [1, 0.4]
+    actions = [a for a in load_scenario(12).agents if a.role is Role.ACTION]
+    assert actions and all(a.prune_confidence == 0.9 for a in actions)
+    assert ACTION_IDLE_LIMIT_S == 3.0 and ALTITUDE_STEP == 5.0
+    assert PATROL_RADIUS_STEPS * 20 == 100
