@@ -14,9 +14,9 @@ Prints, for scenarios #1 and #24 (greedy, seed 0, 180 s = 1,800 ticks):
   ``fcplan replay --video`` path to MP4 (512 px) and GIF (320 px).
 
 ``--memory`` instead measures the peak resident memory (``ru_maxrss`` of the child, from
-``os.wait4``) of whole ``fcplan replay REC --video OUT`` processes on #24 (greedy, seed 0) at
-512 px, 1x speed (one frame per tick), for a 30-s, a 90-s and the whole 180-s episode, GIF and
-MP4: bounded memory means the peak does not grow with the clip. ``--old PATH`` runs the same
+``os.wait4``) of whole ``fcplan replay REC --video OUT`` processes on #24 (greedy, seed 0,
+recorded by the same tree) at 512 px, 1x speed (one frame per tick), for a 30-s, a 90-s and the
+whole 180-s episode, GIF and MP4: bounded memory means the peak does not grow with the clip. ``--old PATH`` runs the same
 commands from another source tree (e.g. an export of ``main`` before streaming) for before/after;
 ``python -c "import fcplan.video, fcplan.render, fcplan.recording"`` is the baseline (the
 interpreter and the libraries alone).
@@ -117,14 +117,14 @@ def peak_rss(args: list[str], tree: Path) -> tuple[float, float]:
 def memory(old: Path | None) -> None:
     """Print peak RSS of ``fcplan replay --video`` by clip length, format and tree."""
     tmp = tempfile.mkdtemp()
-    rec = os.path.join(tmp, "r24.npz")
-    run_episode(24, "greedy", seed=0, record=rec)
     trees = {"new": Path(__file__).resolve().parents[1], **({"old": old.resolve()} if old else {})}
     base = ["-c", "import fcplan.video, fcplan.render, fcplan.recording"]
     print(f"load average {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} CPUs")
     print("peak RSS of fcplan replay r24.npz --video OUT --size 512 (1x: one frame per tick)")
     print(f"{'tree':<5} {'format':<7} {'clip s':>6} {'frames':>6} {'peak MiB':>9} {'wall s':>7}")
     for tree, path in trees.items():
+        rec = os.path.join(tmp, f"r24_{tree}.npz")  # each tree replays its own recording format
+        peak_rss(["-m", "fcplan", "run", "24", "--record", rec], path)
         mib, _ = peak_rss(base, path)
         print(f"{tree:<5} {'(none)':<7} {'-':>6} {'-':>6} {mib:>9.0f} {'-':>7}")
         for suffix in (".gif", ".mp4"):
