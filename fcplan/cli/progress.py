@@ -68,7 +68,6 @@ def progress_bar(
         file=out,
         delay=DELAY_S,
         leave=False,
-        dynamic_ncols=True,
         disable=disable,
     )
 
