@@ -6,6 +6,8 @@ from __future__ import annotations
 import inspect
 import json
 
+import pytest
+
 from fcplan import scheduling
 from fcplan.cli import main
 from fcplan.cli.schedulers import describe
@@ -85,3 +87,37 @@ def test_unknown_names_and_broken_plugins(capsys, monkeypatch):
     assert main(["schedulers"]) == 0
     out = capsys.readouterr().out
     assert "cannot be loaded" in out and "ImportError: gone" in out and "greedy" in out
+
+
+#: Phrases of Python's own errors that a user should never read instead of "must be ...".
+LEAKS = ("not supported between", "invalid literal", "could not convert", "unexpected keyword")
+
+#: Schedulers whose factories still leak a Python error for a mistyped setting on this branch;
+#: their own branches validate every setting at construction (issue 17).
+PENDING = {
+    "milp": "milp's settings are validated on the milp branch",
+    "milp-cvxpy": "milp's settings are validated on the milp branch",
+    "routing": "routing's settings are validated on the sched branch",
+}
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.xfail(reason=PENDING[n])) if n in PENDING else n
+        for n in available_schedulers()
+    ],
+)
+def test_a_mistyped_setting_is_named_with_what_is_allowed(name, capsys):
+    """``fcplan run 1 -s NAME:KEY=x`` for every numeric setting of every scheduler is one line
+    naming the setting and its value, never a Python error's text (``-s milp:slots=x`` used to
+    print "'<' not supported between instances of 'str' and 'int'")."""
+    numeric = [
+        key
+        for key, info in describe(name)["settings"].items()
+        if isinstance(info["default"], (int, float)) and not isinstance(info["default"], bool)
+    ]
+    for key in numeric:
+        assert main(["run", "1", "-s", f"{name}:{key}=x"]) == 2
+        err = capsys.readouterr().err
+        assert f"{key}=x" in err and not any(leak in err for leak in LEAKS), err
