@@ -41,6 +41,7 @@ __all__ = ["GifStream", "VideoError", "replay_ticks", "write_video", "VIDEO_SUFF
 VIDEO_SUFFIXES = (".mp4", ".gif")
 _GIF_COLORS = 128  # palette entries taken from the first frame; index 255 marks "unchanged"
 _GIF_CLEAR = 255
+_GIF_MAX_DELAY = 0xFFFF  # centiseconds, the largest delay of one GIF frame
 
 
 class VideoError(FcplanError, ValueError):
@@ -220,9 +221,10 @@ class GifStream:
     runs; a frame identical to the previous one lengthens the previous one's delay instead. Frame
     delays follow a clock at ``fps`` (GIF counts in 1/100 s: at 30 fps the delays run 3, 3, 4, ...
     so the clip keeps its length). The LZW image data is Pillow's encoder
-    (:func:`PIL.GifImagePlugin.getdata`); the file structure (GIF89a: screen descriptor, global
-    colour table, NETSCAPE2.0 loop, per frame a graphic control extension and an image
-    descriptor) is written here.
+    (``Image.tobytes("gif", "P")``); the file structure (GIF89a: screen descriptor, global colour
+    table, NETSCAPE2.0 loop, per frame a graphic control extension and an image descriptor) is
+    written here, so nothing is held between frames (Pillow's own writers keep every frame, or,
+    through ``GifImagePlugin.getdata``, a class per frame until the garbage collector runs).
 
     Parameters
     ----------
@@ -281,7 +283,11 @@ class GifStream:
         if not changed.any():
             assert self._pending is not None
             data, offset, cs = self._pending
-            self._pending = (data, offset, cs + delay)
+            if cs + delay <= _GIF_MAX_DELAY:
+                self._pending = (data, offset, cs + delay)
+                return
+            self._flush()  # a delay is 16 bits: go on with a 1-px frame that changes nothing
+            self._pending = (np.full((1, 1), _GIF_CLEAR, np.uint8), (0, 0), delay)
             return
         rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
         box = (slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1))
@@ -315,17 +321,18 @@ class GifStream:
         self.fh.write(b"!\xff\x0bNETSCAPE2.0\x03\x01" + struct.pack("<H", 0) + b"\x00")
 
     def _flush(self) -> None:
+        """Write the pending frame: graphic control extension (delay, disposal 1, transparent
+        index), image descriptor (its box, no local table) and its LZW data (Pillow's encoder)."""
         if self._pending is None:
             return
-        from PIL import GifImagePlugin, Image
+        from PIL import Image
 
-        data, offset, cs = self._pending
+        data, (x, y), cs = self._pending
         self._pending = None
         h, w = data.shape
-        im = Image.frombytes("P", (w, h), data.tobytes())
-        params = {"duration": 10 * cs, "disposal": 1, "transparency": _GIF_CLEAR}
-        for chunk in GifImagePlugin.getdata(im, offset, **params):
-            self.fh.write(chunk)
+        lzw = Image.frombytes("P", (w, h), data.tobytes()).tobytes("gif", "P")
+        self.fh.write(b"!\xf9\x04" + struct.pack("<BHBB", 0x05, cs, _GIF_CLEAR, 0))
+        self.fh.write(b"," + struct.pack("<HHHHB", x, y, w, h, 0) + b"\x08" + lzw + b"\x00")
 
 
 @contextlib.contextmanager

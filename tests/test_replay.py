@@ -192,6 +192,15 @@ def test_gif_delays_follow_the_clock(fps):
     assert total == 10 * round(100 * 30 / fps)
 
 
+def test_gif_still_frames_longer_than_a_gif_delay_keep_their_length():
+    """A picture that stays the same for longer than one GIF delay can say (655.35 s) is
+    continued by frames that change nothing, so the clip keeps its length."""
+    frames = [PALETTE[np.zeros((4, 4), int)]] * 700
+    im = _gif(frames, fps=1)
+    durations = [f.info["duration"] for f in ImageSequence.Iterator(im)]
+    assert sum(durations) == 700_000 and max(durations) <= 655_350
+
+
 def test_gif_memory_does_not_grow_with_the_clip():
     """Writing ten times more frames does not raise the peak of traced memory: frames are
     encoded and written as they come, none is kept."""

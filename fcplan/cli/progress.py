@@ -1,10 +1,11 @@
 """Progress bars of the long single commands (``fcplan run``, ``fcplan replay --video``).
 
-One style for every command: a :mod:`tqdm` bar (``tqdm.auto``, which updates in place in a
-terminal and in Jupyter) on stderr, so stdout keeps only the results. A bar appears only when the
-work lasts longer than :data:`DELAY_S` seconds and stderr is a terminal: short commands, pipes,
-redirections and tests print nothing extra, and the printed results never depend on it. The bar
-is removed when the work is done (``leave=False``), so the results that follow stay together.
+The style of ``fcplan compare`` and ``fcplan sweep`` (:mod:`fcplan.experiments.progress`), in
+the units of the work: a :mod:`tqdm` bar (``tqdm.auto``, which updates in place in a terminal and
+in Jupyter) on stderr, so stdout keeps only the results, which never depend on it. It appears
+only when the work lasts longer than :data:`DELAY_S` seconds, so quick commands print nothing
+extra; in a terminal it redraws twice a second, elsewhere (a log, a pipe) at most every
+:data:`QUIET_INTERVAL_S` seconds, so a long run leaves a few lines, not hundreds.
 
 :class:`EpisodeProgress` counts an episode in simulated seconds (an observer of the
 :class:`~fcplan.mission.Mission`, updated once per simulated second, so it costs nothing
@@ -13,28 +14,30 @@ measurable per tick); :func:`progress_bar` is the bar itself, also used for vide
 Examples
 --------
 >>> import io
->>> progress_bar(10, desc="frames", unit="frame", file=io.StringIO()).disable  # not a terminal
-True
->>> bar = progress_bar(10, desc="frames", unit="frame", file=io.StringIO(), disable=False)
+>>> out = io.StringIO()
+>>> bar = progress_bar(10, desc="video", unit="frame", file=out)
 >>> bar.update(10); bar.n
 10
->>> bar.close()
+>>> bar.close(); out.getvalue()  # done before DELAY_S: nothing drawn
+''
+
 """
 
 from __future__ import annotations
 
 import sys
+import warnings
 from typing import IO, Any
-
-from tqdm.auto import tqdm
 
 from fcplan.mission import BaseObserver
 from fcplan.world import StepInfo, World
 
-__all__ = ["DELAY_S", "EpisodeProgress", "progress_bar"]
+__all__ = ["DELAY_S", "QUIET_INTERVAL_S", "EpisodeProgress", "progress_bar"]
 
 #: Seconds of work before a bar is shown.
 DELAY_S = 2.0
+#: Seconds between redraws where stderr is not a terminal.
+QUIET_INTERVAL_S = 15.0
 
 
 def progress_bar(
@@ -43,7 +46,7 @@ def progress_bar(
     desc: str,
     unit: str,
     file: IO[str] | None = None,
-    disable: bool | None = None,
+    disable: bool = False,
 ) -> Any:
     """A tqdm bar on ``file`` (default stderr), shown after :data:`DELAY_S` seconds.
 
@@ -55,19 +58,24 @@ def progress_bar(
         Label before the bar, and the name of one unit (``"frame"``, ``"s"``).
     file : text stream, optional
         Where the bar goes (default ``sys.stderr``).
-    disable : bool, optional
-        None (default): shown only when ``file`` is a terminal; False: always; True: never.
+    disable : bool
+        Draw nothing.
     """
     out = sys.stderr if file is None else file
-    if disable is None:
-        disable = not (hasattr(out, "isatty") and out.isatty())
+    isatty = getattr(out, "isatty", None)
+    tty = bool(isatty is not None and isatty())
+    with warnings.catch_warnings():  # Jupyter without ipywidgets: the text bar, no warning
+        warnings.simplefilter("ignore")
+        from tqdm.auto import tqdm
     return tqdm(
         total=total,
         desc=desc,
-        unit=unit,
+        unit=f" {unit}",
         file=out,
         delay=DELAY_S,
-        leave=False,
+        mininterval=0.5 if tty else QUIET_INTERVAL_S,
+        dynamic_ncols=tty,
+        leave=True,
         disable=disable,
     )
 
@@ -79,7 +87,7 @@ class EpisodeProgress(BaseObserver):
     --------
     >>> import io
     >>> from fcplan import run_episode
-    >>> bar = progress_bar(180, desc="#1", unit="s", file=io.StringIO(), disable=False)
+    >>> bar = progress_bar(180, desc="#1", unit="s", file=io.StringIO())
     >>> _ = run_episode(1, "idle", observers=[EpisodeProgress(bar, 10)])
     >>> bar.n
     180

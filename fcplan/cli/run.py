@@ -9,8 +9,8 @@ Prints the scenario, scheduler and seed, the ticks and simulated time, the wall 
 replans with the median and 95th-percentile solve times and the fallbacks, then both metric
 definitions (:func:`fcplan.metrics.format_metrics`). ``--json`` prints the same as one JSON
 document instead; ``--record`` also writes a recording for ``fcplan replay``. An episode that
-takes more than two seconds shows a progress bar in simulated seconds on stderr (a terminal
-only: :mod:`fcplan.cli.progress`). ``fcplan run --help`` lists the registered schedulers;
+takes more than two seconds shows a progress bar in simulated seconds on stderr
+(:mod:`fcplan.cli.progress`). ``fcplan run --help`` lists the registered schedulers;
 ``fcplan schedulers`` describes them and their settings.
 
 Examples
@@ -101,7 +101,6 @@ def run(args: argparse.Namespace) -> int:
     scheduler = make_scheduler(args.scheduler)
     label = f"{scenario.name} {getattr(scheduler, 'name', args.scheduler)}"
     with progress_bar(scenario.duration_s, desc=label, unit="s") as bar:
-        observers = [] if bar.disable else [EpisodeProgress(bar, scenario.ticks_per_second)]
         res = run_episode(
             scenario,
             scheduler,
@@ -109,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
             replan_period=args.replan_period,
             time_limit=args.time_limit,
             record=args.record,
-            observers=observers,
+            observers=[EpisodeProgress(bar, scenario.ticks_per_second)],
         )
     if args.json:
         out = {

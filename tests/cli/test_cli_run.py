@@ -36,19 +36,22 @@ def test_run_json_is_machine_readable(capsys):
 
 
 def test_progress_bar_counts_simulated_seconds_and_changes_no_result(capsys, monkeypatch):
-    """With a terminal on stderr, ``fcplan run`` moves a bar to the episode's length in
-    simulated seconds; the results printed on stdout are those of a run without a bar."""
+    """``fcplan run`` moves a bar to the episode's length in simulated seconds; the results
+    printed on stdout are those of a run without a bar."""
     import io
 
     import fcplan.cli.progress as progress
 
+    real = progress.progress_bar
+    monkeypatch.setattr(
+        progress, "progress_bar", lambda total, **kw: real(total, **kw, disable=True)
+    )
     assert main(["run", "1", "-s", "idle", "--json"]) == 0
     plain = json.loads(capsys.readouterr().out)
     bars = []
-    real = progress.progress_bar
 
     def shown_bar(total, **kwargs):
-        bars.append(real(total, **{**kwargs, "file": io.StringIO(), "disable": False}))
+        bars.append(real(total, **{**kwargs, "file": io.StringIO()}))
         return bars[-1]
 
     monkeypatch.setattr(progress, "progress_bar", shown_bar)
