@@ -106,11 +106,15 @@ def peak_rss(args: list[str], tree: Path) -> tuple[float, float]:
     """Peak resident MiB and wall seconds of one ``python args`` process run from ``tree``."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
     t0 = time.perf_counter()
-    child = subprocess.Popen([sys.executable, *args], cwd=tree, env=env, stdout=subprocess.DEVNULL)
-    _, status, usage = os.wait4(child.pid, 0)
-    child.returncode = os.waitstatus_to_exitcode(status)
-    if child.returncode:
-        raise SystemExit(f"{' '.join(args)} failed with status {child.returncode}")
+    with tempfile.TemporaryFile() as err:  # progress bars and errors, shown only on failure
+        child = subprocess.Popen(
+            [sys.executable, *args], cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=err
+        )
+        _, status, usage = os.wait4(child.pid, 0)
+        child.returncode = os.waitstatus_to_exitcode(status)
+        if child.returncode:
+            err.seek(0)
+            raise SystemExit(f"{' '.join(args)}: status {child.returncode}: {err.read().decode()}")
     return usage.ru_maxrss / 1024, time.perf_counter() - t0  # Linux: ru_maxrss in KiB
 
 
