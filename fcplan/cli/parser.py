@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import difflib
 import os
 import signal
 import sys
@@ -120,6 +119,8 @@ def _unrecognized(
 ) -> CliError:
     """The error for arguments no parser took, naming the command and the closest options
     (``fcplan compare: unrecognized arguments: --seed 3 (did you mean --seeds?)``)."""
+    import difflib
+
     command = parser
     sub = getattr(parser, "_subparsers", None)
     if sub is not None and getattr(args, "command", None):

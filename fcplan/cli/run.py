@@ -26,7 +26,6 @@ Examples
 from __future__ import annotations
 
 import argparse
-import json
 from typing import TYPE_CHECKING
 
 from fcplan.cli.util import SubParsers, check_output, positive_float, scenario_name, seed
@@ -90,6 +89,8 @@ def schedulers_epilog() -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Run the episode and print its results."""
+    import json
+
     from fcplan.cli.progress import EpisodeProgress, progress_bar
     from fcplan.episode import run_episode
     from fcplan.metrics import format_metrics

@@ -32,10 +32,7 @@ Examples
 from __future__ import annotations
 
 import argparse
-import inspect
-import json
 import re
-import textwrap
 from typing import Any
 
 from fcplan.cli.util import SubParsers
@@ -119,6 +116,8 @@ def describe(name: str) -> dict[str, Any]:
         mode), ``settings`` (setting -> ``{"default": ..., "doc": ...}``; a ``**settings``
         entry has no default) and, for a plug-in that fails to load, ``error``.
     """
+    import inspect
+
     from fcplan.errors import FcplanError
     from fcplan.scheduling import scheduler_factory, supports_deterministic
 
@@ -155,6 +154,8 @@ def _setting_line(key: str, info: dict[str, Any]) -> str:
 
 def _format(info: dict[str, Any], detail: bool) -> list[str]:
     """The lines of one scheduler's block."""
+    import textwrap
+
     head = f"{info['name']:<14} "
     if "error" in info:
         return [head + f"(cannot be loaded: {info['error']})"]
@@ -185,6 +186,8 @@ def _format(info: dict[str, Any], detail: bool) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     """Print the registered schedulers (or the named ones, in detail)."""
+    import json
+
     from fcplan.scheduling import available_schedulers, scheduler_factory
 
     names = args.names or available_schedulers()

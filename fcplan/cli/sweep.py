@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from fcplan.cli.util import SubParsers, positive_int
 
@@ -69,6 +68,8 @@ def add_parser(sub: SubParsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep; exit status 1 when some episodes were lost (re-run to play them)."""
+    from pathlib import Path
+
     from fcplan.experiments.sweep import sweep
 
     results = args.results or str(Path("results") / Path(args.config).stem)

@@ -41,7 +41,6 @@ import os
 import re
 import stat
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any, NoReturn, TypeAlias
 
 from fcplan.errors import FcplanError
@@ -202,6 +201,8 @@ def check_output(path: str | None, option: str) -> None:
     """Fail before a long run, not after it, when an output file cannot be written."""
     if path is None:
         return
+    from pathlib import Path
+
     p = Path(path)
     if p.is_dir():
         raise CliError(f"{option} {path}: is a directory")
