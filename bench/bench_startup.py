@@ -3,7 +3,8 @@
 Times complete processes, as a user's shell does: ``python -m fcplan --help``,
 ``python -m fcplan scenarios`` and ``python -m fcplan run 1`` (a whole 180-s episode of #1 with
 greedy, start-up included), with ``python -c pass`` as the baseline of the interpreter itself.
-The commands are run interleaved (round k runs every command once, in a shuffled order), so a
+Each tree's bytecode is compiled once, untimed, into a
+cache outside the tree (as an installed package has it). The commands are run interleaved (round k runs every command once, in a shuffled order), so a
 change of machine load hits all of them alike; the table gives the median and the spread of the
 wall time and the median CPU time (user + system of the child, which load distorts less), and
 the median minus the baseline's. ``--old PATH`` adds the same commands run from another source
@@ -25,6 +26,7 @@ import resource
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -43,9 +45,14 @@ def _child_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def time_once(args: list[str], tree: Path) -> tuple[float, float]:
-    """Wall and CPU seconds of one ``python args`` process with ``tree`` on ``PYTHONPATH``."""
-    env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1"}
+def time_once(args: list[str], tree: Path, cache: Path) -> tuple[float, float]:
+    """Wall and CPU seconds of one ``python args`` process with ``tree`` on ``PYTHONPATH``.
+
+    Bytecode is written and read under ``cache`` (``PYTHONPYCACHEPREFIX``), as an installed
+    package has it, without touching the tree (``PYTHONDONTWRITEBYTECODE`` would make every
+    process compile fcplan's sources again)."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env.update(PYTHONPATH=str(tree), PYTHONPYCACHEPREFIX=str(cache))
     cpu0, t0 = _child_cpu(), time.perf_counter()
     subprocess.run(
         [sys.executable, *args], cwd=tree, env=env, check=True, stdout=subprocess.DEVNULL
@@ -61,8 +68,9 @@ def main() -> None:
     args = ap.parse_args()
     trees = {"new": ROOT, **({"old": args.old.resolve()} if args.old else {})}
     jobs = [(tree, name) for tree in trees for name in COMMANDS]
-    for tree, name in jobs:  # warm the file cache and the bytecode once, untimed
-        time_once(COMMANDS[name], trees[tree])
+    caches = {tree: Path(tempfile.mkdtemp(prefix=f"startup_{tree}_")) for tree in trees}
+    for tree, name in jobs:  # warm the file cache and write the bytecode once, untimed
+        time_once(COMMANDS[name], trees[tree], caches[tree])
     wall: dict[tuple[str, str], list[float]] = {job: [] for job in jobs}
     cpu: dict[tuple[str, str], list[float]] = {job: [] for job in jobs}
     rng = random.Random(args.seed)
@@ -70,7 +78,7 @@ def main() -> None:
     for _ in range(args.rounds):
         rng.shuffle(jobs)
         for tree, name in jobs:
-            w, c = time_once(COMMANDS[name], trees[tree])
+            w, c = time_once(COMMANDS[name], trees[tree], caches[tree])
             wall[tree, name].append(w)
             cpu[tree, name].append(c)
     load1 = os.getloadavg()
