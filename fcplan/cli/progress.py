@@ -18,7 +18,7 @@ Examples
 >>> bar = progress_bar(10, desc="video", unit="frame", file=out)
 >>> bar.update(10); bar.n
 10
->>> bar.close(); out.getvalue()  # done before DELAY_S: nothing drawn
+>>> bar.close(); out.getvalue()  # done before DELAY_S: nothing drawn (tqdm not even imported)
 ''
 
 """
@@ -26,13 +26,14 @@ Examples
 from __future__ import annotations
 
 import sys
+import time
 import warnings
 from typing import IO, Any
 
 from fcplan.mission import BaseObserver
 from fcplan.world import StepInfo, World
 
-__all__ = ["DELAY_S", "QUIET_INTERVAL_S", "EpisodeProgress", "progress_bar"]
+__all__ = ["DELAY_S", "QUIET_INTERVAL_S", "EpisodeProgress", "LazyBar", "progress_bar"]
 
 #: Seconds of work before a bar is shown.
 DELAY_S = 2.0
@@ -47,8 +48,8 @@ def progress_bar(
     unit: str,
     file: IO[str] | None = None,
     disable: bool = False,
-) -> Any:
-    """A tqdm bar on ``file`` (default stderr), shown after :data:`DELAY_S` seconds.
+) -> LazyBar:
+    """A bar on ``file`` (default stderr) that appears after :data:`DELAY_S` seconds.
 
     Parameters
     ----------
@@ -61,23 +62,75 @@ def progress_bar(
     disable : bool
         Draw nothing.
     """
-    out = sys.stderr if file is None else file
-    isatty = getattr(out, "isatty", None)
-    tty = bool(isatty is not None and isatty())
-    with warnings.catch_warnings():  # Jupyter without ipywidgets: the text bar, no warning
-        warnings.simplefilter("ignore")
-        from tqdm.auto import tqdm
-    return tqdm(
-        total=total,
-        desc=desc,
-        unit=f" {unit}",
-        file=out,
-        delay=DELAY_S,
-        mininterval=0.5 if tty else QUIET_INTERVAL_S,
-        dynamic_ncols=tty,
-        leave=True,
-        disable=disable,
-    )
+    return LazyBar(total, desc=desc, unit=unit, file=file, disable=disable)
+
+
+class LazyBar:
+    """Counts work and becomes a :class:`tqdm.auto.tqdm` bar once it has lasted :data:`DELAY_S`
+    seconds: a quick command never imports tqdm (about 0.1 s of start-up with its asyncio
+    support). Use it as a context manager, or call :meth:`close`.
+
+    Attributes
+    ----------
+    n, total : float
+        Work done and to do.
+    """
+
+    def __init__(
+        self,
+        total: float,
+        *,
+        desc: str,
+        unit: str,
+        file: IO[str] | None = None,
+        disable: bool = False,
+    ) -> None:
+        self.total, self.desc, self.unit, self.disable = total, desc, unit, disable
+        self.file = sys.stderr if file is None else file
+        self.n: float = 0
+        self._start = time.monotonic()
+        self._bar: Any = None
+
+    def update(self, k: float = 1) -> None:
+        """Count ``k`` more units; draw (or start drawing) the bar when it is due."""
+        self.n += k
+        if self._bar is not None:
+            self._bar.update(k)
+        elif not self.disable and time.monotonic() - self._start >= DELAY_S:
+            self._bar = self._open()
+
+    def _open(self) -> Any:
+        isatty = getattr(self.file, "isatty", None)
+        tty = bool(isatty is not None and isatty())
+        with warnings.catch_warnings():  # Jupyter without ipywidgets: the text bar, no warning
+            warnings.simplefilter("ignore")
+            from tqdm.auto import tqdm
+        bar = tqdm(
+            total=self.total,
+            initial=self.n,
+            desc=self.desc,
+            unit=f" {self.unit}",
+            file=self.file,
+            mininterval=0.5 if tty else QUIET_INTERVAL_S,
+            dynamic_ncols=tty,
+            leave=True,
+        )
+        bar.start_t -= (
+            time.monotonic() - self._start
+        )  # its rate and elapsed time count from the start
+        return bar
+
+    def close(self) -> None:
+        """End the bar's line (nothing if it never appeared)."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+    def __enter__(self) -> LazyBar:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 class EpisodeProgress(BaseObserver):
@@ -93,7 +146,7 @@ class EpisodeProgress(BaseObserver):
     180
     """
 
-    def __init__(self, bar: Any, ticks_per_second: int) -> None:
+    def __init__(self, bar: LazyBar, ticks_per_second: int) -> None:
         self.bar = bar
         self.ticks_per_second = ticks_per_second
 
