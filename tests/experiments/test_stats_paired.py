@@ -36,7 +36,15 @@ def test_wilcoxon_matches_scipy_without_zeros():
     """The p-value is scipy's two-sided signed-rank test on the non-zero differences."""
     d = np.array([1.5, -0.5, 2.0, 0.0, 3.0, 2.5, -1.0, 4.0])
     assert wilcoxon_p(d) == pytest.approx(stats.wilcoxon(d[d != 0]).pvalue)
-    assert math.isnan(wilcoxon_p([0.0, 0.0])) and math.isnan(wilcoxon_p([1.0, math.nan]))
+    assert math.isnan(wilcoxon_p([])) and math.isnan(wilcoxon_p([1.0, math.nan]))
+
+
+def test_wilcoxon_of_all_ties_is_one():
+    """Every difference zero is no evidence of a difference: p = 1 (it still counts in the Holm
+    family), not NaN."""
+    assert wilcoxon_p([0.0, 0.0, 0.0]) == 1.0
+    (c,) = paired_comparisons({"a": [1.0, 2.0], "b": [1.0, 2.0]})
+    assert c.p == 1.0 and c.ties == 2 and c.verdict() == "identical on all 2 pairs"
 
 
 def test_paired_comparisons_every_pair_adjusted_together():
