@@ -61,23 +61,54 @@ __all__ = [
     "MetricRanking",
     "OracleFraction",
     "PairKey",
+    "RESULTS_PAIR_ON",
     "RANKING_METRICS",
-    "fixed_width",
-    "fraction_cells",
     "metric_label",
     "metric_rankings",
     "oracle_fractions",
-    "paired_cells",
     "paired_scores",
     "paired_table",
-    "ranking_cells",
+    "results_pair_key",
     "separation",
+    "StudyStats",
+    "study_stats",
 ]
 
 PairKey = Callable[[Mapping[str, Any]], Hashable]
 """The instance an episode row played (rows of two schedulers with equal keys are a pair)."""
 
 Rows = Sequence[Mapping[str, Any]]
+
+RANKING_METRICS: tuple[str, ...] = tuple(c.name for c in RANKING_COLUMNS)
+"""Column names of :data:`~fcplan.experiments.tables.RANKING_COLUMNS`."""
+
+
+RESULTS_PAIR_ON: tuple[str, ...] = (
+    "study_hash",
+    "scenario",
+    "seed",
+    "overrides",
+    "replan_period",
+    "time_limit",
+)
+"""The columns that name the instance of a sweep result row (:func:`results_pair_key`)."""
+
+
+def results_pair_key(row: Mapping[str, Any]) -> tuple[Any, ...]:
+    """The instance a sweep result row played: its :data:`RESULTS_PAIR_ON` values, with a
+    missing or NaN value (a row written before study hashes, no time limit) read as None.
+
+    Examples
+    --------
+    >>> results_pair_key({"scenario": "#3", "seed": 1, "overrides": "{}", "replan_period": 1.0,
+    ...                   "time_limit": float("nan")})
+    (None, '#3', 1, '{}', 1.0, None)
+    """
+    out = []
+    for c in RESULTS_PAIR_ON:
+        v = row.get(c)
+        out.append(None if v is None or (isinstance(v, float) and v != v) else v)
+    return tuple(out)
 
 
 def metric_label(metric: str) -> str:
@@ -92,13 +123,6 @@ def metric_label(metric: str) -> str:
         if col.name == metric:
             return col.label
     return metric
-
-
-def _decimals(metric: str) -> int:
-    for col in REPORT_COLUMNS:
-        if col.name == metric:
-            return col.decimals + 1
-    return 2
 
 
 def paired_scores(
@@ -275,15 +299,11 @@ def metric_rankings(
         scores = paired_scores(rows, schedulers, metric, pair_key)
         means = {s: mean_ci(list(v.values())).mean for s, v in scores.items()}
         sign = -1.0 if higher else 1.0
-        order = tuple(
-            sorted(schedulers, key=lambda s: (math.isnan(means[s]), sign * means[s]))
-        )
+        order = tuple(sorted(schedulers, key=lambda s: (math.isnan(means[s]), sign * means[s])))
         pairs = paired_comparisons(scores, metric=metric, higher_is_better=higher, alpha=alpha)
         blocks = [k for k in scores[schedulers[0]] if all(k in scores[s] for s in schedulers)]
         fr = friedman([[scores[s][k] for k in blocks] for s in schedulers], higher)
-        out.append(
-            MetricRanking(metric, metric_label(metric), order, means, tuple(pairs), fr)
-        )
+        out.append(MetricRanking(metric, metric_label(metric), order, means, tuple(pairs), fr))
     return out
 
 
@@ -324,94 +344,137 @@ def _finite(x: float) -> float:
 
 
 # --------------------------------------------------------------------------------------------
-# cells (shared by the text, Markdown and HTML tables)
-
-Cells = tuple[list[str], list[list[str]]]
+# a study's statistics, computed once, shown by compare (text) and report (Markdown, HTML, CSV)
 
 
-def _p(p: float) -> str:
-    if p != p:
-        return "-"
-    return f"{p:.2g}" if p >= 1e-4 else "<1e-4"
+@dataclass(frozen=True)
+class StudyStats:
+    """The paired tables, fractions of the oracle and rankings of one study.
 
-
-def _num(x: float, d: int, sign: bool = False) -> str:
-    if x != x:
-        return "nan"
-    return f"{x:+.{d}f}" if sign else f"{x:.{d}f}"
-
-
-def paired_cells(comparisons: Sequence[PairedComparison]) -> Cells:
-    """Header and rows of a paired table: a, b, n, ``a - b [low, high]``, d_z, wins/ties/losses,
-    p, Holm p, verdict."""
-    head = ["a", "b", "n", "a - b [95% CI]", "d_z", "W/T/L", "p", "Holm p", "verdict"]
-    body = []
-    for c in comparisons:
-        d = _decimals(c.metric)
-        ci = (
-            f"{_num(c.diff.mean, d, True)} [{_num(c.diff.low, d, True)}, "
-            f"{_num(c.diff.high, d, True)}]"
-        )
-        body.append(
-            [
-                c.a,
-                c.b,
-                str(c.n),
-                ci,
-                _num(c.effect, 2, True),
-                f"{c.wins}/{c.ties}/{c.losses}",
-                _p(c.p),
-                _p(c.p_holm),
-                c.verdict(),
-            ]
-        )
-    return head, body
-
-
-def fraction_cells(fractions: Sequence[OracleFraction]) -> Cells:
-    """Header and rows of the fraction-of-oracle table."""
-    head = ["scheduler", "n", "x / oracle [95% CI]", "mean x / mean oracle", "better than oracle"]
-    body = []
-    for f in fractions:
-        cell = f"{f.fraction.mean:.3f} [{f.fraction.low:.3f}, {f.fraction.high:.3f}]"
-        n = str(f.fraction.n) + (f" (+{f.excluded} oracle <= 0)" if f.excluded else "")
-        body.append([f.scheduler, n, cell, _num(f.ratio_of_means, 3), str(f.above)])
-    return head, body
-
-
-def ranking_cells(rankings: Sequence[MetricRanking]) -> Cells:
-    """Header and rows of the ranking table: one row per metric."""
-    head = ["metric", "ranking (best first)", "pairs differing", "median |d_z|", "Friedman p", "W"]
-    body = [
-        [
-            r.label,
-            r.chain(),
-            f"{r.significant}/{len(r.pairs)}",
-            _num(r.median_abs_effect, 2),
-            _p(r.friedman.p),
-            _num(r.friedman.w, 2),
-        ]
-        for r in rankings
-    ]
-    return head, body
-
-
-def fixed_width(head: list[str], body: list[list[str]], indent: str = "") -> str:
-    """A plain-text table: columns padded to their widest cell, the last one left ragged.
-
-    Examples
-    --------
-    >>> print(fixed_width(["a", "bb"], [["xyz", "1"]]))
-    a    bb
-    xyz  1
+    Attributes
+    ----------
+    policies : tuple of str
+        The compared schedulers (every scheduler but the clairvoyant references).
+    oracle : str or None
+        The scheduler the fractions are taken of (None: no oracle in the study).
+    metrics : tuple of str
+        The metrics with a paired table, headline first.
+    paired : dict of str -> list of PairedComparison
+        Per metric, every pair of policies (Holm within the metric).
+    fractions : list of OracleFraction
+        Of the headline metric (empty without an oracle).
+    rankings : list of MetricRanking
+        One per ranking metric present.
+    confidence : float
     """
-    widths = [max(len(row[k]) for row in [head, *body]) for k in range(len(head))]
-    lines = [
-        indent + "  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip()
-        for row in [head, *body]
-    ]
-    return "\n".join(lines)
+
+    policies: tuple[str, ...]
+    oracle: str | None
+    metrics: tuple[str, ...]
+    paired: dict[str, list[PairedComparison]]
+    fractions: list[OracleFraction]
+    rankings: list[MetricRanking]
+    confidence: float = 0.95
+
+    def separation(self) -> str:
+        """:func:`separation` of the rankings."""
+        return separation(self.rankings)
+
+    def paired_records(self) -> list[dict[str, Any]]:
+        """Every paired comparison as a flat dict (the report's ``paired.csv``)."""
+        return [
+            {
+                "a": c.a,
+                "b": c.b,
+                "metric": c.metric,
+                "pairs": c.n,
+                "mean_diff": c.diff.mean,
+                "ci": c.diff.half_width,
+                "low": c.diff.low,
+                "high": c.diff.high,
+                "effect_dz": c.effect,
+                "wins": c.wins,
+                "ties": c.ties,
+                "losses": c.losses,
+                "p_wilcoxon": c.p,
+                "p_holm": c.p_holm,
+                "resolved": c.resolved,
+                "pairs_needed_80": c.pairs_needed(),
+                "verdict": c.verdict(),
+            }
+            for pairs in self.paired.values()
+            for c in pairs
+        ]
+
+    def fraction_records(self) -> list[dict[str, Any]]:
+        """Every fraction of the oracle as a flat dict."""
+        return [
+            {
+                "scheduler": f.scheduler,
+                "oracle": f.oracle,
+                "metric": f.metric,
+                "pairs": f.fraction.n,
+                "fraction_mean": f.fraction.mean,
+                "fraction_ci": f.fraction.half_width,
+                "ratio_of_means": f.ratio_of_means,
+                "excluded": f.excluded,
+                "better_than_oracle": f.above,
+            }
+            for f in self.fractions
+        ]
+
+    def ranking_records(self) -> list[dict[str, Any]]:
+        """Every ranking as a flat dict."""
+        return [
+            {
+                "metric": r.metric,
+                "ranking": r.chain(),
+                "pairs": len(r.pairs),
+                "pairs_differing": r.significant,
+                "median_abs_dz": r.median_abs_effect,
+                "friedman_p": r.friedman.p,
+                "kendall_w": r.friedman.w,
+                "blocks": r.friedman.blocks,
+            }
+            for r in self.rankings
+        ]
 
 
-RANKING_METRICS: tuple[str, ...] = tuple(c.name for c in RANKING_COLUMNS)
-"""Column names of :data:`~fcplan.experiments.tables.RANKING_COLUMNS`."""
+def study_stats(
+    rows: Rows,
+    schedulers: Sequence[str],
+    metrics: Sequence[str],
+    pair_key: PairKey,
+    *,
+    references: Sequence[str] = (),
+    oracle: str | None = None,
+    confidence: float = 0.95,
+    alpha: float = 0.05,
+) -> StudyStats:
+    """The :class:`StudyStats` of a study's completed episodes.
+
+    Parameters
+    ----------
+    rows, schedulers, pair_key
+        Completed episodes, every scheduler label in display order, the pairing (module
+        docstring).
+    metrics : sequence of str
+        Metrics with a paired table; the first is the headline (fractions of the oracle).
+    references : sequence of str
+        Clairvoyant schedulers: not compared, not ranked.
+    oracle : str, optional
+        The reference the fractions are taken of (default: the first of ``references``).
+    """
+    policies = tuple(s for s in schedulers if s not in references)
+    oracle = oracle if oracle is not None else (references[0] if references else None)
+    paired = {
+        m: paired_table(rows, policies, m, pair_key, confidence=confidence, alpha=alpha)
+        for m in metrics
+    }
+    fractions = (
+        oracle_fractions(rows, [oracle, *policies], oracle, metrics[0], pair_key)
+        if oracle is not None and metrics
+        else []
+    )
+    rankings = metric_rankings(rows, policies, RANKING_METRICS, pair_key, alpha=alpha)
+    return StudyStats(policies, oracle, tuple(metrics), paired, fractions, rankings, confidence)

@@ -435,10 +435,17 @@ class PairedComparison:
             return "one pair: no interval"
         if self.ties == n:
             return f"identical on all {n} pairs"
+        untied = n - self.ties
+        floor = (
+            f"Wilcoxon cannot reach p<{self.alpha:g} with {untied} non-tied pairs"
+            if smallest_wilcoxon_p(untied) >= self.alpha
+            else ""
+        )
         if self.resolved:
             if self.p_holm < self.alpha:
                 return f"{self.leader} better"
-            return f"{self.leader} ahead on the mean, not significant after Holm"
+            text = f"{self.leader} ahead on the mean, not significant after Holm"
+            return text + (f" ({floor})" if floor else "")
         notes = []
         need = self.pairs_needed()
         if need == need:
@@ -448,11 +455,8 @@ class PairedComparison:
                 if math.isfinite(need)
                 else f"no resolvable effect at {size}"
             )
-        untied = n - self.ties
-        if smallest_wilcoxon_p(untied) >= self.alpha:
-            notes.append(
-                f"Wilcoxon cannot reach p<{self.alpha:g} with {untied} non-tied pairs"
-            )
+        if floor:
+            notes.append(floor)
         return f"unresolved at n={n}" + (f" ({'; '.join(notes)})" if notes else "")
 
 
@@ -517,8 +521,6 @@ def paired_comparisons(
             rows.append((a, b, ci, wilcoxon_p(d), effect, counts))
     adjusted = holm([r[3] for r in rows])
     return [
-        PairedComparison(
-            a, b, ci, p, float(ph), eff, metric, *counts, higher_is_better, alpha
-        )
+        PairedComparison(a, b, ci, p, float(ph), eff, metric, *counts, higher_is_better, alpha)
         for (a, b, ci, p, eff, counts), ph in zip(rows, adjusted, strict=True)
     ]

@@ -38,8 +38,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fcplan.errors import UnknownNameError
-from fcplan.metrics import DEFINITIONS, OUTCOMES, MetricSpec, metric_spec
+from fcplan.errors import FcplanError, UnknownNameError
+from fcplan.metrics import DEFINITIONS, METRICS, OUTCOMES, MetricSpec, metric_spec
 from fcplan.scenario.model import DIFFICULTIES
 
 __all__ = [
@@ -49,9 +49,11 @@ __all__ = [
     "REPORT_COLUMNS",
     "RUN_COLUMNS",
     "SCORE_COLUMNS",
+    "check_metric",
     "difficulty_key",
     "fallback_majority",
     "higher_is_better",
+    "metric_columns",
 ]
 
 
@@ -178,3 +180,31 @@ def fallback_majority(row: dict) -> bool:
     """
     replans, fallbacks = row.get("replans") or 0, row.get("fallbacks") or 0
     return bool(replans == replans and replans > 0 and fallbacks > replans / 2)
+
+
+def metric_columns() -> list[str]:
+    """Every numeric metric column of episode rows: ``<definition>.<metric>`` for both
+    definitions (the verbal grade excluded) and ``outcome.<name>``.
+
+    Examples
+    --------
+    >>> cols = metric_columns()
+    >>> "manual.final_score" in cols, "outcome.burned_area_cells" in cols, "manual.grade" in cols
+    (True, True, False)
+    """
+    out = [s.key(d) for d in DEFINITIONS for s in METRICS if s.name != "grade"]
+    return out + [f"outcome.{s.name}" for s in OUTCOMES]
+
+
+def check_metric(name: str) -> str:
+    """``name`` if it is a :func:`metric_columns` entry, else a one-line :class:`FcplanError`.
+
+    Examples
+    --------
+    >>> check_metric("manual.perception")
+    'manual.perception'
+    """
+    cols = metric_columns()
+    if name not in cols:
+        raise FcplanError(f"metric {name!r} is not a numeric metric; use one of {', '.join(cols)}")
+    return name
