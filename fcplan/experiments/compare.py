@@ -363,7 +363,9 @@ def _auto(
         seeds = auto.seeds(look)
         runner.play(seeds)
         result = runner.result(seeds, meta, time.perf_counter() - t0)
-        pairs = result.comparisons(auto.metric, confidence=auto.look_confidence)
+        pairs = result.comparisons(
+            auto.metric, confidence=auto.look_confidence, alpha=auto.look_alpha
+        )
         decision = auto.decide(pairs, look)
         result.stopped = decision.reason if decision.stop else ""
         if checkpoint is not None:

@@ -276,14 +276,15 @@ class ComparisonResult:
         )
 
     def comparisons(
-        self, metric: str | None = None, *, confidence: float = 0.95
+        self, metric: str | None = None, *, confidence: float = 0.95, alpha: float = 0.05
     ) -> list[PairedComparison]:
         """Every pair of compared schedulers (the oracle left out) on ``metric`` (default: the
         headline), Holm-adjusted over the pairs (:func:`~fcplan.experiments.analysis.paired_table`).
         """
         metric = metric or self.metrics[0]
         policies = [s for s in self._schedulers() if s not in self.references]
-        return paired_table(self.pair_rows(), policies, metric, _pair_key, confidence=confidence)
+        rows = self.pair_rows()
+        return paired_table(rows, policies, metric, _pair_key, confidence=confidence, alpha=alpha)
 
     # ---- text ---------------------------------------------------------------------------
 

@@ -366,6 +366,8 @@ class PairedComparison:
         The metric's direction (which scheduler a positive difference favours).
     alpha : float
         Significance level of :meth:`verdict`.
+    family : int
+        Number of pairs in the Holm family.
     """
 
     a: str
@@ -380,6 +382,7 @@ class PairedComparison:
     losses: int = 0
     higher_is_better: bool = True
     alpha: float = 0.05
+    family: int = 1
 
     @property
     def n(self) -> int:
@@ -426,7 +429,7 @@ class PairedComparison:
         'x better'
         >>> (c,) = paired_comparisons({"x": [1, 2, 3, 4], "y": [2, 1, 3, 3]})
         >>> c.verdict()
-        'unresolved at n=4 (~118 pairs for 80% power at d_z=+0.26; Wilcoxon cannot reach p<0.05 with 3 non-tied pairs)'
+        "unresolved at n=4 (~118 pairs for 80% power at d_z=+0.26; with 3 non-tied pairs Wilcoxon's p is at least 0.25)"
         """
         n = self.n
         if n == 0:
@@ -436,11 +439,12 @@ class PairedComparison:
         if self.ties == n:
             return f"identical on all {n} pairs"
         untied = n - self.ties
-        floor = (
-            f"Wilcoxon cannot reach p<{self.alpha:g} with {untied} non-tied pairs"
-            if smallest_wilcoxon_p(untied) >= self.alpha
-            else ""
-        )
+        least = smallest_wilcoxon_p(untied)
+        floor = ""
+        if least * self.family >= self.alpha:  # no pair of the family can pass Holm at alpha
+            floor = f"with {untied} non-tied pairs Wilcoxon's p is at least {least:.2g}"
+            if self.family > 1:
+                floor += f", {min(1.0, least * self.family):.2g} after Holm over {self.family}"
         if self.resolved:
             if self.p_holm < self.alpha:
                 return f"{self.leader} better"
@@ -521,6 +525,8 @@ def paired_comparisons(
             rows.append((a, b, ci, wilcoxon_p(d), effect, counts))
     adjusted = holm([r[3] for r in rows])
     return [
-        PairedComparison(a, b, ci, p, float(ph), eff, metric, *counts, higher_is_better, alpha)
+        PairedComparison(
+            a, b, ci, p, float(ph), eff, metric, *counts, higher_is_better, alpha, len(rows)
+        )
         for (a, b, ci, p, eff, counts), ph in zip(rows, adjusted, strict=True)
     ]

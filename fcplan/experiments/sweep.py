@@ -304,9 +304,14 @@ def _auto(
             errors=total.errors + s.errors,
             wall_time_s=total.wall_time_s + s.wall_time_s,
         )
-        rows = _study_rows(out, cfg.study_hash)
+        rows = _study_rows(out, cfg.study_hash, step.seeds)
         pairs = paired_table(
-            rows, policies, auto.metric, results_pair_key, confidence=auto.look_confidence
+            rows,
+            policies,
+            auto.metric,
+            results_pair_key,
+            confidence=auto.look_confidence,
+            alpha=auto.look_alpha,
         )
         decision = auto.decide(pairs, look)
         if decision.stop or s.lost:  # lost episodes: stop, a re-run plays them and goes on
@@ -315,12 +320,14 @@ def _auto(
             return total
 
 
-def _study_rows(out: Path, study: str) -> list[dict[str, Any]]:
-    """The completed episodes of ``study`` stored in ``out``."""
+def _study_rows(out: Path, study: str, seeds: tuple[int, ...]) -> list[dict[str, Any]]:
+    """The completed episodes of ``study`` and ``seeds`` stored in ``out`` (episodes of later
+    seeds, stored by an earlier run, do not count before their look)."""
     df = load_results(out)
     if df.empty or "study_hash" not in df:
         return []
-    return df[(df["study_hash"] == study) & (df["status"] == "ok")].to_dict("records")
+    keep = (df["study_hash"] == study) & (df["status"] == "ok") & df["seed"].isin(seeds)
+    return df[keep].to_dict("records")
 
 
 def _check_backend_args(jobs: Any, dask: Any) -> None:
