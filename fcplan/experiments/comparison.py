@@ -39,7 +39,7 @@ import json
 import math
 import os
 import textwrap
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -397,7 +397,7 @@ class ComparisonResult:
 _Cell = Callable[[dict[str, Any]], str]
 
 
-def _pair_key(row: dict[str, Any]) -> Any:
+def _pair_key(row: Mapping[str, Any]) -> Hashable:
     """The instance of a :meth:`ComparisonResult.pair_rows` row."""
     return row["_pair"]
 
