@@ -327,15 +327,12 @@ def compare(
     seed_list = [] if auto else _check_seeds(seeds)
     tl = None if time_limit is None else _positive("time_limit", time_limit)
     rp = _positive("replan_period", replan_period)
-    if jobs is None:
-        jobs = default_jobs()
-    if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
-        raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
+    jobs = _check_jobs(jobs)
     settings = {"time_limit": tl, "replan_period": rp, "deterministic": deterministic}
     study = study_hash(scen, variants, settings)
-    runner = _Runner(scen, variants, tl, rp, int(jobs), episode_progress(progress, "compare"))
+    runner = _Runner(scen, variants, tl, rp, jobs, episode_progress(progress, "compare"))
     runner.reuse(_resumed(resume, study))
-    meta = {**settings, "jobs": int(jobs), "study_hash": study, "metrics": metric_list}
+    meta = {**settings, "jobs": jobs, "study_hash": study, "metrics": metric_list}
     t0 = time.perf_counter()
     try:
         if auto is None:
@@ -372,6 +369,15 @@ def _auto(
             _write_checkpoint(result, checkpoint)
         if decision.stop:
             return result
+
+
+def _check_jobs(jobs: Any) -> int:
+    """``jobs`` (default: the CPUs this process may use), or a one-line error."""
+    if jobs is None:
+        return default_jobs()
+    if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
+        raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
+    return int(jobs)
 
 
 def _is_auto(seeds: Any) -> bool:
