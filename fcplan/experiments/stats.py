@@ -419,7 +419,8 @@ class PairedComparison:
           but the signed-rank test, adjusted over the family, does not agree;
         * ``"unresolved at n=N"``: the interval contains 0 (too wide to tell), with the pairs an
           80 %-power study would need at the observed effect, and a note when the signed-rank
-          test cannot reach ``alpha`` with so few pairs;
+          test cannot reach ``alpha`` with so few pairs (its smallest p is ``2 / 2^n``, times
+          the family size after Holm);
         * ``"identical on all N pairs"``, ``"no pairs"``, ``"one pair: no interval"``.
 
         Examples
@@ -429,7 +430,7 @@ class PairedComparison:
         'x better'
         >>> (c,) = paired_comparisons({"x": [1, 2, 3, 4], "y": [2, 1, 3, 3]})
         >>> c.verdict()
-        "unresolved at n=4 (~118 pairs for 80% power at d_z=+0.26; with 3 non-tied pairs Wilcoxon's p is at least 0.25)"
+        'unresolved at n=4 (~118 pairs for 80% power at d_z=+0.26; Wilcoxon p >= 0.25 at 3 pairs)'
         """
         n = self.n
         if n == 0:
@@ -442,9 +443,8 @@ class PairedComparison:
         least = smallest_wilcoxon_p(untied)
         floor = ""
         if least * self.family >= self.alpha:  # no pair of the family can pass Holm at alpha
-            floor = f"with {untied} non-tied pairs Wilcoxon's p is at least {least:.2g}"
-            if self.family > 1:
-                floor += f", {min(1.0, least * self.family):.2g} after Holm over {self.family}"
+            holm = " after Holm" if self.family > 1 else ""
+            floor = f"Wilcoxon p >= {min(1.0, least * self.family):.2g}{holm} at {untied} pairs"
         if self.resolved:
             if self.p_holm < self.alpha:
                 return f"{self.leader} better"

@@ -98,9 +98,9 @@ def test_verdicts_in_words():
     assert "pairs for 80% power" in c.verdict()
     (c,) = paired_comparisons({"x": [5.0, 6.0, 7.0], "y": [1.0, 1.5, 2.0]})
     assert c.resolved and not c.significant
-    assert c.verdict() == (
-        "x ahead on the mean, not significant after Holm "
-        "(with 3 non-tied pairs Wilcoxon's p is at least 0.25)"
+    assert (
+        c.verdict()
+        == "x ahead on the mean, not significant after Holm (Wilcoxon p >= 0.25 at 3 pairs)"
     )
     assert paired_comparisons({"x": [1.0], "y": [0.0]})[0].verdict() == "one pair: no interval"
     assert paired_comparisons({"x": {}, "y": {}})[0].verdict() == "no pairs"
@@ -113,7 +113,7 @@ def test_holm_floor_is_named_for_the_family():
     scores = {"a": base + 100, "b": base + 50, "c": base}
     for c in paired_comparisons(scores):
         assert c.resolved and not c.significant
-        assert "0.094 after Holm over 3" in c.verdict()
+        assert "Wilcoxon p >= 0.094 after Holm at 6 pairs" in c.verdict()
 
 
 @pytest.mark.parametrize("effect", [0.3, 0.8])
