@@ -70,7 +70,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -231,9 +231,13 @@ def sweep(
     try:
         with lock_results(out):
             remove_stale_temporaries(out)
+
+            def run(step: SweepConfig, rep: ProgressCallback | None) -> SweepSummary:
+                return _run(step, out, jobs, dask, retry_failed, rep)
+
             if auto is None:
-                return _run(cfg, out, jobs, dask, retry_failed, report)
-            return _auto(cfg, auto, out, jobs, dask, retry_failed, report)
+                return run(cfg, report)
+            return _auto(cfg, auto, out, run, report)
     finally:
         if isinstance(report, EpisodeBar):
             report.close()
@@ -273,12 +277,11 @@ def _auto(
     cfg: SweepConfig,
     auto: AutoSeeds,
     out: Path,
-    jobs: int,
-    dask: str | None,
-    retry_failed: bool,
+    run: Callable[[SweepConfig, ProgressCallback | None], SweepSummary],
     report: ProgressCallback | None,
 ) -> SweepSummary:
-    """Sweep seeds ``0 .. k batch - 1`` for k = 1, 2, ... until :meth:`AutoSeeds.decide` stops."""
+    """Sweep seeds ``0 .. k batch - 1`` for k = 1, 2, ... until :meth:`AutoSeeds.decide` stops
+    (``run(config, progress)`` plays the episodes of a config not stored yet)."""
     policies = [v.label for v in cfg.schedulers if v.name != "oracle"]
     played = planned = 0
 
@@ -291,7 +294,7 @@ def _auto(
     while True:
         look += 1
         step = dataclasses.replace(cfg, seeds=tuple(auto.seeds(look)))
-        s = _run(step, out, jobs, dask, retry_failed, batch_report)
+        s = run(step, batch_report)
         played, planned = played + s.ran + len(s.lost), planned + s.total - s.skipped
         total = dataclasses.replace(
             total,
