@@ -7,7 +7,7 @@ episode (``row`` is the episode's result; a non-empty ``row["error"]`` counts as
 sweeps mark failed rows with ``status``).
 
 The bar is :class:`tqdm.auto.tqdm`: in a terminal it redraws one line in place (``compare:
-40%|####      | 8/20 [00:04<00:06, 1.9 episode/s, failed=1]``); in Jupyter it is a widget updated in
+40%|####      | 8/20 episodes [00:04<00:06, 1.90ep/s, failed=1]``); in Jupyter it is a widget updated in
 place when ``ipywidgets`` is installed (the ``notebooks`` extra), else one text line redrawn at
 most every 15 s, so an executed notebook stores a handful of updates instead of a line per
 episode. Wherever stderr is not a terminal (logs, pipes, notebooks without widgets) it redraws at
@@ -42,6 +42,10 @@ Progress = bool | ProgressCallback | None
 """What the ``progress`` argument of compare and sweep accepts."""
 
 _QUIET_INTERVAL_S = 15.0  # redraw interval where stderr is not a terminal
+_FORMAT = (
+    "{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} episodes "
+    "[{elapsed}<{remaining}, {rate_fmt}{postfix}]"
+)
 
 
 def _tqdm() -> Any:
@@ -86,7 +90,8 @@ class EpisodeBar:
             total=total + self.initial,
             initial=self.initial,
             desc=self.label,
-            unit=" episode",
+            unit="ep",
+            bar_format=_FORMAT,
             file=self.file,
             mininterval=0.5 if tty else _QUIET_INTERVAL_S,
             dynamic_ncols=tty,

@@ -29,7 +29,9 @@ def test_compare_prints_table_and_writes_files(tmp_path, capsys):
     assert lines[1].split()[:3] == ["scheduler", "n", "err"]
     assert lines[2].split()[:3] == ["greedy", "2", "0"] and lines[3].startswith("idle")
     assert "difficulty" in captured.out
-    assert "compare: 100%" in captured.err and "4/4" in captured.err and "episode/s" in captured.err
+    assert (
+        "compare: 100%" in captured.err and "4/4" in captured.err and "4/4 episodes" in captured.err
+    )
     doc = json.loads(out_json.read_text())
     assert [r["scheduler"] for r in doc["table"]] == ["greedy", "idle"]
     assert len(doc["episodes"]) == 4

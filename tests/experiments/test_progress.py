@@ -21,7 +21,13 @@ def test_bar_counts_episodes_and_failures():
         bar(2, 2, {"status": "failed"})
         bar(3, 5, {})  # a new batch of seeds added three episodes
     text = out.getvalue()
-    assert "compare" in text and "3/5" in text and "failed=1" in text and "episode/s" in text
+    assert (
+        "compare" in text
+        and "3/5" in text
+        and "failed=1" in text
+        and "episodes" in text
+        and "ep/s" in text
+    )
 
 
 def test_output_is_bounded_when_not_a_terminal():
