@@ -161,7 +161,7 @@ def run(args: argparse.Namespace) -> int:
     print(result.format())
     if args.by_difficulty:
         print()
-        print(result.format(by_difficulty=True))
+        print(result.format(by_difficulty=True, statistics=False))
     for path, write in ((args.json, result.to_json), (args.csv, result.to_csv)):
         if path is not None:
             try:

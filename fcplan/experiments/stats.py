@@ -368,6 +368,8 @@ class PairedComparison:
         Significance level of :meth:`verdict`.
     family : int
         Number of pairs in the Holm family.
+    median : float
+        Median of the differences (the side the signed-rank test leans to).
     """
 
     a: str
@@ -383,6 +385,7 @@ class PairedComparison:
     higher_is_better: bool = True
     alpha: float = 0.05
     family: int = 1
+    median: float = math.nan
 
     @property
     def n(self) -> int:
@@ -418,7 +421,9 @@ class PairedComparison:
         * ``"<name> ahead on the mean, not significant after Holm"``: the interval excludes 0
           but the signed-rank test, adjusted over the family, does not agree;
         * ``"unresolved at n=N"``: the interval contains 0 (too wide to tell), with the pairs an
-          80 %-power study would need at the observed effect, and a note when the signed-rank
+          80 %-power study would need at the observed effect, a note when the signed-rank test
+          (Holm-adjusted) does find a difference (the typical difference leans to one side while
+          the mean difference is still unresolved), and a note when the signed-rank
           test cannot reach ``alpha`` with so few pairs (its smallest p is ``2 / 2^n``, times
           the family size after Holm);
         * ``"identical on all N pairs"``, ``"no pairs"``, ``"one pair: no interval"``.
@@ -459,6 +464,9 @@ class PairedComparison:
                 if math.isfinite(need)
                 else f"no resolvable effect at {size}"
             )
+        if self.p_holm < self.alpha and self.median == self.median and self.median != 0:
+            side = self.a if (self.median > 0) == self.higher_is_better else self.b
+            notes.append(f"but Wilcoxon favours {side}, Holm p={self.p_holm:.2g}")
         if floor:
             notes.append(floor)
         return f"unresolved at n={n}" + (f" ({'; '.join(notes)})" if notes else "")
@@ -522,11 +530,12 @@ def paired_comparisons(
             ci = mean_ci(d, confidence)
             effect = ci.mean / ci.std if ci.std and ci.std > 0 else math.nan
             counts = (int((d > 0).sum()), int((d == 0).sum()), int((d < 0).sum()))
-            rows.append((a, b, ci, wilcoxon_p(d), effect, counts))
+            median = float(np.median(d)) if d.size else math.nan
+            rows.append((a, b, ci, wilcoxon_p(d), effect, counts, median))
     adjusted = holm([r[3] for r in rows])
     return [
         PairedComparison(
-            a, b, ci, p, float(ph), eff, metric, *counts, higher_is_better, alpha, len(rows)
+            a, b, ci, p, float(ph), eff, metric, *counts, higher_is_better, alpha, len(rows), med
         )
-        for (a, b, ci, p, eff, counts), ph in zip(rows, adjusted, strict=True)
+        for (a, b, ci, p, eff, counts, med), ph in zip(rows, adjusted, strict=True)
     ]

@@ -163,3 +163,14 @@ def test_kendall_w_is_in_the_unit_interval(blocks):
     """Kendall's W is in [0, 1] (or NaN when undefined) for any data, ties included."""
     f = friedman(np.array(blocks).T)
     assert math.isnan(f.w) or 0.0 <= f.w <= 1.0 + 1e-12
+
+
+def test_unresolved_mean_with_a_significant_rank_test_says_so():
+    """When most pairs lean one way but a few large differences the other way keep the mean's
+    interval around 0, the verdict is 'unresolved' and names the side the signed-rank test
+    favours."""
+    d = np.array([-1.0] * 90 + [1.0] * 20 + [10.0] * 6)  # median -1, mean ~ -0.08
+    (c,) = paired_comparisons({"x": d, "y": np.zeros(d.size)})
+    assert not c.resolved and c.p_holm < 0.05 and c.median == -1.0
+    assert c.verdict().startswith("unresolved at n=116 (")
+    assert "but Wilcoxon favours y, Holm p=" in c.verdict()
