@@ -68,14 +68,15 @@ BAD_SPECS = (
 class Tally:
     """Outcome counts of one category, with the first example of each non-clean outcome."""
 
-    def __init__(self, name: str, timeout: float, show_ran: bool = False) -> None:
+    def __init__(self, name: str, timeout: float, cwd: Path, show_ran: bool = False) -> None:
         self.name, self.timeout, self.show_ran = name, timeout, show_ran
+        self.cwd = cwd  # relative paths in hostile arguments land here
         self.counts: Counter = Counter()
         self.seen: set[tuple[str, str]] = set()
         self.peak_mb, self.slowest = 0.0, 0.0
 
     def run(self, argv: list[str], what: str = "", **kw) -> Case:
-        case = run_cli(argv, timeout=self.timeout, fork=True, **kw)
+        case = run_cli(argv, cwd=self.cwd, timeout=self.timeout, fork=True, **kw)
         self.add(case, what or " ".join(argv))
         return case
 
@@ -100,9 +101,10 @@ def mutants(t: Tally, folder: Path, n: int, seed: int) -> None:
         what, doc = mutant(rng)
         f = folder / f"mutant{k}.toml"
         f.write_text(to_toml(doc), encoding="utf-8")
-        case = run_cli(["scenario", "validate", str(f)], timeout=t.timeout, fork=True)
+        case = run_cli(["scenario", "validate", str(f)], cwd=folder, timeout=t.timeout, fork=True)
         if case.outcome == Outcome.RAN:
-            case = run_cli(["run", str(f), "--seed", "0"], timeout=t.timeout, fork=True)
+            argv = ["run", str(f), "--seed", "0"]
+            case = run_cli(argv, cwd=folder, timeout=t.timeout, fork=True)
         t.add(case, what)
 
 
@@ -158,7 +160,7 @@ def specs(t: Tally, folder: Path) -> None:
     from fcplan.scenario.write import dump_scenario
 
     dump_scenario(load_scenario("practice").replace(duration_s=3.0), short)
-    accepted = Tally("specs", t.timeout, show_ran=True)
+    accepted = Tally("specs", t.timeout, folder, show_ran=True)
     for name, setting in _settings():
         for value in SPEC_VALUES:
             accepted.run(["run", str(short), "-s", f"{name}:{setting}={value}"])
@@ -187,8 +189,6 @@ def _settings() -> list[tuple[str, str]]:
 def arguments(t: Tally, folder: Path) -> None:
     from tests.cli.test_cli_abuse import BAD_ARGUMENTS
 
-    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # fcplan play --screenshot, headless
-    os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
     for argv in BAD_ARGUMENTS:
         t.run(list(argv))
     fx = Fixtures.make(folder / "fx")
@@ -268,7 +268,7 @@ def sweeps(t: Tally, folder: Path) -> None:
     d.mkdir()
     config = sw.write_config(d, duration=5.0)
     argv = ["sweep", str(config), "--results", str(d / "r"), "-j", "1", "-q"]
-    case = run_cli(argv, timeout=t.timeout, fork=True, prepare=_full_disk_after(2))
+    case = run_cli(argv, cwd=d, timeout=t.timeout, fork=True, prepare=_full_disk_after(2))
     intact = len(load_results(d / "r")) == 2 and not list((d / "r").glob(".*.tmp"))
     t.add(case if intact else Case(argv, Outcome.TRACEBACK, 1, "rows lost", 0, 0), "ENOSPC")
     print(f"  sweeps ENOSPC injected: {case.outcome}, rows intact {intact}: {case.first_line}")
@@ -297,11 +297,16 @@ def main() -> None:
     }
     tallies = []
     t0 = time.time()
+    os.environ["SDL_VIDEODRIVER"] = "dummy"  # fcplan play --screenshot, headless
+    os.environ["SDL_AUDIODRIVER"] = "dummy"
     print(f"load average at start: {os.getloadavg()}", flush=True)
     for name in args.only.split(","):
-        tally = Tally(name, args.timeout)
         t1 = time.time()
         with tempfile.TemporaryDirectory() as tmp:
+            scratch = Path(tmp) / "cwd"
+            scratch.mkdir()
+            tally = Tally(name, args.timeout, scratch)
+            os.environ["FCPLAN_DATA_DIR"] = str(scratch)  # games are recorded there
             runs[name](tally, Path(tmp))
         c = tally.counts
         print(f"{name}: " + ", ".join(f"{o} {c[o]}" for o in Outcome.ALL)

@@ -9,7 +9,11 @@ folder, a 12-s legacy folder). Each case must end in one line on stderr and exit
 
 Output options (``--json``, ``--record``, ``--video``, ...) are not given the FIFO: writing into
 a named pipe waits for its reader, as it does for every Unix tool (``fcplan compare --json
->(jq .)`` relies on it), so a FIFO without a reader is the caller's hang, not fcplan's.
+>(jq .)`` relies on it), so a FIFO without a reader is the caller's hang, not fcplan's. Nor are
+they given the system's ``/dev/zero`` and ``/dev/null``: a writer that replaces its target
+(write a temporary file, rename it) would replace the device itself when run as root. They get a
+private character device instead (``{node}``, a copy of ``/dev/null`` made in the fixtures
+folder when ``mknod`` is permitted), which shows the same fault harmlessly.
 
 Examples
 --------
@@ -27,11 +31,20 @@ from __future__ import annotations
 
 import argparse
 import os
+import stat
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["HOSTILE", "OUTPUTS", "Fixtures", "OptionCase", "base_commands", "option_cases"]
+__all__ = [
+    "HOSTILE",
+    "NOT_FOR_OUTPUTS",
+    "OUTPUTS",
+    "Fixtures",
+    "OptionCase",
+    "base_commands",
+    "option_cases",
+]
 
 #: Values every option and positional is given: special floats, signs, zero, the tiny and the
 #: huge, numbers beyond float and int64, not numbers, empty, special files and folders
@@ -39,8 +52,10 @@ __all__ = ["HOSTILE", "OUTPUTS", "Fixtures", "OptionCase", "base_commands", "opt
 HOSTILE: tuple[str, ...] = (
     "nan", "inf", "-inf", "-1", "0", "1e-300", "1e300", "1e999", "99999999999999999999",
     "0x10", "x", "", " ", "1,", "0-99999999999", "-", "/dev/zero", "/dev/null",
-    "/nonexistent/dir/x", "{folder}", "{fifo}", "{big}", "{deep}",
+    "/nonexistent/dir/x", "{folder}", "{fifo}", "{big}", "{deep}", "{node}",
 )  # fmt: skip
+#: Values never given to an output option (see the module docstring).
+NOT_FOR_OUTPUTS = frozenset({"{fifo}", "/dev/zero", "/dev/null"})
 #: Options naming a file or folder fcplan writes.
 OUTPUTS = frozenset(
     {"--json", "--csv", "--record", "--video", "--screenshot", "--out", "--results"}
@@ -60,13 +75,14 @@ class Fixtures:
     fifo: str
     big: str  # a sparse 1 GiB file
     deep: str  # a TOML file nesting arrays 50,000 deep
+    node: str  # a character device like /dev/null (a regular empty file where mknod is refused)
 
     @classmethod
     def make(cls, folder: str | os.PathLike[str], build: bool = True) -> Fixtures:
         """Write the fixtures into ``folder`` (``build=False``: only name them)."""
         d = Path(folder)
         fx = cls(*(str(d / n) for n in ("", "short.toml", "study.toml", "results", "short.npz",
-                                        "legacy", "fifo", "big.bin", "deep.toml")))  # fmt: skip
+                                        "legacy", "fifo", "big.bin", "deep.toml", "null")))  # fmt: skip
         if build:
             fx._build()
         return fx
@@ -90,10 +106,15 @@ class Fixtures:
         with open(self.big, "wb") as fh:
             fh.truncate(2**30)
         Path(self.deep).write_text('name = "x"\nnotes = ' + "[" * 50_000 + "]" * 50_000 + "\n")
+        try:
+            os.mknod(self.node, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+        except (OSError, AttributeError):  # not permitted here
+            Path(self.node).write_bytes(b"")
 
     def fill(self, value: str) -> str:
         """``value`` with its placeholder replaced by the fixture's path."""
-        return value.format(**{k: getattr(self, k) for k in ("folder", "fifo", "big", "deep")})
+        names = ("folder", "fifo", "big", "deep", "node")
+        return value.format(**{k: getattr(self, k) for k in names})
 
 
 def base_commands(fx: Fixtures) -> dict[str, list[str]]:
@@ -170,7 +191,7 @@ def option_cases(fx: Fixtures) -> list[OptionCase]:
                 continue
             name = action.option_strings[0] if action.option_strings else action.dest
             for value in HOSTILE:
-                if value == "{fifo}" and name in OUTPUTS:
+                if value in NOT_FOR_OUTPUTS and name in OUTPUTS:
                     continue  # see the module docstring
                 argv = _with(base, action, len(words), fx.fill(value))
                 cases.append(OptionCase(command, name, value, argv))

@@ -13,7 +13,8 @@ process), else a fresh ``python -m fcplan`` (for the test suite, whose workers h
 
 Examples
 --------
->>> case = run_cli(["run", "nosuch"], timeout=120)
+>>> import tempfile
+>>> case = run_cli(["run", "nosuch"], cwd=tempfile.mkdtemp(), timeout=120)
 >>> case.outcome, case.orphans
 ('clean error', [])
 >>> case.first_line  # doctest: +ELLIPSIS
@@ -149,14 +150,17 @@ def _limit(memory: int) -> None:
     resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
 
 
-def _forked(argv: list[str], memory: int, err: int, prepare: Callable[[], None] | None) -> int:
-    """Start ``fcplan argv`` in a forked child (its own session); its pid."""
+def _forked(
+    argv: list[str], memory: int, err: int, prepare: Callable[[], None] | None, cwd: str
+) -> int:
+    """Start ``fcplan argv`` in a forked child (its own session, in ``cwd``); its pid."""
     pid = os.fork()
     if pid:
         return pid
     code = 1
     try:  # the child: never returns
         os.setsid()
+        os.chdir(cwd)
         with contextlib.suppress(OSError):  # peak RSS from now on, not the parent's (Linux)
             Path("/proc/self/clear_refs").write_text("5")
         _limit(memory)
@@ -175,8 +179,8 @@ def _forked(argv: list[str], memory: int, err: int, prepare: Callable[[], None] 
         os._exit(code)
 
 
-def _spawned(argv: list[str], memory: int, err: int, env: dict[str, str] | None) -> int:
-    """Start ``python -m fcplan argv`` (its own session); its pid."""
+def _spawned(argv: list[str], memory: int, err: int, env: dict[str, str] | None, cwd: str) -> int:
+    """Start ``python -m fcplan argv`` (its own session, in ``cwd``); its pid."""
     full = {**os.environ, **(env or {})}
     full["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), full.get("PYTHONPATH", "")) if p)
     proc = subprocess.Popen(  # noqa: S603 - our own interpreter and module
@@ -185,6 +189,7 @@ def _spawned(argv: list[str], memory: int, err: int, env: dict[str, str] | None)
         stdout=subprocess.DEVNULL,
         stderr=err,
         env=full,
+        cwd=cwd,
         start_new_session=True,
         preexec_fn=lambda: _limit(memory),  # noqa: PLW1509 - only setrlimit
     )
@@ -195,6 +200,7 @@ def _spawned(argv: list[str], memory: int, err: int, env: dict[str, str] | None)
 def run_cli(
     argv: list[str],
     *,
+    cwd: str | os.PathLike[str],
     timeout: float,
     memory: int = MEMORY_LIMIT,
     fork: bool = False,
@@ -202,9 +208,10 @@ def run_cli(
     env: dict[str, str] | None = None,
     grace: float = ORPHAN_GRACE_S,
 ) -> Case:
-    """Run ``fcplan argv`` as a bounded case (see the module docstring).
+    """Run ``fcplan argv`` in the folder ``cwd`` as a bounded case (see the module docstring).
 
-    ``prepare`` runs in a forked child before the command (``fork=True`` only), e.g. to inject a
+    ``cwd`` should be a scratch folder: relative paths in hostile arguments (an output named
+    ``nan`` or ``-1``) land there. ``prepare`` runs in a forked child before the command (``fork=True`` only), e.g. to inject a
     fault; ``env`` adds environment variables (spawned children only). A case over ``timeout``
     seconds is killed with its whole process group and is a hang.
     """
@@ -213,9 +220,9 @@ def run_cli(
     with tempfile.TemporaryFile() as err:
         t0 = time.monotonic()
         if fork:
-            pid = _forked(argv, memory, err.fileno(), prepare)
+            pid = _forked(argv, memory, err.fileno(), prepare, os.fspath(cwd))
         else:
-            pid = _spawned(argv, memory, err.fileno(), env)
+            pid = _spawned(argv, memory, err.fileno(), env, os.fspath(cwd))
         status, rss_kb = None, 0
         while time.monotonic() - t0 < timeout:
             done, raw, usage = os.wait4(pid, os.WNOHANG)
