@@ -132,18 +132,17 @@ def special_files(t: Tally, folder: Path) -> None:
 
 
 def _big_team(n: int) -> dict:
-    """#12 on a 4,000-px map with ``n`` agents (half perception, half action)."""
+    """#12 on a 2,000-px map with ``n`` agents (half perception, half action), each with its
+    own battery and speed (per-agent lists: the validator's per-agent path)."""
     from fcplan.scenario import load_scenario
 
     doc = load_scenario(12).to_dict()
-    doc["world_size"] = 4_000
-    team = doc["team"]
+    doc["world_size"] = 2_000
     for role in ("perception", "action"):
-        team[role]["count"] = n // 2
-        for key, value in list(team[role].items()):
-            if isinstance(value, list):  # per-agent lists become one value for all
-                team[role][key] = value[0]
-        team[role].pop("start", None)
+        team = doc["team"][role]
+        team["count"] = n // 2
+        team["battery"] = [400.0 + k % 200 for k in range(n // 2)]
+        team["speed"] = [15.0 + k % 10 for k in range(n // 2)]
     return doc
 
 

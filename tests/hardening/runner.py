@@ -10,6 +10,9 @@ counted as orphans) and its :class:`Outcome`.
 Two ways to start the child: ``fork=True`` forks this process and calls
 :func:`fcplan.cli.main` (no interpreter start-up: for the audit script, a single-threaded
 process), else a fresh ``python -m fcplan`` (for the test suite, whose workers have threads).
+:func:`run_in_process` runs :func:`fcplan.cli.main` in this process instead (fast, for the many
+small cases of the test suite): the time bound is a ``SIGALRM``, the memory measured is the peak
+of ``tracemalloc`` (Python and numpy allocations), orphans are this process's new children.
 
 Examples
 --------
@@ -43,6 +46,7 @@ __all__ = [
     "Outcome",
     "classify",
     "run_cli",
+    "run_in_process",
     "session_members",
 ]
 
@@ -240,3 +244,65 @@ def run_cli(
         text = err.read().decode("utf-8", "replace")
     outcome = Outcome.ORPHAN if orphans else classify(status, text)
     return Case(list(argv), outcome, status, text, seconds, rss_kb / 1024, orphans)
+
+
+class _HangError(Exception):
+    pass
+
+
+def _children() -> set[int]:
+    """Live (non-zombie) child processes of this process."""
+    me = os.getpid()
+    out = set()
+    for d in Path("/proc").iterdir():
+        fields = _stat(int(d.name)) if d.name.isdigit() else None
+        if fields is not None and fields[0] != "Z" and int(fields[1]) == me:
+            out.add(int(d.name))
+    return out
+
+
+def run_in_process(argv: list[str], *, timeout: int, grace: float = ORPHAN_GRACE_S) -> Case:
+    """Run :func:`fcplan.cli.main` on ``argv`` here (main thread only; see the module docstring).
+
+    Examples
+    --------
+    >>> run_in_process(["run", "nosuch"], timeout=60).outcome
+    'clean error'
+    """
+    import io
+    import tracemalloc
+
+    from fcplan.cli import main
+
+    def stop(signum, frame):
+        raise _HangError()
+
+    before = _children()
+    err, status = io.StringIO(), None
+    previous = signal.signal(signal.SIGALRM, stop)
+    tracemalloc.start()
+    t0 = time.monotonic()
+    signal.alarm(timeout)
+    try:
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            status = main(argv)
+    except _HangError:
+        status = None
+    except BaseException:  # noqa: BLE001 - anything escaping main is the finding
+        err.write(traceback.format_exc())
+        status = 1
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+        seconds = time.monotonic() - t0
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+    deadline = time.monotonic() + grace
+    while (left := _children() - before) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    for pid in left:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+    text = err.getvalue()
+    outcome = Outcome.ORPHAN if left else classify(status, text)
+    return Case(list(argv), outcome, status, text, seconds, peak / 2**20, sorted(left))
