@@ -58,8 +58,8 @@ from tests.hardening.runner import MEMORY_LIMIT, Case, Outcome, run_cli
 SPEC_VALUES = ("nan", "inf", "-inf", "-1", "0", "1e-300", "1e300", "99999999999999999999", "x",
                "true", "[1]")  # fmt: skip
 BAD_SPECS = (
-    "milp:slots=0", "routing:time_limit=nan", "routing:time_limit=0", "routing:time_limit=-1",
-    "routing:max_visits=-1", "greedy:route_length=0", "greedy:route_length=x", "greedy:nope=1",
+    "milp:slots=0", "milp:slots=x", "routing:time_limit=nan", "routing:time_limit=0",
+    "routing:time_limit=-1", "routing:max_visits=-1", "greedy:route_length=0", "greedy:route_length=x", "greedy:nope=1",
     "cbba:search_altitude=nan", "milp-cvxpy:time_limit=-1", "random:keep_probability=2",
     "idle:x=1", "nosuch", "greedy:", "greedy:=1", ":x=1", "greedy:route_length=1e999",
 )  # fmt: skip
