@@ -29,11 +29,18 @@ DEFAULT = [
 ]
 
 
-#: Cases fixed on another branch (the lead merges it): expected to fail here until then.
+#: Cases whose fix belongs to another branch (fcplan/cli/replay.py and fcplan/video.py are the
+#: cli engineer's): expected to fail here until the lead merges it.
 ELSEWHERE = {
-    ("replay", opt, v): "replay --start/--end accept inf on main; the cli branch checks finiteness"
-    for opt in ("--start", "--end")
-    for v in ("inf", "1e999")
+    **{
+        ("replay", opt, v): "--start/--end accept inf on main; the cli branch checks finiteness"
+        for opt in ("--start", "--end")
+        for v in ("inf", "1e999")
+    },
+    ("replay", "--size", "99999999999999999999"): "--size has no upper bound: numpy refuses "
+    "the frame (ValueError); the cli branch should bound it (e.g. <= 4096)",
+    ("replay", "--fps", "1e-300"): "--fps has no lower bound: a GIF frame delay of 1e302 cs "
+    "overflows (OverflowError/struct.error); the cli branch should bound it (e.g. >= 0.01)",
 }
 
 
