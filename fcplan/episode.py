@@ -16,6 +16,13 @@ Examples
 1800
 >>> sorted(result.metrics)
 ['manual', 'reference2020']
+
+A run whose scheduler fell back to greedy on more than half of its replans is flagged
+(:attr:`EpisodeResult.fallback_majority`, also in :meth:`EpisodeResult.summary`): its score is
+mostly greedy's, not the named scheduler's, and tables must say so.
+
+>>> result.fallback_majority, fell_back_mostly(fallbacks=6, replans=10)
+(False, True)
 """
 
 from __future__ import annotations
@@ -38,7 +45,16 @@ from fcplan.trace import Trace
 if TYPE_CHECKING:
     from fcplan.recording import Recorder
 
-__all__ = ["run_episode", "EpisodeResult"]
+__all__ = ["run_episode", "EpisodeResult", "fell_back_mostly"]
+
+
+def fell_back_mostly(fallbacks: int, replans: int) -> bool:
+    """Whether ``fallbacks`` are more than half of ``replans`` (none: False).
+
+    The rule behind :attr:`EpisodeResult.fallback_majority` and the ``fallback_majority``
+    column of comparisons, sweeps and reports.
+    """
+    return bool(replans > 0 and fallbacks > replans / 2)
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +77,9 @@ class EpisodeResult:
     wall_time_s : float
         Wall time of the whole episode.
     ticks : int
+
+    :attr:`fallbacks` counts the replans where greedy stood in; :attr:`fallback_majority` flags
+    an episode where that happened on more than half of them.
     """
 
     scenario: str
@@ -88,6 +107,12 @@ class EpisodeResult:
         """Number of replans where the scheduler failed and greedy stood in."""
         return sum(s.status == "fallback" for s in self.solves)
 
+    @property
+    def fallback_majority(self) -> bool:
+        """Whether the scheduler fell back to greedy on more than half of its replans (its score
+        is then mostly greedy's; :func:`fell_back_mostly`)."""
+        return fell_back_mostly(self.fallbacks, len(self.solves))
+
     def summary(self) -> dict[str, Any]:
         """Flat dict of the headline numbers (for tables)."""
         out: dict[str, Any] = {
@@ -110,6 +135,7 @@ class EpisodeResult:
             wall_time_s=self.wall_time_s,
             replans=len(self.solves),
             fallbacks=self.fallbacks,
+            fallback_majority=self.fallback_majority,
             optimal_replans=statuses.count("optimal"),
             time_limit_replans=statuses.count("time_limit"),
             solve_p50_ms=float(np.median(st) * 1e3) if st.size else 0.0,
