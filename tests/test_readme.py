@@ -50,12 +50,18 @@ NOT_RUN = {
     "fcplan play --scenario 12 --seed 3": "the interactive game (a window)",
     "fcplan sweep study.toml": "the 1,500-episode study (hours)",
     "fcplan sweep study.toml --dask local": "the 1,500-episode study (hours)",
+    "fcplan sweep study.toml --seeds auto": "the 1,500-episode study (hours)",
+    "fcplan compare --scenarios 1-3 --schedulers greedy,cbba,random --seeds 0-1": (
+        "run, output checked, by tests/cli/test_compare_readme.py"
+    ),
+    "fcplan compare --scenarios 1-3 --schedulers greedy,random --seeds auto": (
+        "run, output checked, by tests/cli/test_compare_readme.py"
+    ),
     "fcplan report results/study --html": "needs the study's results",
 }
 
 #: Commands that run but take more than a few seconds.
 SLOW_COMMANDS = {
-    "fcplan compare",
     "fcplan replay run.npz --video run.mp4",
     "SDL_VIDEODRIVER=dummy fcplan play",
 }
