@@ -9,13 +9,13 @@ extra; in a terminal it redraws twice a second, elsewhere (a log, a pipe) at mos
 
 :class:`EpisodeProgress` counts an episode in simulated seconds (an observer of the
 :class:`~fcplan.mission.Mission`, updated once per simulated second, so it costs nothing
-measurable per tick); :func:`progress_bar` is the bar itself, also used for video frames.
+measurable per tick); :class:`LazyBar` is the bar itself, also used for video frames.
 
 Examples
 --------
 >>> import io
 >>> out = io.StringIO()
->>> bar = progress_bar(10, desc="video", unit="frame", file=out)
+>>> bar = LazyBar(10, desc="video", unit="frame", file=out)
 >>> bar.update(10); bar.n
 10
 >>> bar.close(); out.getvalue()  # done before DELAY_S: nothing drawn (tqdm not even imported)
@@ -33,7 +33,7 @@ from typing import IO, Any
 from fcplan.mission import BaseObserver
 from fcplan.world import StepInfo, World
 
-__all__ = ["DELAY_S", "QUIET_INTERVAL_S", "EpisodeProgress", "LazyBar", "progress_bar"]
+__all__ = ["DELAY_S", "QUIET_INTERVAL_S", "EpisodeProgress", "LazyBar"]
 
 #: Seconds of work before a bar is shown.
 DELAY_S = 2.0
@@ -41,15 +41,11 @@ DELAY_S = 2.0
 QUIET_INTERVAL_S = 15.0
 
 
-def progress_bar(
-    total: float,
-    *,
-    desc: str,
-    unit: str,
-    file: IO[str] | None = None,
-    disable: bool = False,
-) -> LazyBar:
-    """A bar on ``file`` (default stderr) that appears after :data:`DELAY_S` seconds.
+class LazyBar:
+    """A bar on ``file`` (default stderr): counts work and becomes a :class:`tqdm.auto.tqdm` bar
+    once it has lasted :data:`DELAY_S` seconds, so a quick command never imports tqdm (about
+    0.1 s of start-up with its asyncio support). Use it as a context manager, or call
+    :meth:`close`.
 
     Parameters
     ----------
@@ -61,19 +57,11 @@ def progress_bar(
         Where the bar goes (default ``sys.stderr``).
     disable : bool
         Draw nothing.
-    """
-    return LazyBar(total, desc=desc, unit=unit, file=file, disable=disable)
-
-
-class LazyBar:
-    """Counts work and becomes a :class:`tqdm.auto.tqdm` bar once it has lasted :data:`DELAY_S`
-    seconds: a quick command never imports tqdm (about 0.1 s of start-up with its asyncio
-    support). Use it as a context manager, or call :meth:`close`.
 
     Attributes
     ----------
-    n, total : float
-        Work done and to do.
+    n : float
+        Work done so far.
     """
 
     def __init__(
@@ -140,7 +128,7 @@ class EpisodeProgress(BaseObserver):
     --------
     >>> import io
     >>> from fcplan import run_episode
-    >>> bar = progress_bar(180, desc="#1", unit="s", file=io.StringIO())
+    >>> bar = LazyBar(180, desc="#1", unit="s", file=io.StringIO())
     >>> _ = run_episode(1, "idle", observers=[EpisodeProgress(bar, 10)])
     >>> bar.n
     180

@@ -109,11 +109,11 @@ def run(args: argparse.Namespace) -> int:
 
 def _write(rec: Recording, args: argparse.Namespace, window: dict[str, Any]) -> int:
     """Write the video with a progress bar; print what was written."""
-    from fcplan.cli.progress import progress_bar
+    from fcplan.cli.progress import LazyBar
     from fcplan.video import replay_ticks, write_video
 
     total = len(replay_ticks(rec.n_ticks, rec.scenario.ticks_per_second, **window))
-    with progress_bar(total, desc=os.path.basename(args.video), unit="frame") as bar:
+    with LazyBar(total, desc=os.path.basename(args.video), unit="frame") as bar:
         n = write_video(
             rec,
             args.video,

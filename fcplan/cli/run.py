@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     """Run the episode and print its results."""
     import json
 
-    from fcplan.cli.progress import EpisodeProgress, progress_bar
+    from fcplan.cli.progress import EpisodeProgress, LazyBar
     from fcplan.episode import run_episode
     from fcplan.metrics import format_metrics
     from fcplan.scenario import load_scenario
@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     scheduler = make_scheduler(args.scheduler)
     label = f"{scenario.name} {getattr(scheduler, 'name', args.scheduler)}"
-    with progress_bar(scenario.duration_s, desc=label, unit="s") as bar:
+    with LazyBar(scenario.duration_s, desc=label, unit="s") as bar:
         res = run_episode(
             scenario,
             scheduler,

@@ -42,10 +42,8 @@ def test_progress_bar_counts_simulated_seconds_and_changes_no_result(capsys, mon
 
     import fcplan.cli.progress as progress
 
-    real = progress.progress_bar
-    monkeypatch.setattr(
-        progress, "progress_bar", lambda total, **kw: real(total, **kw, disable=True)
-    )
+    real = progress.LazyBar
+    monkeypatch.setattr(progress, "LazyBar", lambda total, **kw: real(total, **kw, disable=True))
     assert main(["run", "1", "-s", "idle", "--json"]) == 0
     plain = json.loads(capsys.readouterr().out)
     bars = []
@@ -54,7 +52,7 @@ def test_progress_bar_counts_simulated_seconds_and_changes_no_result(capsys, mon
         bars.append(real(total, **{**kwargs, "file": io.StringIO()}))
         return bars[-1]
 
-    monkeypatch.setattr(progress, "progress_bar", shown_bar)
+    monkeypatch.setattr(progress, "LazyBar", shown_bar)
     assert main(["run", "1", "-s", "idle", "--json"]) == 0
     with_bar = json.loads(capsys.readouterr().out)
     assert len(bars) == 1 and bars[0].n == bars[0].total == 180
