@@ -21,6 +21,7 @@ range(1, 1801, 10)
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import struct
 from collections.abc import Callable, Iterable, Iterator
@@ -36,9 +37,11 @@ if TYPE_CHECKING:
 #: called as ``progress(done, total)`` after each frame
 Progress = Callable[[int, int], None]
 
-__all__ = ["GifStream", "VideoError", "replay_ticks", "write_video", "VIDEO_SUFFIXES"]
+__all__ = ["FPS_RANGE", "GifStream", "VideoError", "replay_ticks", "write_video", "VIDEO_SUFFIXES"]
 
 VIDEO_SUFFIXES = (".mp4", ".gif")
+#: Frames per second a replay may ask for (a GIF counts delays in 1/100 s).
+FPS_RANGE = (0.01, 1000.0)
 _GIF_COLORS = 128  # palette entries taken from the first frame; index 255 marks "unchanged"
 _GIF_CLEAR = 255
 _GIF_MAX_DELAY = 0xFFFF  # centiseconds, the largest delay of one GIF frame
@@ -75,8 +78,11 @@ def replay_ticks(
     range
         Ticks in ``1..n_ticks``.
     """
-    if not (fps > 0 and speed > 0):
-        raise VideoError(f"--fps and --speed must be > 0 (got fps {fps}, speed {speed})")
+    if not (FPS_RANGE[0] <= fps <= FPS_RANGE[1] and 0 < speed < math.inf):
+        raise VideoError(
+            f"fps must be in {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g} and speed a finite number > 0 "
+            f"(got fps {fps}, speed {speed})"
+        )
     duration = n_ticks / ticks_per_second
     end_s = duration if end_s is None else end_s
     if not 0 <= start_s < end_s or start_s >= duration:
@@ -283,11 +289,7 @@ class GifStream:
         if not changed.any():
             assert self._pending is not None
             data, offset, cs = self._pending
-            if cs + delay <= _GIF_MAX_DELAY:
-                self._pending = (data, offset, cs + delay)
-                return
-            self._flush()  # a delay is 16 bits: go on with a 1-px frame that changes nothing
-            self._pending = (np.full((1, 1), _GIF_CLEAR, np.uint8), (0, 0), delay)
+            self._pending = (data, offset, cs + delay)
             return
         rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
         box = (slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1))
@@ -329,10 +331,16 @@ class GifStream:
 
         data, (x, y), cs = self._pending
         self._pending = None
-        h, w = data.shape
-        lzw = Image.frombytes("P", (w, h), data.tobytes()).tobytes("gif", "P")
-        self.fh.write(b"!\xf9\x04" + struct.pack("<BHBB", 0x05, cs, _GIF_CLEAR, 0))
-        self.fh.write(b"," + struct.pack("<HHHHB", x, y, w, h, 0) + b"\x08" + lzw + b"\x00")
+        while True:  # a delay is 16 bits: a longer one goes on in 1-px frames that change nothing
+            h, w = data.shape
+            lzw = Image.frombytes("P", (w, h), data.tobytes()).tobytes("gif", "P")
+            head = struct.pack("<BHBB", 0x05, min(cs, _GIF_MAX_DELAY), _GIF_CLEAR, 0)
+            self.fh.write(b"!\xf9\x04" + head)
+            self.fh.write(b"," + struct.pack("<HHHHB", x, y, w, h, 0) + b"\x08" + lzw + b"\x00")
+            cs -= _GIF_MAX_DELAY
+            if cs <= 0:
+                return
+            data, x, y = np.full((1, 1), _GIF_CLEAR, np.uint8), 0, 0
 
 
 @contextlib.contextmanager

@@ -247,3 +247,26 @@ def test_a_failed_video_leaves_no_file(rec_path, tmp_path, suffix, monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         write_video(load_recording(rec_path), tmp_path / f"v{suffix}", size=96, speed=20)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_bounds_what_a_frame_and_a_gif_can_hold(rec_path, capsys):
+    """--fps outside 0.01..1000 (a GIF delay of 1e302 cs), --size beyond 4096 px (a frame numpy
+    cannot allocate) and an infinite --start or --end are one-line errors naming the range; the
+    command's fps range is the library's."""
+    from fcplan.cli.replay import _fps
+    from fcplan.video import FPS_RANGE
+
+    assert _fps(str(FPS_RANGE[0])) == FPS_RANGE[0] and _fps(str(FPS_RANGE[1])) == FPS_RANGE[1]
+    for option, value, named in [
+        ("--fps", "1e-300", "0.01..1000"),
+        ("--fps", "1001", "0.01..1000"),
+        ("--size", "99999999999999999999", "64..4096"),
+        ("--size", "63", "64..4096"),
+        ("--start", "inf", "seconds >= 0"),
+        ("--end", "1e999", "seconds >= 0"),
+    ]:
+        assert main(["replay", str(rec_path), "--video", "x.gif", option, value]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and named in err and repr(value) in err, err
+    with pytest.raises(VideoError, match="fps must be in"):
+        replay_ticks(1800, 10, fps=1e-300)

@@ -24,6 +24,7 @@ Examples
 from __future__ import annotations
 
 import argparse
+import math
 import os
 from typing import TYPE_CHECKING, Any
 
@@ -33,7 +34,6 @@ from fcplan.cli.util import (
     check_input,
     check_output,
     positive_float,
-    positive_int,
 )
 
 if TYPE_CHECKING:
@@ -41,8 +41,8 @@ if TYPE_CHECKING:
 
 __all__ = ["add_parser", "run"]
 
-#: Smallest map side (px) a frame is drawn at.
-MIN_SIZE = 64
+#: Map sides (px) a frame may be drawn at.
+SIZE_RANGE = (64, 4096)
 
 
 def _non_negative(text: str) -> float:
@@ -56,21 +56,45 @@ def _non_negative(text: str) -> float:
     return v
 
 
+def _fps(text: str) -> float:
+    """Frames per second in :data:`fcplan.video.FPS_RANGE`."""
+    lo, hi = 0.01, 1000.0  # fcplan.video.FPS_RANGE, without importing numpy to build the parser
+    try:
+        v = float(text)
+    except ValueError:
+        v = math.nan
+    if not lo <= v <= hi:
+        raise argparse.ArgumentTypeError(
+            f"expected frames per second in {lo:g}..{hi:g}, got {text!r}"
+        )
+    return v
+
+
+def _size(text: str) -> int:
+    """A map side in px, in :data:`SIZE_RANGE`."""
+    lo, hi = SIZE_RANGE
+    try:
+        v = int(text)
+    except ValueError:
+        v = 0
+    if not lo <= v <= hi:
+        raise argparse.ArgumentTypeError(f"expected a size in px in {lo}..{hi}, got {text!r}")
+    return v
+
+
 def add_parser(sub: SubParsers) -> None:
     """Add ``fcplan replay`` to the ``fcplan`` sub-parsers ``sub``."""
     p = sub.add_parser("replay", help="watch a recording, or write it as an MP4/GIF video")
     p.add_argument("path", help="recording (.npz) from fcplan run --record or fcplan play")
     p.add_argument("--video", metavar="OUT", help="write OUT (.mp4 or .gif) instead of a window")
-    p.add_argument(
-        "--fps", type=positive_float, default=10.0, metavar="N", help="frames per second (10)"
-    )
+    p.add_argument("--fps", type=_fps, default=10.0, metavar="N", help="frames per second (10)")
     p.add_argument("--speed", type=positive_float, default=1.0, help="times real time (default 1)")
     p.add_argument(
         "--size",
-        type=positive_int,
+        type=_size,
         default=512,
         metavar="PX",
-        help=f"map size in px, at least {MIN_SIZE} (512)",
+        help=f"map size in px, {SIZE_RANGE[0]}..{SIZE_RANGE[1]} (512)",
     )
     p.add_argument("--truth", action="store_true", help="also show fire the team has not seen")
     p.add_argument(
@@ -89,8 +113,6 @@ def run(args: argparse.Namespace) -> int:
     from fcplan.video import VIDEO_SUFFIXES
 
     check_input(args.path, "recording")
-    if args.size < MIN_SIZE:
-        raise CliError(f"--size must be at least {MIN_SIZE} px, got {args.size}")
     if args.video:
         check_output(args.video, "--video")
         if os.path.splitext(args.video)[1].lower() not in VIDEO_SUFFIXES:

@@ -20,11 +20,11 @@ Examples
 >>> import tempfile
 >>> fx = Fixtures.make(tempfile.mkdtemp(), build=False)
 >>> cases = option_cases(fx)
->>> ["run", fx.scenario, "-s", "idle", "--seed", "nan"] in [c.argv for c in cases]
+>>> ["run", fx.scenario, "-s", "idle", "--seed=nan"] in [c.argv for c in cases]
 True
 >>> sorted({c.command for c in cases})  # doctest: +NORMALIZE_WHITESPACE
 ['compare', 'import-legacy', 'play', 'replay', 'report', 'run', 'scenario validate',
- 'scenarios', 'sweep']
+ 'scenarios', 'schedulers', 'sweep']
 """
 
 from __future__ import annotations
@@ -122,6 +122,7 @@ def base_commands(fx: Fixtures) -> dict[str, list[str]]:
     out = os.path.join(fx.folder, "out")
     return {
         "scenarios": ["scenarios"],
+        "schedulers": ["schedulers", "idle"],
         "scenario validate": ["scenario", "validate", fx.scenario],
         "run": ["run", fx.scenario, "-s", "idle"],
         "compare": [
