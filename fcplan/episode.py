@@ -29,13 +29,14 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fcplan.metrics import Metrics, Outcomes, compute_all, compute_outcomes
-from fcplan.mission import Mission, ScenarioLike, as_scenario
+from fcplan.mission import EpisodeObserver, Mission, ScenarioLike, as_scenario
 from fcplan.scenario import Scenario
 from fcplan.scheduling import Scheduler, SolveStats, make_scheduler
 from fcplan.taskgraph import TaskGraphParams
@@ -156,6 +157,7 @@ def run_episode(
     event_replans: bool = True,
     record: str | os.PathLike[str] | None = None,
     latency: str | None = None,
+    observers: Sequence[EpisodeObserver] = (),
 ) -> EpisodeResult:
     """Play one episode of ``scenario`` with ``scheduler`` (a :class:`fcplan.mission.Mission`).
 
@@ -180,6 +182,9 @@ def run_episode(
         Planning takes time in the world: a plan applies that many ticks after its replan, the
         team flying its last orders meanwhile (:meth:`fcplan.mission.Mission.run`). None (the
         default) stops the world while the scheduler thinks, as the manual's game does.
+    observers : sequence of EpisodeObserver
+        Also told about every replan, command and tick (:class:`fcplan.mission.BaseObserver`),
+        e.g. a progress bar; they watch and change nothing.
 
     Returns
     -------
@@ -205,7 +210,7 @@ def run_episode(
         replan_period=replan_period,
         event_replans=event_replans,
         graph_params=graph_params,
-        observers=() if recorder is None else (recorder,),
+        observers=(*observers, *(() if recorder is None else (recorder,))),
     )
     mission.run(scheduler, time_limit=time_limit, latency=latency)
     trace = mission.world.trace()

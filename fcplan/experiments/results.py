@@ -71,7 +71,7 @@ __all__ = [
     "write_manifest",
 ]
 
-FORMAT = {"format": "fcplan-sweep-episode", "version": 1}
+FORMAT: dict[str, Any] = {"format": "fcplan-sweep-episode", "version": 1}
 #: Bound on one row file (a row of a 180-s episode is about 20 KB; one of a 10^6-tick episode
 #: with its per-replan lists about 3 MB).
 MAX_ROW_BYTES = 64 * 2**20
@@ -361,7 +361,8 @@ def _read(path: Path, columns: list[str] | None = None) -> Any:
     if not isinstance(fmt, dict) or fmt.get("format") != FORMAT["format"]:
         raise ResultsError(f"{path}: a Parquet file not written by fcplan sweep (foreign file)")
     version = fmt.get("version", 0)
-    if not isinstance(version, int) or version > FORMAT["version"]:
+    newest: int = FORMAT["version"]
+    if not isinstance(version, int) or version > newest:
         raise ResultsError(
             f"{path}: results format version {version!r:.40} is not one this fcplan reads "
             f"(1..{FORMAT['version']}; written by a newer fcplan?)"

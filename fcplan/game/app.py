@@ -21,7 +21,7 @@ from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-from fcplan.errors import FcplanError
+from fcplan.errors import FcplanError, install_hint
 from fcplan.game.screens import WINDOW, App
 from fcplan.recording.reader import read_bytes
 
@@ -37,7 +37,7 @@ def _import_pygame() -> Any:
     try:
         import pygame
     except ImportError:
-        raise GameError('the game needs pygame: pip install "fcplan[game]"') from None
+        raise GameError(f"the game needs pygame: {install_hint('game')}") from None
     return pygame
 
 
