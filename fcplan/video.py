@@ -39,6 +39,9 @@ Progress = Callable[[int, int], None]
 __all__ = ["GifStream", "VideoError", "replay_ticks", "write_video", "VIDEO_SUFFIXES"]
 
 VIDEO_SUFFIXES = (".mp4", ".gif")
+#: Frame rates a video may have: a GIF frame lasts at most 655.35 s, and no screen shows more
+#: than a few hundred frames a second.
+MIN_FPS, MAX_FPS = 0.01, 1000.0
 _GIF_COLORS = 128  # palette entries taken from the first frame; index 255 marks "unchanged"
 _GIF_CLEAR = 255
 _GIF_MAX_DELAY = 0xFFFF  # centiseconds, the largest delay of one GIF frame
@@ -75,8 +78,11 @@ def replay_ticks(
     range
         Ticks in ``1..n_ticks``.
     """
-    if not (fps > 0 and speed > 0):
-        raise VideoError(f"--fps and --speed must be > 0 (got fps {fps}, speed {speed})")
+    if not (MIN_FPS <= fps <= MAX_FPS and 0 < speed < float("inf")):
+        raise VideoError(
+            f"--fps must be in {MIN_FPS:g}..{MAX_FPS:g} and --speed a finite number > 0 "
+            f"(got fps {fps:g}, speed {speed:g})"
+        )
     duration = n_ticks / ticks_per_second
     end_s = duration if end_s is None else end_s
     if not 0 <= start_s < end_s or start_s >= duration:
@@ -339,6 +345,8 @@ class GifStream:
 def _atomic(path: str) -> Iterator[str]:
     """A path beside ``path`` (same suffix) to write, renamed onto ``path`` once the block ends
     normally; removed if it fails or is interrupted, so nothing half-written is left."""
+    if os.path.exists(path) and not os.path.isfile(path):  # never replace a device or FIFO
+        raise VideoError(f"{path}: not a regular file; videos are written to files")
     head, tail = os.path.split(path)
     stem, suffix = os.path.splitext(tail)
     tmp = os.path.join(head, f".{stem}.{os.getpid()}.part{suffix}")

@@ -41,8 +41,8 @@ if TYPE_CHECKING:
 
 __all__ = ["add_parser", "run"]
 
-#: Smallest map side (px) a frame is drawn at.
-MIN_SIZE = 64
+#: Smallest and largest map side (px) a frame is drawn at (a 4096-px frame is 48 MB of RGB).
+MIN_SIZE, MAX_SIZE = 64, 4096
 
 
 def _non_negative(text: str) -> float:
@@ -70,7 +70,7 @@ def add_parser(sub: SubParsers) -> None:
         type=positive_int,
         default=512,
         metavar="PX",
-        help=f"map size in px, at least {MIN_SIZE} (512)",
+        help=f"map size in px, {MIN_SIZE}..{MAX_SIZE} (512)",
     )
     p.add_argument("--truth", action="store_true", help="also show fire the team has not seen")
     p.add_argument(
@@ -89,8 +89,8 @@ def run(args: argparse.Namespace) -> int:
     from fcplan.video import VIDEO_SUFFIXES
 
     check_input(args.path, "recording")
-    if args.size < MIN_SIZE:
-        raise CliError(f"--size must be at least {MIN_SIZE} px, got {args.size}")
+    if not MIN_SIZE <= args.size <= MAX_SIZE:
+        raise CliError(f"--size must be in {MIN_SIZE}..{MAX_SIZE} px, got {args.size}")
     if args.video:
         check_output(args.video, "--video")
         if os.path.splitext(args.video)[1].lower() not in VIDEO_SUFFIXES:

@@ -29,19 +29,8 @@ DEFAULT = [
 ]
 
 
-#: Cases whose fix belongs to another branch (fcplan/cli/replay.py and fcplan/video.py are the
-#: cli engineer's): expected to fail here until the lead merges it.
-ELSEWHERE = {
-    **{
-        ("replay", opt, v): "--start/--end accept inf on main; the cli branch checks finiteness"
-        for opt in ("--start", "--end")
-        for v in ("inf", "1e999")
-    },
-    ("replay", "--size", "99999999999999999999"): "--size has no upper bound: numpy refuses "
-    "the frame (ValueError); the cli branch should bound it (e.g. <= 4096)",
-    ("replay", "--fps", "1e-300"): "--fps has no lower bound: a GIF frame delay of 1e302 cs "
-    "overflows (OverflowError/struct.error); the cli branch should bound it (e.g. >= 0.01)",
-}
+#: Cases whose fix belongs to another branch, expected to fail here until the lead merges it.
+ELSEWHERE: dict[tuple[str, str, str], str] = {}
 
 
 def _params(keys: list[tuple[str, str, str]]) -> list:
