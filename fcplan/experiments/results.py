@@ -48,7 +48,6 @@ import json
 import os
 import re
 import socket
-import stat
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
@@ -257,25 +256,11 @@ def _row_files(directory: str | os.PathLike[str]) -> Iterator[Path]:
 
 
 def _open_regular(path: Path, cap: int) -> IO[bytes]:
-    """``path`` opened for reading if it is a regular file of at most ``cap`` bytes (opened
-    without blocking and checked with ``fstat``, so a FIFO or device is never waited on)."""
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except OSError as exc:
-        raise ResultsError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise ResultsError(f"{path}: not a regular file (a FIFO, socket or device?); remove it")
-        if st.st_size > cap:
-            raise ResultsError(
-                f"{path}: {st.st_size:,} bytes, more than the {cap:,} a results file may have; "
-                "not written by fcplan sweep: move it elsewhere"
-            )
-        return os.fdopen(fd, "rb")
-    except BaseException:
-        os.close(fd)
-        raise
+    """``path`` opened if it is a regular file of at most ``cap`` bytes (never blocking on a
+    FIFO or device: :func:`fcplan.recording.reader.open_regular`)."""
+    from fcplan.recording.reader import open_regular
+
+    return open_regular(path, ResultsError, cap)
 
 
 def _manifest(path: Path) -> dict[str, Any]:

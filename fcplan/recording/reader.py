@@ -79,6 +79,7 @@ __all__ = [
     "MAX_HEADER_CHARS",
     "check_recording",
     "load_recording",
+    "open_regular",
     "read_bytes",
 ]
 
@@ -94,37 +95,46 @@ _ZIP_METHODS = (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED)
 _MODES = 4  # fcplan.team.Mode: IDLE, ACTIVE, RETURNING, HOMING
 
 
-def read_bytes(
-    path: str, error: type[FcplanError] = RecordingError, max_bytes: int | None = None
-) -> bytes:
-    """The bytes of ``path`` if it is a regular file (of at most ``max_bytes`` bytes).
+def open_regular(
+    path: str | os.PathLike[str], error: type[FcplanError], max_bytes: float = math.inf
+) -> IO[bytes]:
+    """``path`` opened for binary reading if it is a regular file of at most ``max_bytes``.
 
     The file is opened without blocking (a FIFO has no writer to wait for) and checked with
-    ``fstat``, then read up to one byte past the bound, so neither a special file nor a huge one
-    costs time or memory. Failures raise ``error`` naming the file.
+    ``fstat`` before anything is read, so neither a special file nor a huge one costs time or
+    memory. Failures raise ``error`` naming the file.
     """
-    cap = math.inf if max_bytes is None else max_bytes
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:
-        raise error(f"{path}: cannot read: {exc.strerror}") from None
+        raise error(f"{path}: cannot read: {exc.strerror or exc}") from None
     try:
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
-            raise error(f"{path}: not a regular file")
-        if st.st_size > cap:
-            raise error(f"{path}: {st.st_size} bytes exceeds the bound of {max_bytes}")
-        chunks, total = [], 0
-        while chunk := os.read(fd, 1 << 20):
-            chunks.append(chunk)
-            total += len(chunk)
-            if total > cap:
-                raise error(f"{path}: grew past the bound of {max_bytes} bytes while read")
-        return b"".join(chunks)
-    except OSError as exc:
-        raise error(f"{path}: cannot read: {exc.strerror}") from None
-    finally:
+            raise error(f"{path}: not a regular file (a FIFO, socket, device or folder)")
+        if st.st_size > max_bytes:
+            raise error(f"{path}: {st.st_size:,} bytes exceeds the bound of {max_bytes:,}")
+        return os.fdopen(fd, "rb")
+    except BaseException:
         os.close(fd)
+        raise
+
+
+def read_bytes(
+    path: str, error: type[FcplanError] = RecordingError, max_bytes: int | None = None
+) -> bytes:
+    """The bytes of ``path`` if it is a regular file (of at most ``max_bytes`` bytes), opened
+    with :func:`open_regular` and read up to one byte past the bound (a file that grows while
+    read is refused too). Failures raise ``error`` naming the file."""
+    cap = math.inf if max_bytes is None else max_bytes
+    with open_regular(path, error, cap) as fh:
+        try:
+            data = fh.read() if max_bytes is None else fh.read(max_bytes + 1)
+        except OSError as exc:
+            raise error(f"{path}: cannot read: {exc.strerror or exc}") from None
+    if len(data) > cap:
+        raise error(f"{path}: grew past the bound of {max_bytes} bytes while read")
+    return data
 
 
 def load_recording(path: str | os.PathLike[str], *, max_bytes: int = MAX_BYTES) -> Recording:

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import resource
 import signal
 import subprocess
@@ -41,6 +42,7 @@ from pathlib import Path
 
 __all__ = [
     "MEMORY_LIMIT",
+    "ONE_LINE",
     "ORPHAN_GRACE_S",
     "Case",
     "Outcome",
@@ -59,10 +61,15 @@ MEMORY_LIMIT = 6 * 2**30
 ORPHAN_GRACE_S = 5.0
 
 
+#: The one stderr line of a clean error: ``fcplan: error: ...`` or, from the argument parser,
+#: ``fcplan run: error: ...``.
+ONE_LINE = re.compile(r"^fcplan(?: [a-z][a-z-]*)*: error: ")
+
+
 class Outcome:
     """Categories of what a command did with a bad input (the audit's columns)."""
 
-    CLEAN = "clean error"  # exit 2, one line on stderr, no traceback
+    CLEAN = "clean error"  # exit 2, one line "fcplan[ command]: error: ..." on stderr
     RAN = "ran"  # exit 0
     TRACEBACK = "traceback"  # anything else that printed a traceback or exited otherwise
     HANG = "hang"  # over the time bound
@@ -79,6 +86,8 @@ def classify(status: int | None, stderr: str) -> str:
     --------
     >>> classify(2, "fcplan: error: x.toml: world_size must be ...\\n")
     'clean error'
+    >>> classify(2, "fcplan replay: error: argument --end: expected seconds >= 0, got 'x'\\n")
+    'clean error'
     >>> classify(1, "Traceback (most recent call last):\\n ...")
     'traceback'
     >>> classify(None, ""), classify(0, "progress\\n")
@@ -91,7 +100,7 @@ def classify(status: int | None, stderr: str) -> str:
     if "Traceback" in stderr:
         return Outcome.TRACEBACK
     lines = [ln for ln in stderr.splitlines() if ln.strip()]
-    if status == 2 and len(lines) == 1 and lines[0].startswith("fcplan: error: "):
+    if status == 2 and len(lines) == 1 and ONE_LINE.match(lines[0]):
         return Outcome.CLEAN
     if status == 0:
         return Outcome.RAN

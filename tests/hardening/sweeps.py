@@ -179,7 +179,7 @@ def outcome(t: Trial) -> str:
     outlived the bound; traceback if one was printed or a row was lost (the resume did not
     complete the grid, or left a temporary file); else clean error (exit 2 or 143 with one
     line) or ran (exit 0, or killed by the trial and completed by the resume)."""
-    from tests.hardening.runner import Outcome
+    from tests.hardening.runner import ONE_LINE, Outcome
 
     if t.orphans:
         return Outcome.ORPHAN
@@ -189,7 +189,7 @@ def outcome(t: Trial) -> str:
     if "Traceback" in t.stderr or lost:
         return Outcome.TRACEBACK
     lines = [ln for ln in t.stderr.splitlines() if ln.strip()]
-    if t.status == 2 and lines and lines[0].startswith("fcplan: error: "):
+    if t.status == 2 and len(lines) == 1 and ONE_LINE.match(lines[0]):
         return Outcome.CLEAN
     if t.status == 143 and lines and lines[0] == "fcplan: terminated":
         return Outcome.CLEAN

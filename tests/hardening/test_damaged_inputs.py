@@ -15,7 +15,6 @@ import random
 import pytest
 
 from tests.hardening import damage
-from tests.hardening.options import Fixtures
 from tests.hardening.runner import Outcome, run_cli, run_in_process
 
 pytestmark = pytest.mark.skipif(
@@ -26,19 +25,6 @@ TIME_BOUND_S = 240  # a report draws its plots: ~3 s on a quiet machine, 35 s on
 MEMORY_BOUND_MB = 512  # traced Python and numpy allocations of one in-process case
 RSS_BOUND_MB = 1024  # peak resident memory of a command run in its own process
 RANDOM_CASES = 4  # seeded random damages per reader in the default run
-
-
-@pytest.fixture(scope="module")
-def fx(tmp_path_factory):
-    """Valid inputs: a 3-s recording, a two-episode results folder, a 12-s legacy folder."""
-    return Fixtures.make(tmp_path_factory.mktemp("fixtures"))
-
-
-@pytest.fixture
-def scratch(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("FCPLAN_DATA_DIR", str(tmp_path))
-    return tmp_path
 
 
 def _bounded(argv: list[str], what: str) -> str:
