@@ -121,8 +121,8 @@ def _complete(
     bidders = np.flatnonzero(auc.eligible.any(axis=1))
     todo = bidders[[not paths[i] for i in bidders.tolist()]]
     picks = first_items(auc, todo, free)
-    for i, j, score in picks:
-        paths[i], bids[i] = [j], [score]
+    for i, j, bid in picks:
+        paths[i], bids[i] = [j], [bid]
         free[j] = False
     for i in sorted(i for i, _, _ in picks):
         work = int(auc.eligible[i].sum()) + BUILD_OVERHEAD

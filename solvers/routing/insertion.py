@@ -25,7 +25,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from solvers.routing.core import TOL, RoutesResult, RoutingFailedError, RoutingInstance
+from solvers.routing.core import TOL, RoutesResult, RoutingInstance
 
 __all__ = ["complete_by_insertion", "settle"]
 
@@ -101,17 +101,18 @@ def settle(
 ) -> RoutesResult:
     """The result of a search that ended with ``routes`` (task positions; None: nothing found),
     by the time-limit rule of :mod:`solvers.routing.core`: a search cut by the clock is completed
-    by insertion, or replaced by the warm start ``warm`` when that is better or the search found
-    nothing; with neither, :class:`~solvers.routing.core.RoutingFailedError` is raised."""
+    by insertion, or replaced by the warm start ``warm`` (itself completed by insertion) when
+    that is better or the search found nothing; with neither, the routes are built by cheapest
+    insertion from empty routes (``from_insertion``)."""
     status = "time_limit" if timed_out else "feasible"
     flags = {"warm_started": warm_started, "work": work}
     if routes is None:
         if warm is None:
-            raise RoutingFailedError(
-                f"{backend}: no routes for {inst.n_vehicles} vehicles x {inst.n_tasks} tasks "
-                "within the limit, and no warm start"
-            )
-        return inst.result(warm, "time_limit", backend, kept_warm_start=True, **flags)
+            built, _ = complete_by_insertion(inst, [[] for _ in range(inst.n_vehicles)])
+            return inst.result(built, "time_limit", backend, from_insertion=True, **flags)
+        kept, changed = complete_by_insertion(inst, warm)
+        return inst.result(kept, "time_limit", backend, kept_warm_start=True, repaired=changed,
+                           **flags)  # fmt: skip
     repaired = False
     if timed_out:
         routes, repaired = complete_by_insertion(inst, routes)

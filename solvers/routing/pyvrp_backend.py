@@ -92,14 +92,15 @@ def solve_pyvrp(
     """Search ``inst`` with PyVRP until ``deadline`` (``perf_counter`` time; None:
     deterministic, ``opts.iterations``), starting from ``warm`` (task positions) if given and
     ``from_warm``."""
+    if deadline is not None and deadline - time.perf_counter() - opts.reserve_s <= 0:
+        return _out_of_time(inst, warm)  # (before building the data)
     data = _data(inst, opts.scale)
     if deadline is None:
         stop: Any = MaxIterations(int(opts.iterations))
     else:
         time_left = deadline - time.perf_counter() - opts.reserve_s
         if time_left <= 0:
-            return settle(inst, None, warm, backend="pyvrp", timed_out=True,
-                          warm_started=False, work={"iterations": 0})  # fmt: skip
+            return _out_of_time(inst, warm)
         stop = MaxRuntime(opts.wall_fraction * time_left)
     init = None
     if warm is not None and from_warm:
@@ -127,6 +128,12 @@ def solve_pyvrp(
 
 
 _CLIENT = pyvrp.ActivityType.CLIENT
+
+
+def _out_of_time(inst: RoutingInstance, warm: list[list[int]] | None) -> RoutesResult:
+    """The result of a call whose time ran out before any search (the time-limit rule)."""
+    return settle(inst, None, warm, backend="pyvrp", timed_out=True, warm_started=False,
+                  work={"iterations": 0})  # fmt: skip
 
 
 def _data(inst: RoutingInstance, scale: float) -> Any:
