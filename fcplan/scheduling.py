@@ -23,11 +23,12 @@ scheduler says so (``status="time_limit"``, or ``partial=True``: it knows the pl
 unfinished) or when a scheduler whose plans may depend on the clock (it does not declare
 ``deterministic = True``) used up its limit. Such a plan is replaced by greedy's
 (``status="fallback"``, ``timed_out=True``, the reason in ``message``) if it is ``partial`` or
-leaves a **role idle** (:func:`idle_roles`): no agent of the role gets a route although the role
-has work, the action role being the available (not ``HOMING``) agents with water that can reach
-a fire task, the perception role the other available camera agents that can reach a task of
-positive value (:attr:`fcplan.taskgraph.TaskGraph.reachable`). Without a time-out an idle role
-is a decision and stands (``idle`` does that on purpose).
+leaves the **team idle** (:func:`idle_team`): agents have work but none gets a route. An agent
+has work when it is available (not ``HOMING``) and can reach (:attr:`fcplan.taskgraph.TaskGraph.
+reachable`) a fire task, if it has water, or else a task of positive value, if it has a camera.
+A plan that routes some agents with work is the scheduler's answer (a scheduler that knows it
+stopped before planning some role says ``partial``); without a time-out an idle team is a
+decision and stands (``idle`` does that on purpose).
 
 Schedulers are found by name: built-ins and third-party packages register a factory in the
 ``fcplan.schedulers`` entry-point group (``name = "module:Factory"``); :func:`register_scheduler`
@@ -94,7 +95,7 @@ __all__ = [
     "available_schedulers",
     "solve",
     "effective_time_limit",
-    "idle_roles",
+    "idle_team",
 ]
 
 #: Possible :attr:`SolveStats.status` values.
@@ -507,33 +508,33 @@ def effective_time_limit(scheduler: Scheduler, time_limit: float | None) -> floa
     return float(own) if math.isfinite(own) and own > 0 else None
 
 
-def idle_roles(plan: Plan, graph: TaskGraph) -> list[str]:
-    """The roles ``plan`` leaves idle although they have work (module docstring), each as a
-    phrase for a message (empty: every role with work has a routed agent).
+def idle_team(plan: Plan, graph: TaskGraph) -> str:
+    """ "" if ``plan`` routes some agent with work or no agent has work (module docstring), else
+    what the idle team could have done, per role (for a message).
 
     Examples
     --------
     >>> from fcplan.taskgraph import synthetic_task_graph
     >>> g = synthetic_task_graph(4, 12, np.random.default_rng(0))
-    >>> idle_roles(Plan(), g)
-    ['2 action agents (6 fire tasks reachable)', '2 perception agents (12 tasks reachable)']
-    >>> idle_roles(make_scheduler("greedy").plan(g, time_limit=None, rng=None), g)
-    []
+    >>> idle_team(Plan(), g)
+    '2 action agents (6 fire tasks reachable) and 2 perception agents (12 tasks reachable)'
+    >>> idle_team(make_scheduler("greedy").plan(g, time_limit=None, rng=None), g)
+    ''
     """
     free = graph.agent_mode != Mode.HOMING
     useful = graph.reachable & (graph.task_value > 0)[None, :]
     fire = graph.task_kind == TaskKind.FIRE
     water = graph.agent_can_act & (graph.agent_tank > 0)
     routed = np.array([bool(plan.routes.get(a)) for a in graph.agent_ids], dtype=bool)
-    out = []
-    for role, members, tasks in (
-        ("action", free & water & useful[:, fire].any(axis=1), useful[:, fire]),
-        ("perception", free & graph.agent_can_sense & ~water & useful.any(axis=1), useful),
-    ):
-        if members.any() and not routed[members].any():
-            what = f"{int(tasks[members].any(axis=0).sum())} {'fire ' * (role == 'action')}tasks"
-            out.append(f"{int(members.sum())} {role} agents ({what} reachable)")
-    return out
+    roles = (
+        ("action", free & water & useful[:, fire].any(axis=1), useful[:, fire], "fire tasks"),
+        ("perception", free & graph.agent_can_sense & ~water & useful.any(axis=1), useful, "tasks"),
+    )
+    if routed[roles[0][1] | roles[1][1]].any():
+        return ""
+    said = [f"{int(m.sum())} {role} agents ({int(t[m].any(axis=0).sum())} {what} reachable)"
+            for role, m, t, what in roles if m.any()]  # fmt: skip
+    return " and ".join(said)
 
 
 def _timeout_fallback(
@@ -550,10 +551,8 @@ def _timeout_fallback(
     why = f"time-out ({stats.status}, {wall:.4g} s of {limit if limit is not None else 'no'} s)"
     if stats.partial:
         return True, f"{why}: the scheduler reported a partial plan"
-    idle = idle_roles(plan, graph)
-    if idle:
-        return True, f"{why}: the plan left every one of {' and '.join(idle)} idle"
-    return True, ""
+    idle = idle_team(plan, graph)
+    return True, f"{why}: the plan left the team idle: {idle}" if idle else ""
 
 
 def solve(
@@ -566,7 +565,7 @@ def solve(
     """Run ``scheduler`` on ``graph``; always return a valid plan carrying :class:`SolveStats`.
 
     A scheduler that raises, returns an invalid plan, or returns a plan that comes from a
-    time-out and is partial or leaves a role idle (module docstring) is replaced by ``greedy``
+    time-out and is partial or leaves the team idle (module docstring) is replaced by ``greedy``
     for this replan (``status="fallback"``, the reason in ``message``). The stats record the
     wall time of the whole call, the limit it was held to and any overrun.
     """

@@ -19,9 +19,9 @@ determinism         two fresh schedulers from the factory, given generators seed
 time limit          each call returns within ``time_limit * (1 + time_tolerance) +
                     time_slack_s`` wall seconds
 time-out            a call at a limit nobody can meet (``timeout_limit``, 1 us) still
-                    answers: it does not raise, and its plan leaves no role with work idle
-                    (:func:`fcplan.scheduling.idle_roles`) unless the scheduler declares
-                    ``deterministic = True`` (then an idle role is its decision):
+                    answers: it does not raise, and its plan does not leave the team idle
+                    (:func:`fcplan.scheduling.idle_team`) unless the scheduler declares
+                    ``deterministic = True`` (then an idle team is its decision):
                     :func:`fcplan.scheduling.solve` would replace such a plan by greedy's
 no mutation         every numpy array of the graph holds the same bytes after the call
 ==================  ======================================================================
@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 
 from fcplan.plan import Plan, validate_plan
-from fcplan.scheduling import Scheduler, idle_roles, make_scheduler
+from fcplan.scheduling import Scheduler, idle_team, make_scheduler
 from fcplan.taskgraph import TaskGraph
 
 __all__ = ["ConformanceReport", "check_scheduler", "episode_graphs", "shipped_scenarios"]
@@ -158,8 +158,8 @@ def _timeout_failure(scheduler: Scheduler, graph: TaskGraph, limit: float, seed:
         validate_plan(plan, graph)
     except Exception as exc:  # noqa: BLE001 - every failure is reported, not raised
         return f"at time_limit={limit:g}: {type(exc).__name__}: {exc}"
-    idle = [] if getattr(scheduler, "deterministic", False) is True else idle_roles(plan, graph)
-    return f"at time_limit={limit:g} the plan left {' and '.join(idle)} idle" if idle else ""
+    idle = "" if getattr(scheduler, "deterministic", False) is True else idle_team(plan, graph)
+    return f"at time_limit={limit:g} the plan left the team idle: {idle}" if idle else ""
 
 
 def check_scheduler(

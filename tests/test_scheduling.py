@@ -434,7 +434,7 @@ def _greedy_plan(g: TaskGraph) -> Plan:
 def test_an_empty_plan_from_a_time_out_becomes_greedys():
     """A plan the scheduler itself marks as stopped by the clock (status time_limit) that routes
     nobody, on a graph where both roles have reachable work, is replaced by greedy's plan:
-    status 'fallback', timed_out, and a message naming the time-out and the idle roles."""
+    status 'fallback', timed_out, and a message naming the time-out and the idle team."""
     g = _synthetic()
     plan = solve(Canned(Plan(stats=SolveStats(status="time_limit"))), g, time_limit=0.5, rng=rng())
     assert plan.stats.status == "fallback" and plan.stats.timed_out
@@ -444,7 +444,7 @@ def test_an_empty_plan_from_a_time_out_becomes_greedys():
 
 def test_a_clock_bound_scheduler_that_used_up_its_limit_and_routed_nobody_falls_back():
     """Without any status from the scheduler, a call of a clock-bound scheduler (no
-    ``deterministic = True``) that took its whole limit and left a role idle is a time-out
+    ``deterministic = True``) that took its whole limit and left the team idle is a time-out
     and falls back; the limit it was held to and the overrun are recorded."""
     g = _synthetic(1)
     plan = solve(Canned(Plan(), sleep_s=0.02), g, time_limit=0.01, rng=rng())
@@ -467,7 +467,7 @@ def test_an_idle_role_without_a_time_out_is_a_decision():
     assert idle.stats.status == "heuristic" and dict(idle.routes) == {}
 
 
-def test_a_partial_plan_falls_back_even_when_no_role_is_idle():
+def test_a_partial_plan_falls_back_even_when_the_team_acts():
     """A plan its scheduler marks ``partial`` (its limit stopped it before the plan was
     complete) is replaced by greedy's even though it routes agents of every role."""
     g = _synthetic(3)
@@ -477,13 +477,19 @@ def test_a_partial_plan_falls_back_even_when_no_role_is_idle():
     assert plan.stats.status == "fallback" and "partial" in plan.stats.message
 
 
-def test_a_time_out_that_keeps_every_role_busy_stands():
-    """A plan from a time-out that routes at least one agent of each role with work is the
-    scheduler's answer (timed_out is recorded, no fallback)."""
+def test_a_time_out_that_routes_some_agent_with_work_stands():
+    """A plan from a time-out that routes some agent with work is the scheduler's answer
+    (timed_out is recorded, no fallback), even when it routes one role only (a scheduler that
+    knows it stopped before planning a role says ``partial``)."""
     g = _synthetic(4)
-    plan = solve(Canned(_greedy_plan(g).with_stats(SolveStats(status="time_limit"))), g,
+    full = _greedy_plan(g)
+    plan = solve(Canned(full.with_stats(SolveStats(status="time_limit"))), g,
                  time_limit=0.5, rng=rng())  # fmt: skip
     assert plan.stats.status == "time_limit" and plan.stats.timed_out
+    actors = {a: r for a, r in full.routes.items() if a.startswith("A")}
+    one_role = solve(Canned(Plan(routes=actors, stats=SolveStats(status="time_limit"))), g,
+                     time_limit=0.5, rng=rng())  # fmt: skip
+    assert one_role.stats.status == "time_limit" and dict(one_role.routes) == actors
 
 
 def test_the_limit_recorded_is_the_callers_else_the_schedulers_own():
@@ -504,11 +510,15 @@ def test_the_limit_recorded_is_the_callers_else_the_schedulers_own():
 @settings(max_examples=40, deadline=None)
 def test_no_time_out_leaves_a_role_with_work_idle(seed, keep, status):
     """For any subset of greedy's routes returned by a scheduler that ran out of time (or says
-    the clock stopped it), the plan solve returns leaves no role with reachable work idle."""
+    the clock stopped it), the plan solve returns does not leave the team idle, and it is the
+    scheduler's own unless that subset routed nobody."""
     g = _synthetic(seed, n_agents=8, n_tasks=24)
     full = _greedy_plan(g)
     routes = {a: r for a, r in full.routes.items() if keep[g.agent_ids.index(a)]}
     plan = Plan(routes=routes, altitudes={a: full.altitudes[a] for a in routes if a in full.altitudes},
                 stats=SolveStats(status=status))  # fmt: skip
     out = solve(Canned(plan), g, time_limit=0.0, rng=rng())
-    assert scheduling.idle_roles(out, g) == []
+    assert scheduling.idle_team(out, g) == ""
+    assert (out.stats.status == "fallback") == (
+        not routes and bool(scheduling.idle_team(Plan(), g))
+    )

@@ -243,7 +243,7 @@ def test_no_time_at_all_still_gives_every_bidder_work_and_no_fallback():
     """With no time at all (a fake clock moving 1 ms per reading, 40 agents, limit 0) the run
     reads the clock a few times only, every bidder with free work gets one item by the
     completion's vectorised first pass, and ``solve`` keeps CBBA's plan (a time-out that leaves
-    no role idle: status ``time_limit``, no fallback)."""
+    the team busy: status ``time_limit``, no fallback)."""
     g = graph(0, 40, 300)
     with patched(FakeTime(1e-3)) as clock:
         start, clock.reads = clock.now, 0
