@@ -13,7 +13,11 @@ published optimum (%) at each wall-time limit for
 and, with ``--first-solutions``, the core's OR-Tools backend with each first-solution strategy.
 With ``--deterministic`` the core runs at its default deterministic work limits instead (OR-Tools:
 2,000 solutions; PyVRP: 2,000 iterations) and the CPU seconds each took are printed (a measure
-that does not depend on the machine's load).
+that does not depend on the machine's load). With ``--cpu-limits`` the core's PyVRP backend
+(its model and settings, :func:`solvers.routing.pyvrp_backend.solve_pyvrp`'s parameters) is
+stopped on this process's CPU time instead of the wall clock, over ``--seeds`` seeds (mean and
+max gap): the time budgets of the targets, measured the same on a loaded machine. OR-Tools has
+no CPU-time limit, so it is not in that table.
 
 Usage::
 
@@ -21,6 +25,7 @@ Usage::
     nice python bench/bench_tsplib.py --limits 0.1 1 --configs core-ortools core-pyvrp
     nice python bench/bench_tsplib.py --first-solutions --limits 0.1 1
     nice python bench/bench_tsplib.py --deterministic
+    nice python bench/bench_tsplib.py --cpu-limits 0.1 1 --seeds 5
 """
 
 from __future__ import annotations
@@ -95,6 +100,23 @@ def pyvrp_alone(xy: np.ndarray, dist: np.ndarray, limit: float) -> float:
     return tour_length(dist, tour)
 
 
+def pyvrp_cpu(dist: np.ndarray, limit: float, seed: int) -> float:
+    """The core's PyVRP model and parameters of a tour, stopped after ``limit`` CPU seconds."""
+    import pyvrp
+
+    from solvers.routing.core import RoutingInstance
+    from solvers.routing.pyvrp_backend import TOUR_PERTURBATION, _data
+
+    start = time.process_time()
+    inst = RoutingInstance.of(dist, [0])
+    params = pyvrp.SolveParams(perturbation=pyvrp.search.PerturbationParams(*TOUR_PERTURBATION))
+    res = pyvrp.solve(_data(inst, PyVRPOptions().scale),
+                      lambda _: time.process_time() - start >= limit, seed=seed,
+                      collect_stats=False, params=params)  # fmt: skip
+    tour = [0] + [int(inst.tasks[a.idx]) for r in res.best.routes() for a in r if a.is_client()]
+    return tour_length(dist, tour)
+
+
 def run(name: str, xy: np.ndarray, dist: np.ndarray, limit: float | None) -> float:
     if name == "core-ortools":
         return core(xy, dist, limit, "ortools")
@@ -116,9 +138,28 @@ def main() -> None:
     ap.add_argument("--instances", nargs="+", default=list(INSTANCES))
     ap.add_argument("--first-solutions", action="store_true")
     ap.add_argument("--deterministic", action="store_true")
+    ap.add_argument("--cpu-limits", type=float, nargs="+")
+    ap.add_argument("--seeds", type=int, default=5)
     args = ap.parse_args()
     configs = list(FIRST_SOLUTIONS) if args.first_solutions else args.configs
     print(f"# load average at start: {os.getloadavg()[0]:.2f} (2 cores)")
+    if args.cpu_limits:
+        print(f"## core-pyvrp stopped on CPU time: gap (%) mean / max over {args.seeds} seeds")
+        print(f"{'instance':<9} {'optimum':>7}  " + "  ".join(
+            f"{f'{lim:g} cpu s':>14}" for lim in args.cpu_limits))  # fmt: skip
+        for name in args.instances:
+            xy, kind = read_coords(DATA / f"{name}.tsp")
+            dist = tsplib_distances(xy, kind)
+            cells = []
+            for lim in args.cpu_limits:
+                gaps = [
+                    100 * (pyvrp_cpu(dist, lim, s) / OPTIMA[name] - 1) for s in range(args.seeds)
+                ]
+                cells.append(f"{np.mean(gaps):>6.2f} / {max(gaps):>5.2f}")
+            print(
+                f"{name:<9} {OPTIMA[name]:>7}  " + "  ".join(f"{c:>14}" for c in cells), flush=True
+            )
+        return
     if args.deterministic:
         print(f"{'instance':<9} {'optimum':>7}  " + "  ".join(
             f"{c + ' gap %':>16} {'cpu s':>5}" for c in ("core-ortools", "core-pyvrp")))  # fmt: skip

@@ -12,6 +12,24 @@ scheduler raises, returns something that is not a valid plan, it falls back to `
 replan and records why in the stats (``status="fallback"``). An episode never dies because a
 solver did.
 
+Time limits. A scheduler honours ``time_limit`` (wall seconds per call) itself: model building
+counts, its solver gets the time left, an anytime search looks at the clock. :func:`solve`
+reports the limit the call was held to (:func:`effective_time_limit`) and any overrun. A Python
+call cannot be interrupted from outside, so each scheduler has a *floor*: what it does before it
+can look at the clock, plus greedy's plan when it gives up (``bench/bench_time_limits.py``).
+
+A time-out is a fallback, never an idle team. A plan **comes from a time-out** when the
+scheduler says so (``status="time_limit"``, or ``partial=True``: it knows the plan is
+unfinished) or when a scheduler whose plans may depend on the clock (it does not declare
+``deterministic = True``) used up its limit. Such a plan is replaced by greedy's
+(``status="fallback"``, ``timed_out=True``, the reason in ``message``) if it is ``partial`` or
+leaves the **team idle** (:func:`idle_team`): agents have work but none gets a route. An agent
+has work when it is available (not ``HOMING``) and can reach (:attr:`fcplan.taskgraph.TaskGraph.
+reachable`) a fire task, if it has water, or else a task of positive value, if it has a camera.
+A plan that routes some agents with work is the scheduler's answer (a scheduler that knows it
+stopped before planning some role says ``partial``); without a time-out an idle team is a
+decision and stands (``idle`` does that on purpose).
+
 Schedulers are found by name: built-ins and third-party packages register a factory in the
 ``fcplan.schedulers`` entry-point group (``name = "module:Factory"``); :func:`register_scheduler`
 adds one at run time (handy in notebooks). The built-ins are listed once, in the entry-point
@@ -57,7 +75,8 @@ import numpy as np
 
 from fcplan.errors import FcplanError, UnknownNameError
 from fcplan.plan import Plan, validate_plan
-from fcplan.taskgraph import TaskGraph
+from fcplan.taskgraph import TaskGraph, TaskKind
+from fcplan.team import Mode
 
 __all__ = [
     "Scheduler",
@@ -75,6 +94,8 @@ __all__ = [
     "register_scheduler",
     "available_schedulers",
     "solve",
+    "effective_time_limit",
+    "idle_team",
 ]
 
 #: Possible :attr:`SolveStats.status` values.
@@ -106,9 +127,16 @@ class SolveStats:
     message : str
         Why a fallback happened, or solver remarks.
     time_limit_s : float or None
-        The limit the call was given.
+        The limit the call was held to: the caller's, else the scheduler's own default
+        (:func:`effective_time_limit`; None: no limit).
     overrun_s : float
-        Wall time beyond the limit (0 when within it), measured by :func:`solve`.
+        Wall time beyond ``time_limit_s`` (0 when within it), measured by :func:`solve`.
+    solver_s : float
+        Wall time of the scheduler's own call (no validation, no fallback), by :func:`solve`.
+    timed_out : bool
+        The clock stopped the scheduler (module docstring), set by :func:`solve`.
+    partial : bool
+        The scheduler's limit stopped it before its plan was complete (:func:`solve` falls back).
     """
 
     status: str = "heuristic"
@@ -120,6 +148,9 @@ class SolveStats:
     message: str = ""
     time_limit_s: float | None = None
     overrun_s: float = 0.0
+    solver_s: float = 0.0
+    timed_out: bool = False
+    partial: bool = False
 
     def as_dict(self) -> dict[str, Any]:
         """Plain dict (for tables and JSON)."""
@@ -452,14 +483,76 @@ def _setting_error(name: str, settings: dict[str, Any], exc: Exception) -> Fcpla
     return SettingError(f"settings ({given})", reason, scheduler=name)
 
 
-_FALLBACK: Scheduler | None = None
-
-
+@functools.cache
 def _fallback_scheduler() -> Scheduler:
-    global _FALLBACK
-    if _FALLBACK is None:
-        _FALLBACK = make_scheduler("greedy")
-    return _FALLBACK
+    """The greedy scheduler that stands in for a failed one (stateless: one per process)."""
+    return make_scheduler("greedy")
+
+
+def effective_time_limit(scheduler: Scheduler, time_limit: float | None) -> float | None:
+    """The wall-time limit a call of ``scheduler`` is held to: ``time_limit``, else the
+    scheduler's own default (a finite positive ``time_limit`` attribute), else None.
+
+    Examples
+    --------
+    >>> effective_time_limit(make_scheduler("routing"), None)
+    0.1
+    >>> effective_time_limit(make_scheduler("greedy"), None) is None
+    True
+    """
+    if time_limit is not None:
+        return float(time_limit)
+    own = getattr(scheduler, "time_limit", None)
+    if not isinstance(own, (int, float)) or isinstance(own, bool):
+        return None
+    return float(own) if math.isfinite(own) and own > 0 else None
+
+
+def idle_team(plan: Plan, graph: TaskGraph) -> str:
+    """ "" if ``plan`` routes some agent with work or no agent has work (module docstring), else
+    what the idle team could have done, per role (for a message).
+
+    Examples
+    --------
+    >>> from fcplan.taskgraph import synthetic_task_graph
+    >>> g = synthetic_task_graph(4, 12, np.random.default_rng(0))
+    >>> idle_team(Plan(), g)
+    '2 action agents (6 fire tasks reachable) and 2 perception agents (12 tasks reachable)'
+    >>> idle_team(make_scheduler("greedy").plan(g, time_limit=None, rng=None), g)
+    ''
+    """
+    free = graph.agent_mode != Mode.HOMING
+    useful = graph.reachable & (graph.task_value > 0)[None, :]
+    fire = graph.task_kind == TaskKind.FIRE
+    water = graph.agent_can_act & (graph.agent_tank > 0)
+    routed = np.array([bool(plan.routes.get(a)) for a in graph.agent_ids], dtype=bool)
+    roles = (
+        ("action", free & water & useful[:, fire].any(axis=1), useful[:, fire], "fire tasks"),
+        ("perception", free & graph.agent_can_sense & ~water & useful.any(axis=1), useful, "tasks"),
+    )
+    if routed[roles[0][1] | roles[1][1]].any():
+        return ""
+    said = [f"{int(m.sum())} {role} agents ({int(t[m].any(axis=0).sum())} {what} reachable)"
+            for role, m, t, what in roles if m.any()]  # fmt: skip
+    return " and ".join(said)
+
+
+def _timeout_fallback(
+    scheduler: Scheduler, plan: Plan, graph: TaskGraph, wall: float, limit: float | None
+) -> tuple[bool, str]:
+    """``(timed_out, reason)``: whether the clock stopped ``scheduler`` on this call, and why
+    its plan must be replaced by greedy's ("" when it stands; module docstring)."""
+    stats = plan.stats if isinstance(plan.stats, SolveStats) else SolveStats()
+    clock_bound = getattr(scheduler, "deterministic", False) is not True
+    used_up = limit is not None and wall >= limit and clock_bound
+    timed_out = stats.status == "time_limit" or stats.partial or used_up
+    if not timed_out:
+        return False, ""
+    why = f"time-out ({stats.status}, {wall:.4g} s of {limit if limit is not None else 'no'} s)"
+    if stats.partial:
+        return True, f"{why}: the scheduler reported a partial plan"
+    idle = idle_team(plan, graph)
+    return True, f"{why}: the plan left the team idle: {idle}" if idle else ""
 
 
 def solve(
@@ -471,15 +564,24 @@ def solve(
 ) -> Plan:
     """Run ``scheduler`` on ``graph``; always return a valid plan carrying :class:`SolveStats`.
 
-    A scheduler that raises or returns an invalid plan is replaced by ``greedy`` for this
-    replan (``status="fallback"``, the reason in ``message``).
+    A scheduler that raises, returns an invalid plan, or returns a plan that comes from a
+    time-out and is partial or leaves the team idle (module docstring) is replaced by ``greedy``
+    for this replan (``status="fallback"``, the reason in ``message``). The stats record the
+    wall time of the whole call, the limit it was held to and any overrun.
     """
+    limit = effective_time_limit(scheduler, time_limit)
     t0 = time.perf_counter()
-    message = ""
+    message, timed_out = "", False
+    plan: Plan | None
     try:
         plan = scheduler.plan(graph, time_limit=time_limit, rng=rng)
+        solver_s = time.perf_counter() - t0
         validate_plan(plan, graph)
+        timed_out, message = _timeout_fallback(scheduler, plan, graph, solver_s, limit)
+        if message:
+            plan = None
     except Exception as exc:  # noqa: BLE001 - an episode must survive any solver failure
+        solver_s = time.perf_counter() - t0
         message = f"{type(exc).__name__}: {exc}"
         plan = None
     if plan is None:
@@ -489,8 +591,8 @@ def solve(
     else:
         stats = plan.stats if isinstance(plan.stats, SolveStats) else SolveStats()
     wall = time.perf_counter() - t0
-    overrun = max(wall - time_limit, 0.0) if time_limit is not None else 0.0
+    overrun = max(wall - limit, 0.0) if limit is not None else 0.0
     # every replan records the graph's size (the scheduler's own size keys win)
     size = {"agents": graph.n_agents, "tasks": graph.n_tasks, **stats.size}
-    stats = replace(stats, wall_time_s=wall, time_limit_s=time_limit, overrun_s=overrun, size=size)
-    return plan.with_stats(stats)
+    return plan.with_stats(replace(stats, wall_time_s=wall, time_limit_s=limit, overrun_s=overrun,
+                                   solver_s=solver_s, timed_out=timed_out, size=size))  # fmt: skip

@@ -18,6 +18,11 @@ determinism         two fresh schedulers from the factory, given generators seed
                     that builds the scheduler in its deterministic mode
 time limit          each call returns within ``time_limit * (1 + time_tolerance) +
                     time_slack_s`` wall seconds
+time-out            a call at a limit nobody can meet (``timeout_limit``, 1 us) still
+                    answers: it does not raise, and its plan does not leave the team idle
+                    (:func:`fcplan.scheduling.idle_team`) unless the scheduler declares
+                    ``deterministic = True`` (then an idle team is its decision):
+                    :func:`fcplan.scheduling.solve` would replace such a plan by greedy's
 no mutation         every numpy array of the graph holds the same bytes after the call
 ==================  ======================================================================
 
@@ -45,7 +50,7 @@ from typing import Any
 import numpy as np
 
 from fcplan.plan import Plan, validate_plan
-from fcplan.scheduling import Scheduler, make_scheduler
+from fcplan.scheduling import Scheduler, idle_team, make_scheduler
 from fcplan.taskgraph import TaskGraph
 
 __all__ = ["ConformanceReport", "check_scheduler", "episode_graphs", "shipped_scenarios"]
@@ -146,6 +151,17 @@ def _call(
     return plan, time.perf_counter() - t0
 
 
+def _timeout_failure(scheduler: Scheduler, graph: TaskGraph, limit: float, seed: int) -> str:
+    """Why a call at ``limit`` fails the time-out check ("" when it passes)."""
+    try:
+        plan, _ = _call(scheduler, graph, limit, seed)
+        validate_plan(plan, graph)
+    except Exception as exc:  # noqa: BLE001 - every failure is reported, not raised
+        return f"at time_limit={limit:g}: {type(exc).__name__}: {exc}"
+    idle = "" if getattr(scheduler, "deterministic", False) is True else idle_team(plan, graph)
+    return f"at time_limit={limit:g} the plan left the team idle: {idle}" if idle else ""
+
+
 def check_scheduler(
     factory: Callable[[], Scheduler],
     *,
@@ -155,6 +171,7 @@ def check_scheduler(
     time_limit: float | None = 0.5,
     time_tolerance: float = 0.1,
     time_slack_s: float = 0.05,
+    timeout_limit: float | None = 1e-6,
     determinism_every: int = 4,
     raise_on_failure: bool = True,
 ) -> ConformanceReport:
@@ -174,6 +191,8 @@ def check_scheduler(
         Passed to every ``plan`` call; None skips the time-limit check.
     time_tolerance, time_slack_s : float
         A call may take ``time_limit * (1 + time_tolerance) + time_slack_s`` seconds.
+    timeout_limit : float or None
+        The limit of the time-out check (module docstring); None skips it.
     determinism_every : int
         Check determinism on every n-th graph (it costs two more calls); 0 disables the check.
     raise_on_failure : bool
@@ -208,6 +227,10 @@ def check_scheduler(
             changed = [k for k, v in before.items() if after.get(k) != v]
             if changed:
                 report.failures.append(f"{where}: the scheduler changed graph arrays {changed}")
+            if timeout_limit is not None:
+                failure = _timeout_failure(scheduler, graph, timeout_limit, seed)
+                if failure:
+                    report.failures.append(f"{where}: {failure}")
             if determinism_every and (report.graphs - 1) % determinism_every == 0:
                 a, _ = _call(factory(), graph, time_limit, seed)
                 b, _ = _call(factory(), graph, time_limit, seed)

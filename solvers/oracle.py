@@ -66,8 +66,20 @@ class OracleScheduler:
         self.inner = make_scheduler(inner, **settings)
         self.name = "oracle" if inner == "greedy" and not settings else f"oracle[{inner}]"
 
+    @property
+    def deterministic(self) -> bool:
+        """Whether the inner scheduler's plans are independent of the clock (its own flag)."""
+        return getattr(self.inner, "deterministic", False) is True
+
+    @property
+    def time_limit(self) -> float | None:
+        """The inner scheduler's default limit (seconds per call; None: none)."""
+        limit = getattr(self.inner, "time_limit", None)
+        return limit if isinstance(limit, (int, float)) else None
+
     def plan(
         self, graph: TaskGraph, *, time_limit: float | None = None, rng: np.random.Generator
     ) -> Plan:
-        """The inner scheduler's plan on the clairvoyant ``graph``."""
+        """The inner scheduler's plan on the clairvoyant ``graph`` (within ``time_limit``, as
+        the inner scheduler honours it)."""
         return self.inner.plan(graph, time_limit=time_limit, rng=rng)

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import fcplan
 from fcplan import scheduling
@@ -398,3 +400,125 @@ def test_supports_deterministic_reads_the_attribute_or_the_signature():
     assert supports_deterministic("routing")
     assert supports_deterministic("flagged-test:x=1")
     assert not any(supports_deterministic(n) for n in ("greedy", "idle", "random"))
+
+
+# ---------------------------------------------------------------------- time-outs
+def _synthetic(seed: int = 0, n_agents: int = 6, n_tasks: int = 30) -> TaskGraph:
+    from fcplan.taskgraph import synthetic_task_graph
+
+    return synthetic_task_graph(n_agents, n_tasks, np.random.default_rng(seed))
+
+
+class Canned:
+    """A wall-clock scheduler returning a fixed plan with fixed stats (``deterministic`` False
+    unless asked), optionally after sleeping."""
+
+    name = "canned"
+    time_limit = 0.25
+
+    def __init__(self, plan: Plan, sleep_s: float = 0.0, deterministic: bool = False) -> None:
+        self.fixed, self.sleep_s, self.deterministic = plan, sleep_s, deterministic
+
+    def plan(self, graph, *, time_limit=None, rng=None):
+        if self.sleep_s:
+            import time
+
+            time.sleep(self.sleep_s)
+        return self.fixed
+
+
+def _greedy_plan(g: TaskGraph) -> Plan:
+    return make_scheduler("greedy").plan(g, time_limit=None, rng=rng())
+
+
+def test_an_empty_plan_from_a_time_out_becomes_greedys():
+    """A plan the scheduler itself marks as stopped by the clock (status time_limit) that routes
+    nobody, on a graph where both roles have reachable work, is replaced by greedy's plan:
+    status 'fallback', timed_out, and a message naming the time-out and the idle team."""
+    g = _synthetic()
+    plan = solve(Canned(Plan(stats=SolveStats(status="time_limit"))), g, time_limit=0.5, rng=rng())
+    assert plan.stats.status == "fallback" and plan.stats.timed_out
+    assert "time-out" in plan.stats.message and "action agents" in plan.stats.message
+    assert dict(plan.routes) == dict(_greedy_plan(g).routes)
+
+
+def test_a_clock_bound_scheduler_that_used_up_its_limit_and_routed_nobody_falls_back():
+    """Without any status from the scheduler, a call of a clock-bound scheduler (no
+    ``deterministic = True``) that took its whole limit and left the team idle is a time-out
+    and falls back; the limit it was held to and the overrun are recorded."""
+    g = _synthetic(1)
+    plan = solve(Canned(Plan(), sleep_s=0.02), g, time_limit=0.01, rng=rng())
+    assert plan.stats.status == "fallback" and plan.stats.timed_out
+    assert plan.stats.time_limit_s == 0.01
+    assert plan.stats.overrun_s >= 0.01 and plan.stats.solver_s >= 0.02
+
+
+def test_an_idle_role_without_a_time_out_is_a_decision():
+    """The same empty plan stands when nothing says the clock stopped the scheduler: a
+    heuristic status within the limit, or a scheduler that declares ``deterministic = True``
+    even when its call took longer than the limit (``idle`` at any limit)."""
+    g = _synthetic(2)
+    within = solve(Canned(Plan(stats=SolveStats())), g, time_limit=60.0, rng=rng())
+    assert within.stats.status == "heuristic" and not within.stats.timed_out
+    assert dict(within.routes) == {}
+    slow = solve(Canned(Plan(), sleep_s=0.02, deterministic=True), g, time_limit=0.01, rng=rng())
+    assert slow.stats.status == "heuristic" and dict(slow.routes) == {}
+    idle = solve(make_scheduler("idle"), g, time_limit=1e-9, rng=rng())
+    assert idle.stats.status == "heuristic" and dict(idle.routes) == {}
+
+
+def test_a_partial_plan_falls_back_even_when_the_team_acts():
+    """A plan its scheduler marks ``partial`` (its limit stopped it before the plan was
+    complete) is replaced by greedy's even though it routes agents of every role."""
+    g = _synthetic(3)
+    half = _greedy_plan(g)
+    plan = solve(Canned(half.with_stats(SolveStats(status="time_limit", partial=True))), g,
+                 time_limit=0.5, rng=rng())  # fmt: skip
+    assert plan.stats.status == "fallback" and "partial" in plan.stats.message
+
+
+def test_a_time_out_that_routes_some_agent_with_work_stands():
+    """A plan from a time-out that routes some agent with work is the scheduler's answer
+    (timed_out is recorded, no fallback), even when it routes one role only (a scheduler that
+    knows it stopped before planning a role says ``partial``)."""
+    g = _synthetic(4)
+    full = _greedy_plan(g)
+    plan = solve(Canned(full.with_stats(SolveStats(status="time_limit"))), g,
+                 time_limit=0.5, rng=rng())  # fmt: skip
+    assert plan.stats.status == "time_limit" and plan.stats.timed_out
+    actors = {a: r for a, r in full.routes.items() if a.startswith("A")}
+    one_role = solve(Canned(Plan(routes=actors, stats=SolveStats(status="time_limit"))), g,
+                     time_limit=0.5, rng=rng())  # fmt: skip
+    assert one_role.stats.status == "time_limit" and dict(one_role.routes) == actors
+
+
+def test_the_limit_recorded_is_the_callers_else_the_schedulers_own():
+    """``time_limit_s`` is the caller's limit, else the scheduler's ``time_limit`` attribute
+    (None for a scheduler without one); overruns are measured against it."""
+    g = _synthetic(5)
+    own = solve(Canned(_greedy_plan(g), sleep_s=0.01), g, time_limit=None, rng=rng())
+    assert own.stats.time_limit_s == Canned.time_limit and own.stats.overrun_s == 0.0
+    assert solve(make_scheduler("greedy"), g, time_limit=None, rng=rng()).stats.time_limit_s is None
+    assert solve(make_scheduler("greedy"), g, time_limit=2.0, rng=rng()).stats.time_limit_s == 2.0
+
+
+@given(
+    seed=st.integers(0, 10_000),
+    keep=st.lists(st.booleans(), min_size=8, max_size=8),
+    status=st.sampled_from(["time_limit", "feasible", "heuristic"]),
+)
+@settings(max_examples=40, deadline=None)
+def test_no_time_out_leaves_a_role_with_work_idle(seed, keep, status):
+    """For any subset of greedy's routes returned by a scheduler that ran out of time (or says
+    the clock stopped it), the plan solve returns does not leave the team idle, and it is the
+    scheduler's own unless that subset routed nobody."""
+    g = _synthetic(seed, n_agents=8, n_tasks=24)
+    full = _greedy_plan(g)
+    routes = {a: r for a, r in full.routes.items() if keep[g.agent_ids.index(a)]}
+    plan = Plan(routes=routes, altitudes={a: full.altitudes[a] for a in routes if a in full.altitudes},
+                stats=SolveStats(status=status))  # fmt: skip
+    out = solve(Canned(plan), g, time_limit=0.0, rng=rng())
+    assert scheduling.idle_team(out, g) == ""
+    assert (out.stats.status == "fallback") == (
+        not routes and bool(scheduling.idle_team(Plan(), g))
+    )

@@ -19,7 +19,8 @@ auction: bundle construction, consensus, the stopping rule), :mod:`~solvers.cbba
 independent implementation in ``tests/solvers/test_cbba_reference.py``).
 
 Modes: with a ``time_limit`` (argument or setting) the scheduler stops on the wall clock and
-returns within the limit + 10 % + 5 ms (or raises, so ``solve`` falls back to greedy);
+returns within the limit, but for its floor (setting up the auctions and completing a cut
+auction's empty bidders with one item each, :mod:`~solvers.cbba.clock`);
 ``deterministic=True`` never reads the clock and stops on ``max_rounds`` only, so plans are the
 same in any process and under any load (use it for comparisons).
 
@@ -38,7 +39,6 @@ True
 """
 
 from solvers.cbba.auction import StageResult
-from solvers.cbba.clock import CBBATimeLimitError
 from solvers.cbba.comms import CommGraph, communication_graph
 from solvers.cbba.scheduler import CBBAResult, CBBAScheduler
 from solvers.cbba.settings import CBBASettingsError
@@ -48,7 +48,6 @@ __all__ = [
     "CBBAScheduler",
     "CBBAResult",
     "CBBASettingsError",
-    "CBBATimeLimitError",
     "CommGraph",
     "StageResult",
     "StaticInstance",

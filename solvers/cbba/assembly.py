@@ -13,12 +13,22 @@ Greedy completion
 An auction that did not converge may leave a bidder with nothing only because it was stopped (it
 had not built a bundle yet, or lost everything it held to the conflict rule). Handing that back
 would make the limit decide, not the algorithm, so after a cut every bidder with an empty route
-is *completed*, in index order: it builds a bundle exactly as in the auction (same scores,
-insertion and feasibility rules, at most its bundle limit) from the items nobody holds, each
-item it takes leaving the pool. ``completed`` counts the agents that got a route this way. After
-a converged auction nothing is completed: an empty route there is what CBBA decided. With a
-clock, completion gives up as soon as what is left of it would end past the clock's hard deadline
-and raises :class:`~solvers.cbba.clock.CBBATimeLimitError` (:mod:`solvers.cbba.clock`).
+is *completed* from the items nobody holds, with the auction's scores and feasibility rules:
+
+1. **first items**, all at once: the score of an item on an empty path is its discounted value
+   at the straight flight from the agent's start (the auction's insertion score there), so one
+   (agents x items) table holds them all; the best (agent, item) pair is taken, its agent and
+   item leave the table, and so on until no pair scores more than 0 (sequential greedy
+   assignment; ties to the lower agent, then item, index). This is one vectorised pass, cheap
+   next to a bundle construction (a few milliseconds on 100 agents x 2,000 items), and it is
+   always done: it is the floor of a cut auction;
+2. **the rest of each bundle**, agent by agent in index order, exactly as a bundle construction
+   of the auction (insertion anywhere, at most the agent's bundle limit), from the items still
+   free, each item it takes leaving the pool; with a clock, only while the agent's construction
+   would still end before the limit (:meth:`~solvers.cbba.clock.Clock.past_end`).
+
+``completed`` counts the agents that got a route this way. After a converged auction nothing is
+completed: an empty route there is what CBBA decided.
 
 Examples
 --------
@@ -39,9 +49,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from solvers.cbba.auction import Auction, StageResult, insertion_scores
-from solvers.cbba.clock import BUILD_OVERHEAD, CBBATimeLimitError, Clock
+from solvers.cbba.clock import BUILD_OVERHEAD, Clock
 
-__all__ = ["Assembly", "assemble"]
+__all__ = ["Assembly", "assemble", "first_items"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,21 +113,21 @@ def assemble(stage: StageResult, auc: Auction, clock: Clock | None = None) -> As
 def _complete(
     auc: Auction, paths: list[list[int]], bids: list[list[float]], clock: Clock | None
 ) -> int:
-    """Give each bidder with an empty path a greedy bundle of free items; returns how many got
-    one. Changes ``paths`` and ``bids`` in place."""
+    """Give each bidder with an empty path a greedy bundle of free items (module docstring);
+    returns how many got one. Changes ``paths`` and ``bids`` in place."""
     free = np.ones(auc.value.shape[1], dtype=bool)
     for path in paths:
         free[path] = False
-    bidders = np.flatnonzero(auc.eligible.any(axis=1)).tolist()
-    todo = [i for i in bidders if not paths[i]]
-    work = {i: int(auc.eligible[i].sum()) + BUILD_OVERHEAD for i in todo}
-    completed = 0
-    for n, i in enumerate(todo):
-        if clock is not None and clock.past_hard(sum(work[k] for k in todo[n:])):
-            raise CBBATimeLimitError(
-                f"cbba: time limit {clock.limit:g} s too short to give {len(todo) - n} "
-                "agent(s) a route"
-            )
+    bidders = np.flatnonzero(auc.eligible.any(axis=1))
+    todo = bidders[[not paths[i] for i in bidders.tolist()]]
+    picks = first_items(auc, todo, free)
+    for i, j, bid in picks:
+        paths[i], bids[i] = [j], [bid]
+        free[j] = False
+    for i in sorted(i for i, _, _ in picks):
+        work = int(auc.eligible[i].sum()) + BUILD_OVERHEAD
+        if clock is not None and clock.past_end(work):
+            break
         t = time.perf_counter() if clock is not None else 0.0
         path, got = paths[i], bids[i]
         while len(path) < auc.limit[i]:
@@ -133,6 +143,46 @@ def _complete(
             got.insert(int(where[k]), float(score[k]))
             free[j] = False
         if clock is not None:
-            clock.record(time.perf_counter() - t, work[i])
-        completed += bool(path)
-    return completed
+            clock.record(time.perf_counter() - t, work)
+    return len(picks)
+
+
+def first_items(auc: Auction, agents: np.ndarray, free: np.ndarray) -> list[tuple[int, int, float]]:
+    """Sequential greedy assignment of one free item to each of ``agents`` (empty paths), by
+    the auction's insertion score on an empty path: ``(agent, item, score)`` picks, best first
+    (module docstring, step 1).
+
+    Examples
+    --------
+    >>> from solvers.cbba.static import StaticInstance, static_auction
+    >>> inst = StaticInstance.random(np.random.default_rng(0), n_agents=3, n_tasks=8)
+    >>> auc = static_auction(inst)
+    >>> picks = first_items(auc, np.arange(3), np.ones(8, dtype=bool))
+    >>> sorted(i for i, _, _ in picks), len({j for _, j, _ in picks})
+    ([0, 1, 2], 3)
+    """
+    if agents.size == 0:
+        return []
+    d0, d1 = auc.d_start[agents], auc.d_home[agents]
+    legs = np.hypot(*(auc.home[agents] - auc.start[agents]).T)[:, None]
+    # the terms of insertion_scores on an empty path, in its order (the same floats)
+    feasible = legs + (d0 + d1 - legs) <= auc.budget[agents, None] + 1e-9
+    score = auc.value[agents] * np.exp(-auc.rate * ((0.0 + d0) / auc.speed[agents, None]))
+    score = np.where(
+        auc.eligible[agents] & free[None, :] & feasible & (score > 0.0), score, -np.inf
+    )
+    best = np.argmax(score, axis=1)
+    best_s = score[np.arange(agents.size), best]
+    picks: list[tuple[int, int, float]] = []
+    while True:
+        r = int(np.argmax(best_s))  # ties: the lower agent row, then (argmax per row) item
+        if not np.isfinite(best_s[r]):
+            return picks
+        j = int(best[r])
+        picks.append((int(agents[r]), j, float(score[r, j])))
+        score[r] = -np.inf
+        score[:, j] = -np.inf
+        touched = np.flatnonzero(best == j)
+        best[touched] = np.argmax(score[touched], axis=1)
+        best_s[touched] = score[touched, best[touched]]
+        best_s[r] = -np.inf

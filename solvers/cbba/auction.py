@@ -73,8 +73,9 @@ Cost
 ----
 A round costs one bundle construction per agent whose view changed (``O(L)`` numpy passes over
 the tasks it may bid on) plus, per neighbour slot (at most ``A - 1``), one numpy pass over the
-tasks somebody holds; only the entries where a message differs from the receiver's belief go
-through the table.
+items the agents do not all agree on (an item on which every agent holds the same ``y`` and
+``z`` cannot change in a round: every message about it equals its receiver's belief); only the
+entries where a message differs from the receiver's belief go through the table.
 """
 
 from __future__ import annotations
@@ -269,7 +270,9 @@ class _Agents:
         a neighbour slot."""
         a = self.n_agents
         s0 = self.s.copy()
-        cols = np.flatnonzero((self.z != NO_WINNER).any(axis=0))
+        # only items the agents do not all agree on can change (module docstring, "Cost")
+        agree = (self.z == self.z[:1]).all(axis=0) & (self.y == self.y[:1]).all(axis=0)
+        cols = np.flatnonzero(~agree)
         if cols.size == 0:
             for rec, snd in slots:
                 self.s[rec] = np.maximum(self.s[rec], s0[snd])

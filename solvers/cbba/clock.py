@@ -12,20 +12,20 @@ where ``pending_work`` is the *work* of the bidders that hold nothing yet (each 
 bundle construction to complete; the work of a bundle construction is the number of items the
 agent may bid on plus :data:`BUILD_OVERHEAD` for the fixed cost of a pass) and ``unit_s`` the
 seconds per unit of work measured so far in this call. ``soft`` is the stage's deadline (the
-dump auction gets a share of the limit, the sense auction the rest). The greedy completion may
-run until ``hard`` (the limit + 10 % + 5 ms, less a millisecond for the plan); when the
-completion it still has to do would end past ``hard``, it gives up at once (so the fallback has
-time) and raises :class:`CBBATimeLimitError`, and :func:`fcplan.scheduling.solve` falls back to
-greedy.
+dump auction gets a share of the limit, the sense auction the rest). The completion's first
+pass (one item per empty bidder, vectorised: :mod:`solvers.cbba.assembly`) always runs; the
+rest of each completed bundle is built only while it would end before ``end``, the limit less
+:data:`PLAN_MARGIN_S` (:meth:`Clock.past_end`). What a call can take beyond its limit is thus
+its floor: setting up the auctions (graph views, scores), the step under way when the clock
+ran out, and the first pass.
 
 In deterministic mode there is no clock at all (``None``): only the round cap stops an auction,
 and the wall time is never read, so plans are identical under any machine load.
 
 Examples
 --------
->>> import time
 >>> clock = Clock.start(0.5)
->>> clock.past(), clock.past_hard()
+>>> clock.past(), clock.past_end()
 (False, False)
 >>> clock.record(0.01, work=1000)  # one bundle construction over 900 items took 10 ms
 >>> clock.past(pending_work=100 * 1000)  # 100 of them would take 1 s: stop now
@@ -37,17 +37,12 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-__all__ = ["BUILD_OVERHEAD", "CBBATimeLimitError", "Clock"]
+__all__ = ["BUILD_OVERHEAD", "PLAN_MARGIN_S", "Clock"]
 
-#: Wall time kept back after the greedy completion for turning routes into a plan (s).
+#: Wall time kept back before the limit for turning routes into a plan (s).
 PLAN_MARGIN_S = 0.001
 #: Work units of the fixed cost of a bundle construction (numpy call overheads), in items.
 BUILD_OVERHEAD = 100
-
-
-class CBBATimeLimitError(RuntimeError):
-    """The time limit ran out before every agent that could bid had a route (the caller falls
-    back to another scheduler)."""
 
 
 @dataclass
@@ -62,9 +57,8 @@ class Clock:
         Seconds allowed.
     soft : float
         When the current auction should stop (see the module docstring).
-    hard : float
-        When the greedy completion must have finished: ``t0 + 1.1 * limit + 0.005`` less
-        :data:`PLAN_MARGIN_S`.
+    end : float
+        When the completion must have finished: ``t0 + limit`` less :data:`PLAN_MARGIN_S`.
     build_s, work : float
         Total time and work of the bundle constructions measured so far.
     """
@@ -72,7 +66,7 @@ class Clock:
     t0: float
     limit: float
     soft: float
-    hard: float
+    end: float
     build_s: float = 0.0
     work: float = 0.0
 
@@ -80,8 +74,7 @@ class Clock:
     def start(cls, limit: float) -> Clock:
         """A clock for a call that starts now and may take ``limit`` seconds."""
         t0 = time.perf_counter()
-        hard = t0 + 1.1 * limit + 0.005 - PLAN_MARGIN_S
-        return cls(t0=t0, limit=limit, soft=t0 + limit, hard=hard)
+        return cls(t0=t0, limit=limit, soft=t0 + limit, end=t0 + limit - PLAN_MARGIN_S)
 
     def stage_deadline(self, share: float) -> None:
         """Let the next auction run until ``share`` of the limit has passed since the start."""
@@ -101,6 +94,6 @@ class Clock:
         """Should the auction stop, keeping back time for ``pending_work`` of completion?"""
         return time.perf_counter() + pending_work * self.unit_s >= self.soft
 
-    def past_hard(self, pending_work: float = 0.0) -> bool:
-        """Would ``pending_work`` of completion, started now, end past ``hard``?"""
-        return time.perf_counter() + pending_work * self.unit_s >= self.hard
+    def past_end(self, pending_work: float = 0.0) -> bool:
+        """Would ``pending_work`` of completion, started now, end past :attr:`end`?"""
+        return time.perf_counter() + pending_work * self.unit_s >= self.end

@@ -52,13 +52,13 @@ Limits and modes
   construction and every neighbour slot of a consensus round and stop in time to complete
   what is missing. The dump auction may use a share of the limit proportional to its size
   (dumpers x fires against cameras x tasks, between 20 % and 80 %), the sense auction what is
-  left. ``plan()`` returns within the limit + 10 % + 5 ms of its own work, as long as the
-  limit is not shorter than setting up the auctions (reading the graph's views and scoring
-  the items, which is not interrupted: well under a millisecond on the manual's scenarios,
-  tens of milliseconds on 100 agents x 2,000 tasks); every other step between two looks at the
-  clock is one bundle construction or one neighbour slot (about a millisecond at most). Pauses
-  that the operating system imposes on a loaded machine come on top (``bench/README.md``).
-  Plans then depend on the machine's speed and load.
+  left. ``plan()`` returns within the limit but for its floor: setting up the auctions
+  (reading the graph's views and scoring the items, which is not interrupted: well under a
+  millisecond on the manual's scenarios, tens of milliseconds on 100 agents x 2,000 tasks),
+  the step under way when the clock ran out (one bundle construction or one neighbour slot,
+  about a millisecond at most) and the first pass of the completion below (a few
+  milliseconds at that size). Pauses that the operating system imposes on a loaded machine
+  come on top (``bench/README.md``). Plans then depend on the machine's speed and load.
 * **Deterministic mode** (``deterministic=True``): the wall clock is never read; each auction
   stops at convergence or after ``max_rounds`` rounds, so the same graph gives the same plan in
   any process and under any load, whatever time limit is passed (use it for comparisons; the
@@ -66,11 +66,9 @@ Limits and modes
 
 An auction cut short (by either limit) is assembled from the bundles the agents hold then
 (conflicts resolved by bid), and every bidder left with nothing is completed greedily from the
-free tasks (:mod:`solvers.cbba.assembly`), so the limit never hands back idle agents as a
-decision; ``completed`` in the stats counts them. If even that does not fit in the wall limit +
-10 % + 5 ms, :class:`~solvers.cbba.clock.CBBATimeLimitError` is raised and
-:func:`fcplan.scheduling.solve` falls back to greedy for that replan (status ``fallback``, the
-reason in its message).
+free tasks (:mod:`solvers.cbba.assembly`: one item each in a single vectorised pass, then the
+rest of the bundles while the clock allows), so the limit never hands back idle agents as a
+decision and never makes the scheduler fail; ``completed`` in the stats counts them.
 
 Stats
 -----
@@ -253,13 +251,7 @@ class CBBAScheduler:
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Run both auctions on ``graph`` and return the assembled plan (``rng`` is unused:
-        CBBA breaks ties by agent index).
-
-        Raises
-        ------
-        solvers.cbba.clock.CBBATimeLimitError
-            The wall limit ran out before every bidder had a route (see the module docstring).
-        """
+        CBBA breaks ties by agent index)."""
         res = self.run(graph, time_limit=time_limit)
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}

@@ -50,12 +50,16 @@ any process and under any load. Otherwise it stops at ``time_limit`` seconds for
 each backend gets the time left after building its model. A search cut by the clock is never
 handed back as if it were a decision:
 
-* if it found nothing, the ``warm_start`` routes (made feasible) are returned
-  (``kept_warm_start``), else :class:`RoutingFailedError` is raised (a scheduler's caller falls
-  back to greedy, :func:`fcplan.scheduling.solve`);
+* if it found nothing, the ``warm_start`` routes (made feasible, then completed by cheapest
+  insertion) are returned (``kept_warm_start``), else routes built by cheapest insertion from
+  empty routes (``from_insertion``; :mod:`solvers.routing.insertion`), the construction
+  heuristic a search would have started from;
 * if it found routes that a single feasible insertion would improve (OR-Tools completes an
   interrupted first solution by leaving the rest out), the routes are completed by cheapest
   insertion (``repaired``), and the warm start is returned instead if it is better.
+
+A backend looks at the clock before it builds its model, so a call whose time is already over
+costs the instance checks and the insertion only.
 
 Examples
 --------
@@ -101,7 +105,8 @@ TOL = 1e-6
 
 
 class RoutingFailedError(RuntimeError):
-    """The search found no routes within its limit and there was no warm start to keep."""
+    """No routes: a required task cannot be served, or a search that the clock did not stop
+    found none."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -133,6 +138,9 @@ class RoutesResult:
         better.
     repaired : bool
         The clock cut the search and the routes were completed by cheapest insertion.
+    from_insertion : bool
+        The clock ended the search before it found anything and there was no warm start: the
+        routes are cheapest insertion's from empty routes.
     size : dict
         ``vehicles``, ``tasks`` (searched), ``locations``.
     work : dict
@@ -149,6 +157,7 @@ class RoutesResult:
     warm_started: bool = False
     kept_warm_start: bool = False
     repaired: bool = False
+    from_insertion: bool = False
     size: dict = field(default_factory=dict)
     work: dict = field(default_factory=dict)
 

@@ -25,7 +25,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from solvers.routing.core import TOL, RoutesResult, RoutingFailedError, RoutingInstance
+from solvers.routing.core import TOL, RoutesResult, RoutingInstance
 
 __all__ = ["complete_by_insertion", "settle"]
 
@@ -34,59 +34,75 @@ def complete_by_insertion(
     inst: RoutingInstance, routes: Sequence[Sequence[int]]
 ) -> tuple[list[list[int]], bool]:
     """``(routes, changed)``: ``routes`` (task positions, feasible) completed by cheapest
-    insertion (see the module docstring)."""
+    insertion (see the module docstring).
+
+    Required tasks go first (the cheapest feasible insertion of any of them), then the
+    insertion of largest gain. Each vehicle keeps, per task, its cheapest feasible insertion;
+    after an insertion only that vehicle's row is recomputed, so a step costs one pass over one
+    route's arcs and the free tasks (ties: the lower vehicle, then task, then position).
+    """
     out = [list(r) for r in routes]
-    d, tasks = inst.dist, inst.tasks
-    used = np.zeros(inst.n_tasks, dtype=bool)
+    n_v, m = inst.n_vehicles, inst.n_tasks
+    used = np.zeros(m, dtype=bool)
     for r in out:
         used[r] = True
     length = np.array([inst.route_legs(v, r).sum() for v, r in enumerate(out)])
+    cost = np.full((n_v, m), np.inf)  # cheapest feasible insertion of each task per vehicle
+    where = np.zeros((n_v, m), dtype=np.int64)
+    longer = np.zeros((n_v, m))
+    for v in range(n_v):
+        _row(inst, out[v], v, length[v], used, cost, where, longer)
     changed = False
-    while not used.all():
-        free = np.flatnonzero(~used)
-        veh, pos, a, b = _arcs(inst, out)
-        k_loc = tasks[free]
-        longer = d[a[:, None], k_loc[None, :]] + d[k_loc[None, :], b[:, None]] - d[a, b][:, None]
-        cost = longer
-        if not inst.charge_return:
-            closing = pos == np.array([len(out[v]) for v in veh])  # arcs into the end
-            cost = np.where(closing[:, None], d[a[:, None], k_loc[None, :]], longer)
-        fits = (
-            inst.ok[np.ix_(veh, free)]
-            & (np.array([len(out[v]) for v in veh]) < inst.visits[veh])[:, None]
-            & (length[veh][:, None] + longer <= inst.budget[veh][:, None] + TOL)
-        )
-        must = fits & inst.required[free][None, :]
+    while True:
+        fits = np.isfinite(cost)
+        must = fits & inst.required[None, :]
         if must.any():  # required tasks first, cheapest first
-            gain = np.where(must, -cost, -np.inf)
+            flat = int(np.argmin(np.where(must, cost, np.inf)))
         else:
-            gain = np.where(fits, inst.prize[free][None, :] - cost, -np.inf)
-        i, j = np.unravel_index(int(np.argmax(gain)), gain.shape)
-        if not (must.any() or gain[i, j] > 0):
-            break
-        v, k = int(veh[i]), int(free[j])
-        out[v].insert(int(pos[i]), k)
-        length[v] += longer[i, j]
+            gain = np.where(fits, inst.prize[None, :] - np.where(fits, cost, 0.0), -np.inf)
+            flat = int(np.argmax(gain))
+            if not gain.flat[flat] > 0:
+                break
+        v, k = divmod(flat, m)
+        out[v].insert(int(where[v, k]), k)
+        length[v] += longer[v, k]
         used[k] = changed = True
+        cost[:, k] = np.inf
+        _row(inst, out[v], v, length[v], used, cost, where, longer)
     return out, changed
 
 
-def _arcs(
-    inst: RoutingInstance, routes: list[list[int]]
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Every arc of every vehicle's path: (vehicle, insertion position in its route, from
-    location, to location)."""
-    veh: list[int] = []
-    pos: list[int] = []
-    a: list[int] = []
-    b: list[int] = []
-    for v, r in enumerate(routes):
-        path = [int(inst.starts[v]), *(int(inst.tasks[k]) for k in r), int(inst.ends[v])]
-        veh += [v] * (len(path) - 1)
-        pos += range(len(path) - 1)
-        a += path[:-1]
-        b += path[1:]
-    return np.array(veh), np.array(pos), np.array(a), np.array(b)
+def _row(
+    inst: RoutingInstance,
+    route: list[int],
+    v: int,
+    length: float,
+    used: np.ndarray,
+    cost: np.ndarray,
+    where: np.ndarray,
+    longer: np.ndarray,
+) -> None:
+    """Vehicle ``v``'s cheapest feasible insertion of every free task into ``route``: its cost
+    (inf: none), position and added length go into row ``v`` of ``cost``, ``where``,
+    ``longer``."""
+    cost[v] = np.inf
+    free = np.flatnonzero(~used & inst.ok[v])
+    if free.size == 0 or len(route) >= inst.visits[v]:
+        return
+    d, k_loc = inst.dist, inst.tasks[free]
+    path = np.concatenate(([inst.starts[v]], inst.tasks[route], [inst.ends[v]]))
+    a, b = path[:-1], path[1:]
+    add = d[a[:, None], k_loc[None, :]] + d[k_loc[None, :], b[:, None]] - d[a, b][:, None]
+    c = add
+    if not inst.charge_return:  # the arc into the end is free: inserting before it costs d[a, k]
+        c = add.copy()
+        c[-1] = d[a[-1], k_loc]
+    c = np.where(length + add <= inst.budget[v] + TOL, c, np.inf)
+    best = np.argmin(c, axis=0)
+    cols = np.arange(free.size)
+    cost[v, free] = c[best, cols]
+    where[v, free] = best
+    longer[v, free] = add[best, cols]
 
 
 def settle(
@@ -101,17 +117,18 @@ def settle(
 ) -> RoutesResult:
     """The result of a search that ended with ``routes`` (task positions; None: nothing found),
     by the time-limit rule of :mod:`solvers.routing.core`: a search cut by the clock is completed
-    by insertion, or replaced by the warm start ``warm`` when that is better or the search found
-    nothing; with neither, :class:`~solvers.routing.core.RoutingFailedError` is raised."""
+    by insertion, or replaced by the warm start ``warm`` (itself completed by insertion) when
+    that is better or the search found nothing; with neither, the routes are built by cheapest
+    insertion from empty routes (``from_insertion``)."""
     status = "time_limit" if timed_out else "feasible"
     flags = {"warm_started": warm_started, "work": work}
     if routes is None:
         if warm is None:
-            raise RoutingFailedError(
-                f"{backend}: no routes for {inst.n_vehicles} vehicles x {inst.n_tasks} tasks "
-                "within the limit, and no warm start"
-            )
-        return inst.result(warm, "time_limit", backend, kept_warm_start=True, **flags)
+            built, _ = complete_by_insertion(inst, [[] for _ in range(inst.n_vehicles)])
+            return inst.result(built, "time_limit", backend, from_insertion=True, **flags)
+        kept, changed = complete_by_insertion(inst, warm)
+        return inst.result(kept, "time_limit", backend, kept_warm_start=True, repaired=changed,
+                           **flags)  # fmt: skip
     repaired = False
     if timed_out:
         routes, repaired = complete_by_insertion(inst, routes)

@@ -139,14 +139,15 @@ def solve_ortools(
     """Search ``inst`` with OR-Tools until ``deadline`` (``perf_counter`` time; None:
     deterministic, on ``opts``' work limits), starting from ``warm`` (task positions) if given
     and ``from_warm``."""
+    if deadline is not None and deadline - time.perf_counter() - opts.reserve_s <= 0:
+        return _out_of_time(inst, warm)  # (before building a model that could not be searched)
     rm = _build(inst, opts)
     params = _parameters(opts, deadline, _first_solution(inst, opts))
     time_left = None
     if deadline is not None:
         time_left = deadline - time.perf_counter() - opts.reserve_s
         if time_left <= 0:
-            return settle(inst, None, warm, backend="ortools", timed_out=True,
-                          warm_started=False, work={"branches": 0})  # fmt: skip
+            return _out_of_time(inst, warm)
         params.time_limit.FromMicroseconds(max(int(opts.wall_fraction * time_left * 1e6), 1))
     model = rm.model
     branches = opts.branch_limit if deadline is None else opts.wall_branch_limit
@@ -173,6 +174,12 @@ def solve_ortools(
     work = {"branches": int(model.solver().Branches())}
     return settle(inst, routes, warm, backend="ortools", timed_out=timed_out,
                   warm_started=start is not None, work=work)  # fmt: skip
+
+
+def _out_of_time(inst: RoutingInstance, warm: list[list[int]] | None) -> RoutesResult:
+    """The result of a call whose time ran out before any search (the time-limit rule)."""
+    return settle(inst, None, warm, backend="ortools", timed_out=True, warm_started=False,
+                  work={"branches": 0})  # fmt: skip
 
 
 def _first_solution(inst: RoutingInstance, opts: OrToolsOptions) -> str:

@@ -46,10 +46,13 @@ other perception routes fly at ``search_altitude`` (high: a wide view). Altitude
 each agent's bounds. Agents with an empty route are not mentioned in the plan (they keep their
 current route), as in ``greedy``.
 
-**Model size**: each role's candidate nodes are its ``max(max_nodes, nodes_per_vehicle * V)``
-most valuable tasks that one of its ``V`` vehicles can reach (default 60, or 2 per vehicle on big
-teams); the others are not offered this replan. On big task graphs this is what keeps a replan
-within its time limit. Routes hold at most ``max_visits`` (4) tasks.
+**Model size**: a role with more than ``group_vehicles`` vehicles is split into groups of at
+most that many vehicles lying close together, each with the tasks nearest to it, and each group
+is its own model (:mod:`solvers.routing.decompose`; 12 by default, so the manual's teams are one
+model per role). Each model's candidate nodes are its ``max(max_nodes, nodes_per_vehicle * V)``
+most valuable tasks that one of its ``V`` vehicles can reach (default 60); the others are not
+offered this replan. On big task graphs this is what keeps a replan within its time limit.
+Routes hold at most ``max_visits`` (4) tasks.
 
 **Search and time**: each model is a :func:`solvers.routing.solve_routes` problem (locations:
 the ``V`` vehicles' starts, their depot slots, the candidate tasks) searched by ``backend``:
@@ -82,10 +85,11 @@ scheduler, paired over scenarios 1-24 x seeds 0-2 (wall-clock mode on a loaded m
 ``bench/README.md``), so it is not the default.
 
 **Time limit**: a search cut by the clock is never handed back as a decision
-(:mod:`solvers.routing.core`): if it found nothing, the warm start is kept; unfinished routes
-are completed by cheapest insertion; with neither, :class:`~solvers.routing.RoutingFailedError`
-is raised and :func:`fcplan.scheduling.solve` falls back to ``greedy`` for that replan
-(``status="fallback"``, the reason in the message).
+(:mod:`solvers.routing.core`): unfinished routes are completed by cheapest insertion; if it found
+nothing, the warm start is kept (completed by insertion), or, without one, the routes are built
+by cheapest insertion from scratch. So the scheduler always answers with routes of its own
+model; its floor, when the limit is over before it starts, is reading the graph and building
+the distance matrices and the insertion (no solver model is built then).
 
 **Status**: routing never proves optimality. ``feasible``: the work limits or a local optimum
 ended the search; ``time_limit``: the clock did (the worse of the two models is reported; the
@@ -108,6 +112,7 @@ from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
 from solvers.routing.core import BACKENDS, RoutesResult
+from solvers.routing.decompose import bisection_sizes, spatial_groups
 from solvers.routing.ortools_backend import OrToolsOptions
 from solvers.routing.pyvrp_backend import PyVRPOptions
 from solvers.routing.solve import solve_routes
@@ -140,8 +145,10 @@ class RoutingScheduler:
     max_visits : int
         Most tasks per route (0: no limit).
     max_nodes, nodes_per_vehicle : int
-        Candidate tasks per role per replan: the ``max(max_nodes, nodes_per_vehicle * V)`` most
-        valuable reachable ones, ``V`` the role's vehicles (``max_nodes=0``: all of them).
+        Candidate tasks per model per replan: the ``max(max_nodes, nodes_per_vehicle * V)`` most
+        valuable reachable ones, ``V`` the model's vehicles (``max_nodes=0``: all of them).
+    group_vehicles : int
+        Most vehicles per model: a role with more is split into spatial groups (0: never).
     fire_base_px : float
         Drop penalty (px) of any fire task for action agents, on top of the value term: action
         agents have nothing else to do, so every reachable fire is worth a trip this long.
@@ -188,6 +195,7 @@ class RoutingScheduler:
         max_visits: int = 4,
         max_nodes: int = 60,
         nodes_per_vehicle: int = 2,
+        group_vehicles: int = 12,
         fire_base_px: float = 2000.0,
         fire_value_px: float = 200.0,
         watch_value_px: float = 1000.0,
@@ -221,6 +229,9 @@ class RoutingScheduler:
         self.max_visits = int(max_visits)
         self.max_nodes = int(max_nodes)
         self.nodes_per_vehicle = int(nodes_per_vehicle)
+        if not (isinstance(group_vehicles, int) and group_vehicles >= 0):
+            raise ValueError(f"group_vehicles must be an integer >= 0, got {group_vehicles!r}")
+        self.group_vehicles = group_vehicles
         self.fire_base_px = float(fire_base_px)
         self.fire_value_px = float(fire_value_px)
         self.watch_value_px = float(watch_value_px)
@@ -254,14 +265,7 @@ class RoutingScheduler:
 
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
-        """Route both roles on ``graph`` within ``time_limit`` seconds (default: the setting).
-
-        Raises
-        ------
-        RoutingFailedError
-            If a model's search finds nothing in time and there is no warm start
-            (:func:`fcplan.scheduling.solve` then falls back to greedy).
-        """
+        """Route both roles on ``graph`` within ``time_limit`` seconds (default: the setting)."""
         limit = self.time_limit if time_limit is None else float(time_limit)
         # keep a little of the limit for turning routes into the plan and freeing the models
         deadline = time.perf_counter() + limit - min(0.1 * limit, 0.005)
@@ -276,7 +280,7 @@ class RoutingScheduler:
         warm = last[2] if last is not None and self.warm_start != "off" else {}
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}
-        sols: dict[str, RoutesResult] = {}
+        sols: dict[str, list[RoutesResult]] = {}
         first_fires = self._route_actors(graph, actors, sensors, deadline, warm, routes, sols)
         if sensors.size:
             self._route_sensors(graph, sensors, first_fires, deadline, warm, routes, alts, sols)
@@ -291,36 +295,34 @@ class RoutingScheduler:
         deadline: float,
         warm: dict[str, tuple[str, ...]],
         routes: dict[str, tuple[str, ...]],
-        sols: dict[str, RoutesResult],
+        sols: dict[str, list[RoutesResult]],
     ) -> list[int]:
         """Action agents -> fires (one visit per dump left in the tank); the routes go into
-        ``routes``, the model's solution into ``sols``. Returns the first fire of each route."""
+        ``routes``, the models' solutions into ``sols``. Returns the first fire of each route."""
         fires, blocks = graph.fire_tasks, graph.search_tasks
         stale = graph.task_staleness[fires]
         fresh = np.exp(-np.maximum(stale - self.fresh_s, 0.0) / max(self.fresh_s, 1e-9))
         act_value = self.fire_base_px + self.fire_value_px * graph.task_value[fires] * fresh
         act_value = np.where(graph.task_value[fires] > 0, act_value, 0.0)
-        act_nodes = self._candidates(graph, actors, fires, act_value)
+        models = self._models(graph, actors, fires, act_value)
         sense_value_guess = np.r_[
             self.watch_value_px * graph.task_value[fires],
             self.search_value_px * graph.task_value[blocks],
         ]
         n_sense = min(
-            self._n_candidates(sensors.size),
+            sum(self._n_candidates(n) for n in bisection_sizes(sensors.size, self._group_size)),
             int((sense_value_guess > 0).sum()) if sensors.size else 0,
         )  # for the time split only
         first_fires: list[int] = []
-        if actors.size and act_nodes[0].size:
-            share = act_nodes[0].size / (act_nodes[0].size + n_sense)
-            share = 1.0 if n_sense == 0 else min(max(share, 0.25), 0.5)
-            sol, rows = self._solve(
-                graph, actors, act_nodes, deadline, share, warm, capacity=graph.agent_tank[actors]
-            )
-            sols["action"] = sol
-            for v, ks in enumerate(rows):
-                if ks.size:
-                    routes[graph.agent_ids[actors[v]]] = tuple(graph.task_ids[k] for k in ks)
-                    first_fires.append(int(ks[0]))
+        n_act = sum(nodes[0].size for _, nodes in models)
+        if n_act:
+            share = 1.0 if n_sense == 0 else min(max(n_act / (n_act + n_sense), 0.25), 0.5)
+            for agents, rows in self._solve_models(graph, models, deadline, share, warm,
+                                                   sols.setdefault("action", []), tank=True):  # fmt: skip
+                for i, ks in zip(agents.tolist(), rows, strict=True):
+                    if ks.size:
+                        routes[graph.agent_ids[i]] = tuple(graph.task_ids[k] for k in ks)
+                        first_fires.append(int(ks[0]))
         return first_fires
 
     def _route_sensors(
@@ -332,10 +334,10 @@ class RoutingScheduler:
         warm: dict[str, tuple[str, ...]],
         routes: dict[str, tuple[str, ...]],
         alts: dict[str, float],
-        sols: dict[str, RoutesResult],
+        sols: dict[str, list[RoutesResult]],
     ) -> None:
         """Perception agents -> search blocks and fires to watch; the routes and altitudes go
-        into ``routes`` and ``alts``, the model's solution into ``sols``."""
+        into ``routes`` and ``alts``, the models' solutions into ``sols``."""
         fires, blocks = graph.fire_tasks, graph.search_tasks
         stale = graph.task_staleness[fires]
         fought = self._fought(graph, fires, first_fires, sensors.size)
@@ -351,24 +353,20 @@ class RoutingScheduler:
                 / graph.agent_speed[sensors, None]
             )
             search = search * self.search_horizon_s / (self.search_horizon_s + eta.min(0))
-        value = np.r_[watch, search]
-        nodes = self._candidates(graph, sensors, tasks, value)
-        if not nodes[0].size:
-            return
-        sol, rows = self._solve(graph, sensors, nodes, deadline, 1.0, warm)
-        sols["perception"] = sol
-        for v, ks in enumerate(rows):
-            if not ks.size:
-                continue
-            i = int(sensors[v])
-            if graph.task_kind[ks[0]] == TaskKind.FIRE:
-                ks, z = ks[:1], self.watch_altitude  # watch: hover over the fire
-            else:
-                z = self.search_altitude
-            routes[graph.agent_ids[i]] = tuple(graph.task_ids[k] for k in ks)
-            alts[graph.agent_ids[i]] = graph.clip_altitude(i, z)
+        models = self._models(graph, sensors, tasks, np.r_[watch, search])
+        solved = self._solve_models(graph, models, deadline, 1.0, warm,
+                                    sols.setdefault("perception", []), tank=False)  # fmt: skip
+        for agents, rows in solved:
+            for i, ks in zip(agents.tolist(), rows, strict=True):
+                if not ks.size:
+                    continue
+                if graph.task_kind[ks[0]] == TaskKind.FIRE:
+                    ks, z = ks[:1], self.watch_altitude  # watch: hover over the fire
+                else:
+                    z = self.search_altitude
+                routes[graph.agent_ids[i]] = tuple(graph.task_ids[k] for k in ks)
+                alts[graph.agent_ids[i]] = graph.clip_altitude(i, z)
 
-    # ------------------------------------------------------------------ helpers
     def _fought(
         self, graph: TaskGraph, fires: np.ndarray, first_fires: list[int], n_sensors: int
     ) -> np.ndarray:
@@ -386,30 +384,66 @@ class RoutingScheduler:
         out[np.isin(fires, ks[:n_watch])] = True
         return out
 
+    @property
+    def _group_size(self) -> int:
+        """Most vehicles per model (huge: no split)."""
+        return self.group_vehicles if self.group_vehicles > 0 else 1 << 62
+
     def _n_candidates(self, n_vehicles: int) -> int:
         """Candidate nodes for a model with ``n_vehicles`` vehicles (huge: no cap)."""
         if self.max_nodes <= 0:
             return 1 << 62
         return max(self.max_nodes, self.nodes_per_vehicle * n_vehicles)
 
-    def _candidates(
+    def _models(
         self, graph: TaskGraph, agents: np.ndarray, tasks: np.ndarray, value: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """(task rows, penalties px) of the most valuable tasks (see :meth:`_n_candidates`) some
-        agent of ``agents`` can serve (positive value, within a round trip, reachable with the way
-        home)."""
+    ) -> list[tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]]:
+        """One role's models: per spatial group of ``agents`` (:mod:`solvers.routing.decompose`),
+        its vehicles and (task rows, penalties px) of its candidates, the most valuable tasks
+        (see :meth:`_n_candidates`) of the group that one of its vehicles can serve (positive
+        value, within a round trip, reachable with the way home). Groups without a candidate
+        are left out."""
         if agents.size == 0 or tasks.size == 0:
-            return np.zeros(0, np.int64), np.zeros(0)
+            return []
         start, budget, trip = graph.agent_start_pos, graph.agent_budget_px, graph.in_round_trip
         d = (
             _pairwise(start[agents], graph.task_pos[tasks])
             + graph.task_home_distance[np.ix_(agents, tasks)]
         )
-        reach = (trip[np.ix_(agents, tasks)] & (d <= budget[agents, None])).any(axis=0)
-        ok = np.flatnonzero(reach & (value > 0))
-        top = ok[np.argsort(-value[ok], kind="stable")[: self._n_candidates(agents.size)]]
-        top = np.sort(top)  # task order: the model does not depend on value ties
-        return tasks[top], value[top]
+        reach = trip[np.ix_(agents, tasks)] & (d <= budget[agents, None]) & (value > 0)[None, :]
+        out = []
+        for gv, gt in spatial_groups(start[agents], graph.task_pos[tasks], reach, self._group_size):
+            ok = gt[reach[np.ix_(gv, gt)].any(axis=0)]
+            top = ok[np.argsort(-value[ok], kind="stable")[: self._n_candidates(gv.size)]]
+            top = np.sort(top)  # task order: the model does not depend on value ties
+            if top.size:
+                out.append((agents[gv], (tasks[top], value[top])))
+        return out
+
+    def _solve_models(
+        self,
+        graph: TaskGraph,
+        models: list[tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]],
+        deadline: float,
+        share: float,
+        warm: dict[str, tuple[str, ...]],
+        sols: list[RoutesResult],
+        *,
+        tank: bool,
+    ) -> list[tuple[np.ndarray, list[np.ndarray]]]:
+        """Solve one role's models in turn with ``share`` of the time left before
+        ``deadline``, each model a part in proportion to its nodes; their solutions go into
+        ``sols``. Returns per model its agents and their routes as task rows."""
+        now = time.perf_counter()
+        role_end = now + max(deadline - now, 0.0) * share
+        weights = [nodes[0].size for _, nodes in models]
+        out = []
+        for n, (agents, nodes) in enumerate(models):
+            sol, rows = self._solve(graph, agents, nodes, role_end, weights[n] / sum(weights[n:]),
+                                    warm, capacity=graph.agent_tank[agents] if tank else None)  # fmt: skip
+            sols.append(sol)
+            out.append((agents, rows))
+        return out
 
     def _solve(
         self,
@@ -468,27 +502,30 @@ class RoutingScheduler:
         return res, rows
 
 
-def _stats(graph: TaskGraph, sols: dict[str, RoutesResult]) -> SolveStats:
-    """The plan's stats from the models' results (the worse status of the two)."""
-    status = "time_limit" if any(s.status == "time_limit" for s in sols.values()) else "feasible"
+def _stats(graph: TaskGraph, sols: dict[str, list[RoutesResult]]) -> SolveStats:
+    """The plan's stats from the models' results (the worst status of them)."""
+    results = [(role, n, s) for role, lst in sols.items() for n, s in enumerate(lst)]
+    status = "time_limit" if any(s.status == "time_limit" for *_, s in results) else "feasible"
     size = {
-        "models": len(sols),
-        "vehicles": sum(s.size["vehicles"] for s in sols.values()),
-        "nodes": sum(s.size["tasks"] for s in sols.values()),
+        "models": len(results),
+        "vehicles": sum(s.size["vehicles"] for *_, s in results),
+        "nodes": sum(s.size["tasks"] for *_, s in results),
         "agents": graph.n_agents,
         "tasks": graph.n_tasks,
     }
     message = "; ".join(
-        f"{role}: {s.backend}, {s.size['vehicles']} vehicles x {s.size['tasks']} nodes, travel "
+        f"{role}{f' {n + 1}/{len(sols[role])}' if len(sols[role]) > 1 else ''}: {s.backend}, "
+        f"{s.size['vehicles']} vehicles x {s.size['tasks']} nodes, travel "
         f"{s.travel:.0f} px, dropped {s.dropped:.0f} px, {s.status}"
         + (", from the warm start" if s.warm_started else "")
         + (", warm start kept (nothing better in time)" if s.kept_warm_start else "")
         + (", completed by insertion after the time-out" if s.repaired else "")
-        for role, s in sols.items()
+        + (", built by insertion (nothing found in time)" if s.from_insertion else "")
+        for role, n, s in results
     )
     return SolveStats(
         status=status,
-        objective=float(sum(s.objective for s in sols.values())),
+        objective=float(sum(s.objective for *_, s in results)),
         size=size,
         message=message,
     )

@@ -90,8 +90,7 @@ def solve_routes(
     ValueError
         On malformed input or an unknown backend.
     RoutingFailedError
-        If a required task cannot be served, or the search found nothing within its limit and
-        there is no usable warm start.
+        If a required task cannot be served, or a search the clock did not stop found nothing.
     """
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; one of {', '.join(BACKENDS)}")

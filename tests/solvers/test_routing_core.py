@@ -200,18 +200,25 @@ def test_warm_start_is_used_and_never_worsened(backend):
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-def test_time_out_before_any_search_keeps_the_warm_start_or_raises(backend):
-    """With no time left the search cannot run: the (fitted) warm start comes back as
-    ``time_limit`` with ``kept_warm_start``, and without a warm start RoutingFailedError is
-    raised: an empty plan is never handed back as a decision."""
+def test_time_out_before_any_search_keeps_the_warm_start_or_builds_by_insertion(backend):
+    """With no time left the search cannot run: the (fitted) warm start comes back, completed
+    by cheapest insertion, as ``time_limit`` with ``kept_warm_start``; without a warm start the
+    routes are cheapest insertion's from empty routes (``from_insertion``): an empty plan is
+    never handed back as a decision, and the result is what insertion alone gives."""
     dist, starts, ends, rng = random_instance(4, 2, 20)
     prizes = np.r_[np.zeros(4), np.full(20, 1e4)]
     kw = {"starts": starts, "ends": ends, "prizes": prizes, "backend": backend}
+    inst = RoutingInstance.of(dist, starts, ends, prizes)
     res = solve_routes(dist, time_limit=0.0, warm_start=[[4, 5], [6]], **kw)
-    assert res.routes == ((4, 5), (6,))
     assert res.status == "time_limit" and res.kept_warm_start
-    with pytest.raises(RoutingFailedError, match="no warm start"):
-        solve_routes(dist, time_limit=0.0, **kw)
+    kept, _ = complete_by_insertion(inst, inst.warm_routes([[4, 5], [6]]))
+    assert res.routes == inst.result(kept, "time_limit", backend).routes
+    assert {4, 5, 6} <= {k for r in res.routes for k in r}
+    cold = solve_routes(dist, time_limit=0.0, **kw)
+    built, _ = complete_by_insertion(inst, [[], []])
+    assert cold.status == "time_limit" and cold.from_insertion and not cold.kept_warm_start
+    assert cold.routes == inst.result(built, "time_limit", backend).routes
+    assert cold.n_visits == 20  # every prize (1e4) is worth its detour
 
 
 @pytest.mark.parametrize("seed", range(4))
