@@ -1,56 +1,271 @@
-"""Building the assignment model of a task graph: variables, objective and rows put together."""
+"""Building the route model of a task graph: routes per agent, their values, the cover and freeze
+variables, and the rows (see :mod:`solvers.milp_model`)."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
 import numpy as np
 
-from fcplan.taskgraph import TaskGraph
+from fcplan.taskgraph import TaskGraph, TaskKind
 from solvers.milp_model.constraints import model_rows
-from solvers.milp_model.objective import objective_coefficients
-from solvers.milp_model.types import AUX, MilpModel, MilpParams
-from solvers.milp_model.variables import model_variables
+from solvers.milp_model.objective import (
+    CELL_RATE,
+    block_values,
+    dump_value,
+    fire_weight,
+    route_cover,
+    straight_cover,
+)
+from solvers.milp_model.routes import AgentRoles, agent_roles, enumerate_routes, top_candidates
+from solvers.milp_model.sensing import best_search_altitude
+from solvers.milp_model.types import (
+    COVER,
+    DUMP,
+    FREEZE,
+    ROUTE,
+    SEARCH,
+    WATCH,
+    MilpModel,
+    MilpParams,
+)
 
-__all__ = ["build_milp_model"]
+__all__ = ["RouteSet", "build_milp_model"]
 
 
-def build_milp_model(graph: TaskGraph, params: MilpParams | None = None) -> MilpModel:
-    """Build the assignment MILP of ``graph`` (see :mod:`solvers.milp_model`).
+@dataclass(frozen=True, eq=False)
+class RouteSet:
+    """The routes of a model (``R`` rows), before the variables are laid out."""
+
+    agent: np.ndarray  # (R,) int64
+    kind: np.ndarray  # (R,) int8 DUMP / WATCH / SEARCH
+    tasks: np.ndarray  # (R, L) int64, -1 padded
+    arrival: np.ndarray  # (R, L) float64, NaN padded
+    length: np.ndarray  # (R,) float64 px
+    value: np.ndarray  # (R,) float64 own objective coefficient
+    altitude: np.ndarray  # (R,) float64 (NaN: no camera)
+    cover: np.ndarray  # (R, B) int64 detected share of each block, percent
+
+
+class _Context:
+    """What every agent's routes need from the graph (computed once per model)."""
+
+    def __init__(self, graph: TaskGraph, p: MilpParams) -> None:
+        self.graph, self.p = graph, p
+        self.roles: AgentRoles = agent_roles(graph)
+        self.weight = fire_weight(graph, p)
+        self.fire = graph.task_kind == TaskKind.FIRE
+        self.blocks = np.flatnonzero(~self.fire)
+        self.block_value = block_values(graph, p, self.blocks)
+        self.width = max(p.slots, p.search_slots)
+
+    def altitudes(self, agent: int) -> tuple[float, float]:
+        """(watch, search) altitudes of a camera agent, clipped to its bounds."""
+        g, p = self.graph, self.p
+        lo, hi = (float(v) for v in g.agent_alt_range[agent])
+        speed = float(g.agent_speed[agent])
+        z_search = (
+            best_search_altitude(lo, hi, speed) if p.search_altitude is None else p.search_altitude
+        )
+        return g.clip_altitude(agent, p.watch_altitude), g.clip_altitude(agent, z_search)
+
+
+def _pad(a: np.ndarray, width: int, fill: float) -> np.ndarray:
+    return np.pad(a, ((0, 0), (0, width - a.shape[1])), constant_values=fill)
+
+
+def _agent_routes(ctx: _Context, a: int) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+    """The enumerated routes of agent ``a``: (kind, tasks, arrival, length) per kind."""
+    g, p, roles = ctx.graph, ctx.p, ctx.roles
+    t0 = float(roles.t0[a])
+    speed = max(float(g.agent_speed[a]), 1e-9)
+    direct = t0 + g.start_task_distance[a] / speed  # (K,) arrival on a one-task route
+    out = []
+    if roles.dumper[a]:
+        score = dump_value(g, p, ctx.weight, np.arange(g.n_tasks), direct)
+        cands = top_candidates(score, roles.ok1[a] & ctx.fire, p.fire_candidates)
+        length = min(p.slots, int(roles.tank[a]))
+        out.append((DUMP, *enumerate_routes(g, a, cands, length, t0)))
+    elif roles.sensor[a]:
+        score = dump_value(g, p, ctx.weight, np.arange(g.n_tasks), direct)
+        cands = top_candidates(score, roles.ok1[a] & ctx.fire, p.watch_candidates)
+        out.append((WATCH, *enumerate_routes(g, a, cands, 1, t0)))
+    if roles.sensor[a] and ctx.blocks.size:
+        _, z = ctx.altitudes(a)
+        ends = g.task_pos[ctx.blocks]
+        score_b = straight_cover(g, a, ends, ctx.blocks, z, t0, p) @ ctx.block_value
+        score = np.zeros(g.n_tasks)
+        score[ctx.blocks] = score_b
+        cands = top_candidates(score, roles.ok1[a] & ~ctx.fire, p.search_candidates)
+        out.append((SEARCH, *enumerate_routes(g, a, cands, p.search_slots, t0)))
+    return out
+
+
+def _given_routes(
+    ctx: _Context, a: int, routes: Sequence[Sequence[int]]
+) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+    """Agent ``a``'s ``routes`` (task rows) as (kind, tasks, arrival, length) rows: dumps when the
+    agent has water and the route starts at a fire, a watch for a camera agent's fire, else a
+    search; lengths and arrivals as :func:`enumerate_routes` computes them."""
+    g, roles = ctx.graph, ctx.roles
+    out = []
+    for route in routes:
+        rows = np.asarray(route, dtype=np.int64)
+        if rows.size == 0:
+            continue
+        first_fire = bool(ctx.fire[rows[0]])
+        kind = DUMP if first_fire and roles.dumper[a] else WATCH if first_fire else SEARCH
+        pts = np.vstack([g.agent_start_pos[a], g.task_pos[rows]])
+        legs = np.hypot(*np.diff(pts, axis=0).T)
+        arrival = float(roles.t0[a]) + np.cumsum(legs) / max(float(g.agent_speed[a]), 1e-9)
+        px = float(legs.sum() + np.hypot(*(g.task_pos[rows[-1]] - g.agent_home[a])))
+        out.append((kind, rows[None, :], arrival[None, :], np.array([px])))
+    return out
+
+
+def _valued(ctx: _Context, a: int, kind: int, tasks, arrival, length) -> RouteSet:
+    """The routes of one agent and kind with their values, altitudes and covers."""
+    g, p = ctx.graph, ctx.p
+    n = len(tasks)
+    width = max(ctx.width, tasks.shape[1])
+    value = np.zeros(n)
+    if kind == DUMP:
+        fire_only = np.where((tasks >= 0) & ctx.fire[np.maximum(tasks, 0)], tasks, -1)
+        value = dump_value(g, p, ctx.weight, fire_only, arrival).sum(axis=1)
+    cover = np.zeros((n, ctx.blocks.size), dtype=np.int64)
+    alt = np.full(n, np.nan)
+    if ctx.roles.sensor[a]:
+        z_watch, z_search = ctx.altitudes(a)
+        z = z_search if kind == SEARCH else z_watch
+        alt[:] = z
+        share = route_cover(g, a, tasks, arrival, ctx.blocks, z, float(ctx.roles.t0[a]), p)
+        cover = np.floor(p.cover_levels * share + 0.5).astype(np.int64)
+    return RouteSet(
+        agent=np.full(n, a, dtype=np.int64),
+        kind=np.full(n, kind, dtype=np.int8),
+        tasks=_pad(tasks, width, -1),
+        arrival=_pad(arrival, width, np.nan),
+        length=length,
+        value=value,
+        altitude=alt,
+        cover=cover,
+    )
+
+
+def _route_set(ctx: _Context, given: Mapping[int, Sequence[Sequence[int]]] | None) -> RouteSet:
+    parts = []
+    for a in range(ctx.graph.n_agents):
+        raw = _agent_routes(ctx, a) if given is None else _given_routes(ctx, a, given.get(a, ()))
+        parts += [_valued(ctx, a, kind, t, arr, px) for kind, t, arr, px in raw if len(t)]
+    width = max([ctx.width] + [r.tasks.shape[1] for r in parts])
+    if not parts:
+        z = np.zeros(0)
+        return RouteSet(
+            z.astype(np.int64), z.astype(np.int8), np.zeros((0, width), np.int64),
+            np.zeros((0, width)), z, z, z, np.zeros((0, ctx.blocks.size), np.int64),
+        )  # fmt: skip
+    return RouteSet(
+        agent=np.concatenate([r.agent for r in parts]),
+        kind=np.concatenate([r.kind for r in parts]),
+        tasks=np.concatenate([_pad(r.tasks, width, -1) for r in parts]),
+        arrival=np.concatenate([_pad(r.arrival, width, np.nan) for r in parts]),
+        length=np.concatenate([r.length for r in parts]),
+        value=np.concatenate([r.value for r in parts]),
+        altitude=np.concatenate([r.altitude for r in parts]),
+        cover=np.concatenate([r.cover for r in parts]),
+    )
+
+
+def _fire_visits(ctx: _Context, rs: RouteSet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(R, L) connected fire of each route entry (-1: none), and which entries dump on it and
+    which sense it (a watch, or a dump by an agent with a camera)."""
+    g = ctx.graph
+    on = rs.tasks >= 0
+    k = np.maximum(rs.tasks, 0)
+    cl = np.where(on & ctx.fire[k], g.task_cluster[k], -1)
+    dump = (rs.kind == DUMP)[:, None] & (cl >= 0)
+    sees = ((rs.kind == WATCH) | ((rs.kind == DUMP) & ctx.roles.sensor[rs.agent]))[:, None]
+    return cl, dump, sees & (cl >= 0)
+
+
+def _freeze(
+    ctx: _Context, rs: RouteSet, cl: np.ndarray, dump: np.ndarray, sees: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Connected fires with a dump route and a sensing route: labels and coefficients
+    ``0.1 q gamma (H - t_c)+^2 / 2``, ``t_c`` the earliest arrival of an agent with water at a
+    task of the fire (straight from its start: it depends on the graph only)."""
+    g, p, roles = ctx.graph, ctx.p, ctx.roles
+    if p.growth_cells_s <= 0 or not dump.any():
+        return np.zeros(0, np.int64), np.zeros(0)
+    labels = np.intersect1d(np.unique(cl[dump]), np.unique(cl[sees]))
+    speed = np.maximum(g.agent_speed, 1e-9)[:, None]
+    direct = roles.t0[:, None] + g.start_task_distance / speed  # (A, K)
+    direct = np.where(roles.ok1 & roles.dumper[:, None] & ctx.fire[None, :], direct, np.inf)
+    t_first = np.array([direct[:, g.task_cluster == c].min() for c in labels.tolist()])
+    gap = np.maximum(p.horizon_s - t_first, 0.0)
+    coef = CELL_RATE * p.prune_confidence * p.growth_cells_s * gap * gap / 2.0
+    return labels.astype(np.int64), coef
+
+
+def build_milp_model(
+    graph: TaskGraph,
+    params: MilpParams | None = None,
+    *,
+    routes: Mapping[int, Sequence[Sequence[int]]] | None = None,
+) -> MilpModel:
+    """Build the route model of ``graph`` (see :mod:`solvers.milp_model`).
 
     Parameters
     ----------
     graph : TaskGraph
     params : MilpParams, optional
+    routes : mapping of agent row -> sequence of routes (task rows), optional
+        Use exactly these routes instead of enumerating them (to score other plans).
 
-    Returns
-    -------
-    MilpModel
+    Raises
+    ------
+    ValueError
+        If the model would hold more than ``params.max_routes`` routes.
     """
     p = params or MilpParams()
-    v = model_variables(graph, p)
-    c = objective_coefficients(graph, p, v)
-    mat, b, families = model_rows(graph, p, v)
-    n_x, n_z = v.n_x, v.n_z
-    n = n_x + n_z
+    ctx = _Context(graph, p)
+    rs = _route_set(ctx, routes)
+    if len(rs.agent) > p.max_routes:
+        raise ValueError(f"{len(rs.agent)} routes exceed max_routes={p.max_routes}")
+    swept = np.flatnonzero(rs.cover.any(axis=0))
+    cl, dump, sees = _fire_visits(ctx, rs)
+    labels, freeze_coef = _freeze(ctx, rs, cl, dump, sees)
+    n_r, n_b, n_z = len(rs.agent), swept.size, labels.size
+    mat, b, families = model_rows(rs.agent, rs.tasks, rs.cover[:, swept], cl, dump, sees, labels)
+    c = np.concatenate([rs.value, ctx.block_value[swept] / p.cover_levels, freeze_coef])
     size = {
-        "variables": int(n),
-        "binaries": int(n),
-        "aux": int(n_z),
+        "variables": int(c.size),
+        "routes": int(n_r),
+        "covers": int(n_b),
+        "freezes": int(n_z),
         "constraints": int(b.size),
         "nonzeros": int(mat.nnz),
         "agents": int(graph.n_agents),
         "tasks": int(graph.n_tasks),
-        "fires": int(v.fire.sum()),
-        "pairs": v.n_pairs,
+        "fires": int(ctx.fire.sum()),
     }
     return MilpModel(
         c=c.astype(np.float64),
         A_ub=mat,
         b_ub=b,
-        integrality=np.ones(n, dtype=np.int8),
-        var_agent=np.r_[v.va, np.full(n_z, -1)].astype(np.int64),
-        var_task=np.r_[v.vk, v.zk].astype(np.int64),
-        var_slot=np.r_[v.vs, v.zs].astype(np.int64),
-        var_kind=np.r_[v.vkind, np.full(n_z, AUX)].astype(np.int8),
+        ub=np.concatenate([np.ones(n_r), np.full(n_b, float(p.cover_levels)), np.ones(n_z)]),
+        var_kind=np.concatenate(
+            [np.full(n_r, ROUTE), np.full(n_b, COVER), np.full(n_z, FREEZE)]
+        ).astype(np.int8),
+        var_ref=np.concatenate([np.arange(n_r), ctx.blocks[swept], labels]).astype(np.int64),
+        route_agent=rs.agent,
+        route_kind=rs.kind,
+        route_tasks=rs.tasks,
+        route_arrival=rs.arrival,
+        route_length=rs.length,
+        route_value=rs.value,
+        altitude=rs.altitude,
         row_kind=families,
         agent_ids=graph.agent_ids,
         task_ids=graph.task_ids,

@@ -1,7 +1,9 @@
-"""What both MILP schedulers share: settings, model building, solving and plan decoding."""
+"""What both MILP schedulers share: settings, the two limit modes, the warm start, and the check
+that a plan cut short by a limit does not leave agents idle."""
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any
 
@@ -12,55 +14,136 @@ from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph
 from solvers.milp_model.build import build_milp_model
 from solvers.milp_model.decode import decode_plan
-from solvers.milp_model.types import MilpModel, MilpParams
+from solvers.milp_model.start import idle_agents, initial_solution
+from solvers.milp_model.types import MilpModel, MilpParams, check_setting
 
-__all__ = ["MilpSchedulerBase"]
+__all__ = ["MilpSchedulerBase", "SolverLimits", "IncompletePlanError"]
+
+
+class IncompletePlanError(RuntimeError):
+    """A limit stopped the solver before it had a plan for every agent that has work."""
+
+
+class SolverLimits:
+    """The limits of one solve: a wall-clock deadline (``perf_counter`` seconds, or None) and a
+    deterministic work limit (the backend's unit)."""
+
+    __slots__ = ("deadline", "work")
+
+    def __init__(self, deadline: float | None, work: float) -> None:
+        self.deadline, self.work = deadline, work
+
+    def seconds_left(self, reserve: float = 0.0) -> float | None:
+        """Wall seconds left before the deadline minus ``reserve`` (None: no deadline)."""
+        if self.deadline is None:
+            return None
+        return self.deadline - time.perf_counter() - reserve
 
 
 class MilpSchedulerBase:
-    """What both MILP schedulers share: settings, model building and plan decoding.
+    """What both MILP schedulers share (see :mod:`solvers.milp` for the settings' meaning).
 
-    Subclasses set ``name`` and ``default_time_limit`` and implement :meth:`_solve` (one backend).
+    Subclasses set ``name``, ``default_work_limit`` and ``work_limit_kind`` (``float`` or
+    ``int``) and implement :meth:`_solve` (one backend).
 
     Parameters
     ----------
-    time_limit : float, optional
-        Seconds per replan when the caller gives no limit (a given ``time_limit`` overrides it);
-        ``default_time_limit`` if omitted.
+    deterministic : bool
+        When the caller gives no ``time_limit``: stop on ``work_limit`` only (True, default:
+        identical plans under any load) or on the wall-clock ``time_limit`` setting (False).
+    time_limit : float
+        Wall-clock seconds per replan in non-deterministic mode when the caller gives none.
+    work_limit : float or int
+        The backend's deterministic work limit (CP-SAT: deterministic seconds; HiGHS: nodes).
     seed : int
-        The backend's random seed (single worker / thread, so results are deterministic).
+        The backend's random seed (one worker / thread).
     **model_settings
-        Fields of :class:`MilpParams` (``slots``, ``fresh_s``, ``tau_s``, ``slot_delay_s``,
-        ``search_weight``, ``watch_weight``, ``fire_candidates``, ``search_candidates``,
-        ``watch_altitude``, ``search_altitude`` ...).
+        Fields of :class:`MilpParams`.
     """
 
     name = "milp-base"
-    default_time_limit = 0.2
+    default_work_limit: float = 1.0
+    work_limit_kind: type = float
+    #: share of the wall-clock limit kept back for decoding and validation
+    reserve_share = 0.05
 
     def __init__(
-        self, time_limit: float | None = None, seed: int = 0, **model_settings: Any
+        self,
+        deterministic: bool = True,
+        time_limit: float = 0.2,
+        work_limit: float | None = None,
+        seed: int = 0,
+        **model_settings: Any,
     ) -> None:
-        self.time_limit = float(self.default_time_limit if time_limit is None else time_limit)
+        if not isinstance(deterministic, bool | np.bool_):
+            raise ValueError(f"deterministic must be true or false, got {deterministic!r}")
+        check_setting("time_limit", time_limit, float, 1e-9)
+        work = self.default_work_limit if work_limit is None else work_limit
+        check_setting(
+            "work_limit", work, self.work_limit_kind, 1e-9 if self.work_limit_kind is float else 1
+        )
+        check_setting("seed", seed, int, 0, 2**31 - 1)
+        self.deterministic = bool(deterministic)
+        self.time_limit = float(time_limit)
+        self.work_limit = work
         self.seed = int(seed)
-        self.params = MilpParams(**model_settings)
+        try:
+            self.params = MilpParams(**model_settings)
+        except TypeError as exc:
+            raise ValueError(f"{self.name}: {exc}") from None
+        self._previous: dict[str, tuple[str, ...]] = {}
+        self._previous_time = -math.inf
 
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
-        """Build the model of ``graph``, solve it with the backend and decode the plan.
+        """Build the model of ``graph``, solve it and decode the plan.
+
+        A given ``time_limit`` (s) is a wall-clock limit for the whole call (model building
+        included, about 5 % kept back for decoding); without one the call stops on the work
+        limit only (``deterministic=True``) or on the ``time_limit`` setting.
 
         Raises
         ------
-        RuntimeError
-            If the backend returns no solution within the limit.
+        TimeoutError
+            If building the model used up the wall-clock limit.
+        IncompletePlanError
+            If a limit stopped the solver with no plan, or with agents left idle that a route
+            would have improved (the plan came from the limit, not from a decision).
         """
         t0 = time.perf_counter()
-        limit = self.time_limit if time_limit is None else float(time_limit)
+        if time_limit is not None:
+            check_setting("time_limit", time_limit, float, 0.0)
+        limit = (
+            time_limit
+            if time_limit is not None
+            else None
+            if self.deterministic
+            else self.time_limit
+        )
+        deadline = None if limit is None else t0 + float(limit) * (1.0 - self.reserve_share)
+        if graph.time_s <= self._previous_time:  # a new episode: forget the last plan
+            self._previous = {}
         model = build_milp_model(graph, self.params)
-        remaining = max(limit - (time.perf_counter() - t0), 1e-4)
-        x, stats = self._solve(model, time_limit=remaining, seed=self.seed)
-        return decode_plan(model, x, graph, stats)
+        limits = SolverLimits(deadline, self.work_limit)
+        left = limits.seconds_left()
+        if left is not None and left <= 0:
+            raise TimeoutError(
+                f"building the model took {time.perf_counter() - t0:.4f} s of {limit} s"
+            )
+        hint = initial_solution(model, graph, self._previous)
+        x, stats = self._solve(model, limits=limits, seed=self.seed, hint=hint)
+        if stats.status != "optimal":
+            idle = idle_agents(model, x)
+            if idle.size:
+                names = ", ".join(graph.agent_ids[a] for a in idle.tolist())
+                raise IncompletePlanError(
+                    f"the {stats.status} stop left agents {names} idle with routes to fly"
+                )
+        plan = decode_plan(model, x, graph, stats)
+        self._previous = dict(plan.routes)
+        self._previous_time = graph.time_s
+        return plan
 
     def _solve(
-        self, model: MilpModel, *, time_limit: float, seed: int
+        self, model: MilpModel, *, limits: SolverLimits, seed: int, hint: np.ndarray
     ) -> tuple[np.ndarray, SolveStats]:  # pragma: no cover
         raise NotImplementedError
