@@ -48,9 +48,12 @@ import numpy as np
 from ortools.sat.python import cp_model
 
 from fcplan.scheduling import SolveStats
-from solvers.milp_model import MilpModel, MilpSchedulerBase, SolverLimits
+from solvers.milp_model import IncompletePlanError, MilpModel, MilpSchedulerBase, SolverLimits
 
 __all__ = ["MilpScheduler", "solve_cpsat"]
+
+#: CP-SAT's lower end of an unbounded domain.
+_INT_MIN = -(2**62)
 
 
 class MilpScheduler(MilpSchedulerBase):
@@ -82,6 +85,35 @@ class MilpScheduler(MilpSchedulerBase):
         return solve_cpsat(model, limits=limits, seed=seed, hint=hint)
 
 
+def _cp_model(model: MilpModel, hint: np.ndarray | None) -> cp_model.CpModel:
+    """The CP-SAT model of ``model``, written straight into its proto (variables ``0..n-1``
+    with domains ``[0, ub]``, one linear row each, the floating-point objective, the hint)."""
+    md = cp_model.CpModel()
+    proto = md.proto
+    for u in model.ub.astype(np.int64).tolist():
+        proto.variables.add().domain.extend([0, u])
+    mat = model.A_ub.tocsr()
+    ind = mat.indices.tolist()
+    coef = np.rint(mat.data).astype(np.int64).tolist()
+    ptr = mat.indptr.tolist()
+    rhs = np.floor(model.b_ub + 1e-9).astype(np.int64).tolist()
+    for r, b in enumerate(rhs):
+        lin = proto.constraints.add().linear
+        lin.vars.extend(ind[ptr[r] : ptr[r + 1]])
+        lin.coeffs.extend(coef[ptr[r] : ptr[r + 1]])
+        lin.domain.extend([_INT_MIN, b])
+    nz = np.flatnonzero(model.c)
+    obj = proto.floating_point_objective
+    obj.vars.extend(nz.tolist())
+    obj.coeffs.extend(model.c[nz].tolist())
+    obj.maximize = True
+    if hint is not None:
+        on = np.flatnonzero(np.asarray(hint) > 0.5)
+        proto.solution_hint.vars.extend(on.tolist())
+        proto.solution_hint.values.extend(np.rint(hint[on]).astype(np.int64).tolist())
+    return md
+
+
 def solve_cpsat(
     model: MilpModel,
     *,
@@ -111,28 +143,13 @@ def solve_cpsat(
     IncompletePlanError
         If no solution was found within the limits.
     """
-    from solvers.milp_model import IncompletePlanError
-
     limits = limits or SolverLimits(None, 5.0)
     n = model.n_vars
     if n == 0:
         return np.zeros(0), SolveStats(
             status="optimal", objective=0.0, bound=0.0, gap=0.0, size=dict(model.size)
         )
-    md = cp_model.CpModel()
-    ub = model.ub.astype(np.int64).tolist()
-    x = [md.new_int_var(0, u, f"x{j}") for j, u in enumerate(ub)]
-    mat = model.A_ub.tocsr()
-    ind, ptr = mat.indices, mat.indptr
-    coef = np.rint(mat.data).astype(np.int64).tolist()
-    rhs = np.floor(model.b_ub + 1e-9).astype(np.int64).tolist()
-    for r in range(model.n_rows):
-        lo, hi = ptr[r], ptr[r + 1]
-        md.add(cp_model.LinearExpr.weighted_sum([x[j] for j in ind[lo:hi]], coef[lo:hi]) <= rhs[r])
-    md.maximize(cp_model.LinearExpr.weighted_sum(x, model.c.tolist()))
-    if hint is not None:
-        for j in np.flatnonzero(np.asarray(hint) > 0.5).tolist():
-            md.add_hint(x[j], int(round(float(hint[j]))))
+    md = _cp_model(model, hint)
     solver = cp_model.CpSolver()
     prm = solver.parameters
     prm.num_workers = 1
@@ -151,7 +168,7 @@ def solve_cpsat(
     status = solver.solve(md)
     if status not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
         raise IncompletePlanError(f"CP-SAT found no solution ({solver.status_name(status)})")
-    values = np.array([solver.value(v) for v in x], dtype=np.float64)
+    values = np.asarray(solver.response_proto.solution, dtype=np.float64)[:n]
     if not model.is_feasible(values):  # pragma: no cover - CP-SAT's solutions are feasible
         raise RuntimeError("CP-SAT returned an infeasible point")
     obj = model.objective(values)

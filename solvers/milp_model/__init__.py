@@ -26,25 +26,28 @@ agent's start and own speed, and is kept only if the whole flight, the way home 
 the agent's budget (:meth:`fcplan.taskgraph.TaskGraph.route_ok`). Agents on a forced return
 start from their depot slot once they get there; agents sent home may be given a route again.
 
-Variables: ``y_r`` (binary) chooses route ``r``; ``x_b`` (integer ``0..100``) is the detected
-share, in percent, of search block ``b``; ``u_c`` (binary) marks a connected fire ``c`` that is
+Variables: ``y_r`` (binary) chooses route ``r``; ``x_b`` (integer ``0..L``) is the detected
+share of search block ``b`` in steps of ``1 / L`` (``L = cover_levels``); ``u_c`` (binary) marks a connected fire ``c`` that is
 both dumped on and watched.
 
 Objective (maximise)::
 
-    sum_r D_r y_r  +  sum_b (V_b / 100) x_b  +  sum_c F_c u_c
+    sum_r D_r y_r  +  sum_b (V_b / L) x_b  +  sum_c F_c u_c
 
 * **dumps**: ``D_r = sum_{j: fire} q n_k w_k (H - t_j)+`` with ``q`` the prune confidence
   (``prune_confidence``), ``n_k`` the task's known (sensed, hence prunable) cells and
   ``w_k = 0.1 + theta sum_f PC_f (1 - tau_kf / H)+`` the penalty rate of one of its cells:
   ``tau_kf`` is the graph's estimated time for fire ``k`` to reach facility ``f``
   (``threat_time_s``, the ``threatens`` edges), ``theta`` is ``threat_weight``;
-* **search** (expected detection): block ``b`` of graph value ``g_b`` (its capped coverage age,
-  more near known fire) is taken to hide ``kappa g_b`` undiscovered burning cells
-  (``kappa = search_weight``), worth ``V_b = 0.1 kappa g_b H``. A route sweeping it at ``t``
-  finds them with probability ``s_rb`` = covered share x sensing probability at the route's
-  altitude (:mod:`~solvers.milp_model.sensing`) x ``(H - t)+ / H``; the best of the route's
-  legs counts;
+* **search** (expected detection): block ``b`` is taken to hide ``E_b`` undiscovered burning
+  cells, ``E_b = kappa 60 (A_b / 60) ** alpha (1 + min(n_b, 50) / 10)`` with ``A_b`` its
+  coverage age (``task_staleness``, capped at ``search_age_cap_s``) and ``n_b`` the known
+  cells in the 3 x 3 blocks around it (``kappa = search_weight``,
+  ``alpha = search_age_exponent``; :func:`~solvers.milp_model.objective.hidden_cells`); found
+  now they are worth ``V_b = 0.1 E_b H``. A route sweeping ``b`` ``t`` seconds from now finds
+  them with probability ``s_rb`` = covered share x sensing probability at the route's altitude
+  (:mod:`~solvers.milp_model.sensing`) x ``(H_s - t)+ / H_s``, the best of the route's legs
+  (``H_s = search_horizon_s``: the agent replans long before a far sweep would happen);
 * **growth stopped**: fronts move on into unsensed cells, and only sensed cells can be put out,
   so a connected fire stops growing only when it is watched (by a watch route or a dumping agent
   with a camera) *and* dumped on: ``F_c = 0.1 q gamma (H - t_c)+^2 / 2`` for ``gamma``
@@ -56,13 +59,14 @@ Constraints (all ``A_ub [y; x; u] <= b_ub``, integral)::
     sum_{r of agent a} y_r <= 1                      (agent: one route each)
     sum_{r dumps on k} y_r <= 1                      (dump_once: one dump per fire task)
     sum_{r watches c} y_r <= 1                       (watch_once: one watcher per fire)
-    x_b - sum_r round(100 s_rb) y_r <= 0,  x_b <= 100 (cover: a block is found once)
+    x_b - sum_r round(L s_rb) y_r <= 0,  x_b <= L     (cover: a block is found once)
     u_c - sum_{r dumps in c} y_r <= 0                (freeze_dump)
     u_c - sum_{r senses c} y_r <= 0                  (freeze_watch)
 
 Battery, tank, roles and the round-trip rule hold route by route, so they need no rows. The
 cover rows make overlapping sweeps count once (a share above 100 % is worth 100 %), which
-spreads the searchers without any spacing rule.
+spreads the searchers without any spacing rule. Shares are rounded to ``1 / L``: a sweep that
+finds less than half a step of a block does not count for it.
 
 Modules: :mod:`~solvers.milp_model.types` (settings and the model's arrays),
 :mod:`~solvers.milp_model.sensing` (field of view, detection, swept blocks),

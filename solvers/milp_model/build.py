@@ -51,13 +51,15 @@ class RouteSet:
 class _Context:
     """What every agent's routes need from the graph (computed once per model)."""
 
-    def __init__(self, graph: TaskGraph, p: MilpParams) -> None:
+    def __init__(
+        self, graph: TaskGraph, p: MilpParams, recent_fire: Sequence[tuple[np.ndarray, np.ndarray]]
+    ) -> None:
         self.graph, self.p = graph, p
         self.roles: AgentRoles = agent_roles(graph)
         self.weight = fire_weight(graph, p)
         self.fire = graph.task_kind == TaskKind.FIRE
         self.blocks = np.flatnonzero(~self.fire)
-        self.block_value = block_values(graph, p, self.blocks)
+        self.block_value = block_values(graph, p, self.blocks, recent_fire)
         self.width = max(p.slots, p.search_slots)
 
     def altitudes(self, agent: int) -> tuple[float, float]:
@@ -116,15 +118,17 @@ def _given_routes(
             continue
         first_fire = bool(ctx.fire[rows[0]])
         kind = DUMP if first_fire and roles.dumper[a] else WATCH if first_fire else SEARCH
-        pts = np.vstack([g.agent_start_pos[a], g.task_pos[rows]])
-        legs = np.hypot(*np.diff(pts, axis=0).T)
-        arrival = float(roles.t0[a]) + np.cumsum(legs) / max(float(g.agent_speed[a]), 1e-9)
-        px = float(legs.sum() + np.hypot(*(g.task_pos[rows[-1]] - g.agent_home[a])))
+        legs = np.r_[g.start_task_distance[a, rows[0]], g.task_distance[rows[:-1], rows[1:]]]
+        flown = np.cumsum(legs)
+        arrival = float(roles.t0[a]) + flown / max(float(g.agent_speed[a]), 1e-9)
+        px = float(flown[-1] + g.task_home_distance[a, rows[-1]])
         out.append((kind, rows[None, :], arrival[None, :], np.array([px])))
     return out
 
 
-def _valued(ctx: _Context, a: int, kind: int, tasks, arrival, length) -> RouteSet:
+def _valued(
+    ctx: _Context, a: int, kind: int, tasks: np.ndarray, arrival: np.ndarray, length: np.ndarray
+) -> RouteSet:
     """The routes of one agent and kind with their values, altitudes and covers."""
     g, p = ctx.graph, ctx.p
     n = len(tasks)
@@ -213,6 +217,7 @@ def build_milp_model(
     params: MilpParams | None = None,
     *,
     routes: Mapping[int, Sequence[Sequence[int]]] | None = None,
+    recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
 ) -> MilpModel:
     """Build the route model of ``graph`` (see :mod:`solvers.milp_model`).
 
@@ -222,6 +227,9 @@ def build_milp_model(
     params : MilpParams, optional
     routes : mapping of agent row -> sequence of routes (task rows), optional
         Use exactly these routes instead of enumerating them (to score other plans).
+    recent_fire : sequence of (positions (F, 2), cells (F,))
+        The fire tasks of recent graphs (:func:`solvers.milp_model.objective.hidden_cells`);
+        the schedulers pass those of the last ``recent_fire_s`` seconds.
 
     Raises
     ------
@@ -229,7 +237,7 @@ def build_milp_model(
         If the model would hold more than ``params.max_routes`` routes.
     """
     p = params or MilpParams()
-    ctx = _Context(graph, p)
+    ctx = _Context(graph, p, recent_fire)
     rs = _route_set(ctx, routes)
     if len(rs.agent) > p.max_routes:
         raise ValueError(f"{len(rs.agent)} routes exceed max_routes={p.max_routes}")

@@ -15,16 +15,27 @@ per active cell inside facility ``f`` per second), counted over the horizon ``H`
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from fcplan.taskgraph import TaskGraph
 from solvers.milp_model.sensing import segment_coverage
 from solvers.milp_model.types import MilpParams
 
-__all__ = ["block_values", "dump_value", "fire_weight", "route_cover", "straight_cover"]
+__all__ = [
+    "block_values",
+    "dump_value",
+    "fire_weight",
+    "hidden_cells",
+    "route_cover",
+    "straight_cover",
+]
 
 #: Penalty per active cell per second (the manual's propagation weight).
 CELL_RATE = 0.1
+#: Coverage age (s) at which a block's value is the same for every ``search_age_exponent``.
+AGE_UNIT_S = 60.0
 
 
 def fire_weight(graph: TaskGraph, p: MilpParams) -> np.ndarray:
@@ -53,9 +64,43 @@ def dump_value(
     return out
 
 
-def block_values(graph: TaskGraph, p: MilpParams, blocks: np.ndarray) -> np.ndarray:
-    """(B,) ``V_b`` of the search task rows ``blocks``."""
-    out: np.ndarray = CELL_RATE * p.search_weight * p.horizon_s * graph.task_value[blocks]
+def hidden_cells(
+    graph: TaskGraph,
+    p: MilpParams,
+    blocks: np.ndarray,
+    recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+) -> np.ndarray:
+    """(B,) undiscovered burning cells expected in the search task rows ``blocks``:
+    ``kappa A60 (A_b / A60) ** alpha (1 + min(n_b, 50) / 10)`` with ``A_b`` the block's
+    coverage age (its ``task_staleness``, capped at ``search_age_cap_s``), ``A60 = 60`` s and
+    ``n_b`` the most known burning cells in the 3 x 3 blocks around it, now or in any of the
+    ``recent_fire`` snapshots (``(positions (F, 2), cells (F,))`` of the fire tasks of recent
+    graphs): fire spreads from known fire, and fronts a dump did not freeze run on after the
+    fire they belong to is put out."""
+    age = np.minimum(graph.task_staleness[blocks], p.search_age_cap_s)
+    fires = graph.fire_tasks
+    near = np.zeros(blocks.size)
+    snapshots = [(graph.task_pos[fires], graph.task_cells[fires]), *recent_fire]
+    centres = graph.task_pos[blocks]
+    for pos, cells in snapshots:
+        if len(cells) and blocks.size:
+            gap = np.abs(centres[:, None, :] - np.asarray(pos)[None, :, :])
+            close = np.all(gap <= 1.5 * p.search_block_px, axis=2)
+            np.maximum(near, close.astype(np.float64) @ np.asarray(cells, np.float64), out=near)
+    scale = AGE_UNIT_S * (np.maximum(age, 0.0) / AGE_UNIT_S) ** p.search_age_exponent
+    out: np.ndarray = p.search_weight * scale * (1.0 + np.minimum(near, 50.0) / 10.0)
+    return out
+
+
+def block_values(
+    graph: TaskGraph,
+    p: MilpParams,
+    blocks: np.ndarray,
+    recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+) -> np.ndarray:
+    """(B,) ``V_b = 0.1 H E_b`` of the search task rows ``blocks``, with ``E_b`` their
+    :func:`hidden_cells`."""
+    out: np.ndarray = CELL_RATE * p.horizon_s * hidden_cells(graph, p, blocks, recent_fire)
     return out
 
 

@@ -100,12 +100,9 @@ def enumerate_routes(
     if m == 0 or length < 1:
         return np.zeros((0, length), np.int64), np.zeros((0, length)), np.zeros(0)
     order = _orders(m, length)  # (P, L) local indices
-    pos = graph.task_pos[cands]
-    start = graph.agent_start_pos[agent]
-    home = graph.agent_home[agent]
-    d_start = np.hypot(*(pos - start).T)
-    d_home = np.hypot(*(pos - home).T)
-    d_between = np.hypot(pos[:, None, 0] - pos[None, :, 0], pos[:, None, 1] - pos[None, :, 1])
+    d_start = graph.start_task_distance[agent, cands]
+    d_home = graph.task_home_distance[agent, cands]
+    d_between = graph.task_distance[np.ix_(cands, cands)]
     valid = order >= 0
     idx = np.where(valid, order, 0)
     leg = np.zeros(order.shape)

@@ -93,6 +93,7 @@ class MilpSchedulerBase:
             raise ValueError(f"{self.name}: {exc}") from None
         self._previous: dict[str, tuple[str, ...]] = {}
         self._previous_time = -math.inf
+        self._recent: list[tuple[float, np.ndarray, np.ndarray]] = []
 
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Build the model of ``graph``, solve it and decode the plan.
@@ -120,9 +121,11 @@ class MilpSchedulerBase:
             else self.time_limit
         )
         deadline = None if limit is None else t0 + float(limit) * (1.0 - self.reserve_share)
-        if graph.time_s <= self._previous_time:  # a new episode: forget the last plan
-            self._previous = {}
-        model = build_milp_model(graph, self.params)
+        if graph.time_s <= self._previous_time:  # a new episode: forget the last plans
+            self._previous, self._recent = {}, []
+        keep = graph.time_s - self.params.recent_fire_s
+        recent = [(pos, cells) for t, pos, cells in self._recent if t >= keep]
+        model = build_milp_model(graph, self.params, recent_fire=recent)
         limits = SolverLimits(deadline, self.work_limit)
         left = limits.seconds_left()
         if left is not None and left <= 0:
@@ -141,6 +144,10 @@ class MilpSchedulerBase:
         plan = decode_plan(model, x, graph, stats)
         self._previous = dict(plan.routes)
         self._previous_time = graph.time_s
+        fires = graph.fire_tasks
+        self._recent = [r for r in self._recent if r[0] >= keep]
+        if fires.size:
+            self._recent.append((graph.time_s, graph.task_pos[fires], graph.task_cells[fires]))
         return plan
 
     def _solve(

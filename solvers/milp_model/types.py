@@ -43,15 +43,21 @@ def check_setting(name: str, value: Any, kind: type, lo: float, hi: float = math
     ValueError: slots must be an integer in 1..4, got 0
     """
     is_int = isinstance(value, int | np.integer) and not isinstance(value, bool | np.bool_)
+    span = f"in {_num(lo)}..{_num(hi)}" if math.isfinite(hi) else f">= {_num(lo)}"
     if kind is int:
         ok = is_int and lo <= value <= hi
-        what = f"an integer in {lo:g}..{hi:g}"
+        what = f"an integer {span}"
     else:
         real = is_int or isinstance(value, float | np.floating)
         ok = real and math.isfinite(float(value)) and lo <= float(value) <= hi
-        what = f"a number in {lo:g}..{hi:g}" if math.isfinite(hi) else f"a number >= {lo:g}"
+        what = f"a number {span}"
     if not ok:
         raise ValueError(f"{name} must be {what}, got {value!r}")
+
+
+def _num(v: float) -> str:
+    """A bound as written: whole numbers without a decimal point, others in ``%g``."""
+    return str(int(v)) if float(v).is_integer() else f"{v:g}"
 
 
 @dataclass(frozen=True, slots=True)
@@ -82,7 +88,16 @@ class MilpParams:
         Cells per second a connected fire adds while fronts run on (>= 0): what a watched dump
         stops.
     search_weight : float
-        Undiscovered burning cells expected per unit of a search block's value (>= 0).
+        Undiscovered burning cells ``kappa`` expected in a search block per second of coverage
+        age at 60 s (>= 0; :func:`solvers.milp_model.objective.hidden_cells`).
+    search_age_exponent : float
+        How the undiscovered cells grow with the coverage age ``A``: ``(A / 60) ** alpha``
+        (0..4; 1: as the age, 2: fires both start and grow while nobody looks).
+    search_age_cap_s : float
+        Coverage ages beyond this count as this (s, > 0).
+    recent_fire_s : float
+        The schedulers remember the fire tasks of the graphs of the last this many seconds:
+        blocks near fire known then count as near fire (s, >= 0; 0: only the current graph).
     search_block_px : float
         Side of the square search blocks (px, > 0; the task graph's ``search_block_px``).
     cover_levels : int
@@ -107,6 +122,9 @@ class MilpParams:
     threat_weight: float = 1.0
     growth_cells_s: float = 2.0
     search_weight: float = 0.05
+    search_age_exponent: float = 1.0
+    search_age_cap_s: float = 300.0
+    recent_fire_s: float = 30.0
     search_block_px: float = 100.0
     cover_levels: int = 10
     watch_altitude: float = 35.0
@@ -124,6 +142,9 @@ class MilpParams:
         check_setting("threat_weight", self.threat_weight, float, 0.0)
         check_setting("growth_cells_s", self.growth_cells_s, float, 0.0)
         check_setting("search_weight", self.search_weight, float, 0.0)
+        check_setting("search_age_exponent", self.search_age_exponent, float, 0.0, 4.0)
+        check_setting("search_age_cap_s", self.search_age_cap_s, float, 1e-3)
+        check_setting("recent_fire_s", self.recent_fire_s, float, 0.0)
         check_setting("search_block_px", self.search_block_px, float, 1e-3)
         check_setting("cover_levels", self.cover_levels, int, 1, 1000)
         check_setting("watch_altitude", self.watch_altitude, float, 0.0)
@@ -143,7 +164,7 @@ class MilpModel:
     """``max c @ x  s.t.  A_ub @ x <= b_ub,  x integer in [0, ub]`` plus what each variable means.
 
     Variables come in three blocks, in this order: ``R`` route variables (binary), ``B`` cover
-    variables (integers ``0..100``, one per search block some route sweeps), ``Z`` freeze
+    variables (integers ``0..cover_levels``, one per search block some route sweeps), ``Z`` freeze
     variables (binary, one per connected fire with a dump and a watch candidate).
 
     Attributes
@@ -155,7 +176,7 @@ class MilpModel:
     b_ub : ndarray, (m,) float64
         Right-hand sides (integral).
     ub : ndarray, (n,) float64
-        Upper bounds (1, or 100 for cover variables); every lower bound is 0.
+        Upper bounds (1, or ``cover_levels`` for cover variables); every lower bound is 0.
     var_kind : ndarray, (n,) int8
         ``ROUTE``, ``COVER`` or ``FREEZE``.
     var_ref : ndarray, (n,) int64
