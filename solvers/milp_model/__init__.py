@@ -90,7 +90,7 @@ True
 >>> bool(m.is_feasible(x)) and bool(np.isclose(m.objective(x), obj))
 True
 >>> sorted(decode_plan(m, x, g).routes)
-['A2', 'A3', 'P1']
+['A3', 'P1', 'P2']
 """
 
 from solvers.milp_model.brute_force import brute_force_optimum

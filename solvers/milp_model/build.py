@@ -1,8 +1,20 @@
 """Building the route model of a task graph: routes per agent, their values, the cover and freeze
-variables, and the rows (see :mod:`solvers.milp_model`)."""
+variables, and the rows (see :mod:`solvers.milp_model`).
+
+Examples
+--------
+>>> import numpy as np
+>>> from fcplan.taskgraph import synthetic_task_graph
+>>> g = synthetic_task_graph(3, 6, np.random.default_rng(0))
+>>> m = build_milp_model(g)
+>>> m.n_routes == m.size["routes"], set(m.row_kind) <= {
+...     "agent", "dump_once", "watch_once", "cover", "freeze_dump", "freeze_watch"}
+(True, True)
+"""
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -157,9 +169,13 @@ def _valued(
     )
 
 
-def _route_set(ctx: _Context, given: Mapping[int, Sequence[Sequence[int]]] | None) -> RouteSet:
+def _route_set(
+    ctx: _Context, given: Mapping[int, Sequence[Sequence[int]]] | None, deadline: float | None
+) -> RouteSet:
     parts = []
     for a in range(ctx.graph.n_agents):
+        if deadline is not None and time.perf_counter() > deadline:
+            raise TimeoutError(f"the wall-clock limit passed while enumerating routes (agent {a})")
         raw = _agent_routes(ctx, a) if given is None else _given_routes(ctx, a, given.get(a, ()))
         parts += [_valued(ctx, a, kind, t, arr, px) for kind, t, arr, px in raw if len(t)]
     width = max([ctx.width] + [r.tasks.shape[1] for r in parts])
@@ -218,6 +234,7 @@ def build_milp_model(
     *,
     routes: Mapping[int, Sequence[Sequence[int]]] | None = None,
     recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+    deadline: float | None = None,
 ) -> MilpModel:
     """Build the route model of ``graph`` (see :mod:`solvers.milp_model`).
 
@@ -230,15 +247,19 @@ def build_milp_model(
     recent_fire : sequence of (positions (F, 2), cells (F,))
         The fire tasks of recent graphs (:func:`solvers.milp_model.objective.hidden_cells`);
         the schedulers pass those of the last ``recent_fire_s`` seconds.
+    deadline : float, optional
+        A :func:`time.perf_counter` time: past it, building stops with ``TimeoutError``.
 
     Raises
     ------
     ValueError
         If the model would hold more than ``params.max_routes`` routes.
+    TimeoutError
+        If ``deadline`` passed while the routes were being enumerated.
     """
     p = params or MilpParams()
     ctx = _Context(graph, p, recent_fire)
-    rs = _route_set(ctx, routes)
+    rs = _route_set(ctx, routes, deadline)
     if len(rs.agent) > p.max_routes:
         raise ValueError(f"{len(rs.agent)} routes exceed max_routes={p.max_routes}")
     swept = np.flatnonzero(rs.cover.any(axis=0))

@@ -1,6 +1,17 @@
 """The model's rows, all ``A_ub x <= b_ub`` with integral entries, by family (see
 :mod:`solvers.milp_model`): ``agent``, ``dump_once``, ``watch_once``, ``cover``, ``freeze_dump``
-and ``freeze_watch``."""
+and ``freeze_watch``.
+
+Examples
+--------
+>>> import numpy as np
+>>> agent = np.array([0, 0, 1]); tasks = np.array([[0], [1], [0]])
+>>> dump = np.ones((3, 1), bool); cl = np.zeros((3, 1), np.int64)
+>>> mat, b, fam = model_rows(agent, tasks, np.zeros((3, 0), np.int64), cl, dump,
+...                          np.zeros((3, 1), bool), np.zeros(0, np.int64))
+>>> fam, mat.toarray().tolist(), b.tolist()
+(('agent', 'dump_once'), [[1.0, 1.0, 0.0], [1.0, 0.0, 1.0]], [1.0, 1.0])
+"""
 
 from __future__ import annotations
 

@@ -11,6 +11,17 @@ per active cell inside facility ``f`` per second), counted over the horizon ``H`
   ``p`` (:mod:`solvers.milp_model.sensing`) and earns ``V_b p (H - t)+ / H``;
 * a connected fire ``c`` dumped on *and* watched stops growing: ``0.1 q gamma (H - t_c)+^2 / 2``
   with ``t_c`` the earliest arrival of an agent with water at one of its tasks.
+
+Examples
+--------
+>>> import numpy as np
+>>> from fcplan.taskgraph import synthetic_task_graph
+>>> from solvers.milp_model import MilpParams
+>>> g = synthetic_task_graph(2, 2, np.random.default_rng(0), fire_share=1.0)
+>>> p = MilpParams(horizon_s=30.0, threat_weight=0.0)
+>>> k = np.array([0]); v = dump_value(g, p, fire_weight(g, p), k, np.array([10.0]))
+>>> bool(np.isclose(v[0], 0.9 * g.task_cells[0] * 0.1 * (30.0 - 10.0)))
+True
 """
 
 from __future__ import annotations

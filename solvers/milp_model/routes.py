@@ -13,6 +13,16 @@ and a route is kept only if the whole flight fits the budget,
 ``|s_a k_1| + sum_j |k_j k_{j+1}| + |k_n h_a| <= b_a``, which is
 :meth:`~fcplan.taskgraph.TaskGraph.route_ok` (so every kept route is also
 :attr:`~fcplan.taskgraph.TaskGraph.reachable` at its first task by the triangle inequality).
+
+Examples
+--------
+>>> import numpy as np
+>>> from fcplan.taskgraph import synthetic_task_graph
+>>> g = synthetic_task_graph(3, 6, np.random.default_rng(0))
+>>> cands = np.flatnonzero(agent_roles(g).ok1[2])[:3]
+>>> tasks, arrival, px = enumerate_routes(g, 2, cands, 2, 0.0)
+>>> len(tasks) <= 3 + 3 * 2, all(g.route_ok(2, t[t >= 0].tolist()) for t in tasks)
+(True, True)
 """
 
 from __future__ import annotations

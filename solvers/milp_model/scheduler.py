@@ -1,5 +1,18 @@
 """What both MILP schedulers share: settings, the two limit modes, the warm start, and the check
-that a plan cut short by a limit does not leave agents idle."""
+that a plan cut short by a limit does not leave agents idle.
+
+A scheduler keeps two things between the replans of an episode (forgotten when a graph comes
+from an earlier time than the last one): its last plan, the warm start of the next solve, and
+the fire tasks of the last ``recent_fire_s`` seconds, which value the search blocks near fire
+that has just been put out.
+
+Examples
+--------
+>>> import time
+>>> limits = SolverLimits(deadline=time.perf_counter() + 1.0, work=5.0)
+>>> 0.0 < limits.seconds_left() <= 1.0, SolverLimits(None, 5.0).seconds_left()
+(True, None)
+"""
 
 from __future__ import annotations
 
@@ -105,7 +118,7 @@ class MilpSchedulerBase:
         Raises
         ------
         TimeoutError
-            If building the model used up the wall-clock limit.
+            If building the model used up the wall-clock limit (checked between agents).
         IncompletePlanError
             If a limit stopped the solver with no plan, or with agents left idle that a route
             would have improved (the plan came from the limit, not from a decision).
@@ -125,14 +138,14 @@ class MilpSchedulerBase:
             self._previous, self._recent = {}, []
         keep = graph.time_s - self.params.recent_fire_s
         recent = [(pos, cells) for t, pos, cells in self._recent if t >= keep]
-        model = build_milp_model(graph, self.params, recent_fire=recent)
+        model = build_milp_model(graph, self.params, recent_fire=recent, deadline=deadline)
         limits = SolverLimits(deadline, self.work_limit)
         left = limits.seconds_left()
         if left is not None and left <= 0:
             raise TimeoutError(
                 f"building the model took {time.perf_counter() - t0:.4f} s of {limit} s"
             )
-        hint = initial_solution(model, graph, self._previous)
+        hint = initial_solution(model, graph, self._previous, deadline=deadline)
         x, stats = self._solve(model, limits=limits, seed=self.seed, hint=hint)
         if stats.status != "optimal":
             idle = idle_agents(model, x)

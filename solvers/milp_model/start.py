@@ -1,8 +1,27 @@
 """Warm start and completeness: the gain of adding one route to a solution, a greedy first
-solution seeded with the previous plan, and the agents a solution leaves idle with work to do."""
+solution seeded with the previous plan, and the agents a solution leaves idle with work to do.
+
+The gain of a route is the objective with it minus without it, cover and freeze variables at
+their best in both (:meth:`~solvers.milp_model.MilpModel.best_auxiliaries`); a route of an
+agent that has one already, or one that breaks a row, gains ``-inf``.
+
+Examples
+--------
+>>> import numpy as np
+>>> from fcplan.taskgraph import synthetic_task_graph
+>>> g = synthetic_task_graph(3, 6, np.random.default_rng(0))
+>>> from solvers.milp_model import build_milp_model
+>>> m = build_milp_model(g)
+>>> x = initial_solution(m, g, previous={})
+>>> bool(m.is_feasible(x)), idle_agents(m, x).tolist()
+(True, [])
+>>> idle_agents(m, np.zeros(m.n_vars)).tolist()  # nobody flies: everyone is idle
+[0, 1, 2]
+"""
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping
 
 import numpy as np
@@ -66,12 +85,16 @@ def _best_aux(
 
 
 def initial_solution(
-    model: MilpModel, graph: TaskGraph, previous: Mapping[str, tuple[str, ...]]
+    model: MilpModel,
+    graph: TaskGraph,
+    previous: Mapping[str, tuple[str, ...]],
+    deadline: float | None = None,
 ) -> np.ndarray:
     """A complete first solution: each agent's route of the previous plan (or what is left of it
     after its first task) where the model still has it and it gains, then one route at a time
-    the route of largest gain until none gains. Returns the whole vector (auxiliaries at their
-    best)."""
+    the route of largest gain until none gains (or the :func:`time.perf_counter` ``deadline``
+    passes: the solver completes a partial start). Returns the whole vector (auxiliaries at
+    their best)."""
     n_r = model.n_routes
     y = np.zeros(n_r)
     if n_r == 0:
@@ -92,6 +115,8 @@ def initial_solution(
                 y[hit[0]] = 1.0
                 break
     for _ in range(graph.n_agents):
+        if deadline is not None and time.perf_counter() > deadline:
+            break
         g = route_gains(model, y)
         r = int(np.argmax(g))
         if not g[r] > 1e-12:
