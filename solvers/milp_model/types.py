@@ -122,7 +122,7 @@ class MilpParams:
     threat_weight: float = 1.0
     growth_cells_s: float = 2.0
     search_weight: float = 0.05
-    search_age_exponent: float = 1.0
+    search_age_exponent: float = 2.0
     search_age_cap_s: float = 300.0
     recent_fire_s: float = 30.0
     search_block_px: float = 100.0
