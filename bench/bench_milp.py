@@ -28,15 +28,8 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 import fcplan
+from fcplan.experiments.ranges import parse_range
 from fcplan.scheduling import make_scheduler
-
-
-def _ints(text: str) -> list[int]:
-    out: list[int] = []
-    for part in text.split(","):
-        lo, _, hi = part.partition("-")
-        out.extend(range(int(lo), int(hi or lo) + 1))
-    return out
 
 
 class _Timed:
@@ -114,9 +107,11 @@ def main() -> None:
     ap.add_argument("--limits", nargs="*", type=float, default=[0.02, 0.05, 0.2])
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args()
-    scenarios, seeds = _ints(args.scenarios), _ints(args.seeds)
+    scenarios, seeds = parse_range(args.scenarios), parse_range(args.seeds, names=False)
     jobs = [("milp", sc, sd, None) for sc in scenarios for sd in seeds]
-    jobs += [("milp-cvxpy", sc, sd, None) for sc in _ints(args.cvxpy_scenarios) for sd in seeds]
+    jobs += [
+        ("milp-cvxpy", sc, sd, None) for sc in parse_range(args.cvxpy_scenarios) for sd in seeds
+    ]
     jobs += [("milp", sc, sd, lim) for lim in args.limits for sc in scenarios for sd in seeds]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.jobs) as ex:

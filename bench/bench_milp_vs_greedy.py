@@ -31,15 +31,8 @@ import numpy as np
 from scipy import stats
 
 import fcplan
+from fcplan.experiments.ranges import parse_range
 from fcplan.scheduling import make_scheduler
-
-
-def _ints(text: str) -> list[int]:
-    out: list[int] = []
-    for part in text.split(","):
-        lo, _, hi = part.partition("-")
-        out.extend(range(int(lo), int(hi or lo) + 1))
-    return out
 
 
 def _episode(job: tuple[str, int, int]) -> dict:
@@ -86,7 +79,7 @@ def main() -> None:
     ap.add_argument("--cache", type=Path, default=None)
     ap.add_argument("--per-scenario", action="store_true", help="print the per-scenario table")
     args = ap.parse_args()
-    scenarios, seeds = _ints(args.scenarios), _ints(args.seeds)
+    scenarios, seeds = parse_range(args.scenarios), parse_range(args.seeds, names=False)
     t0 = time.perf_counter()
     done = run([args.a, args.b], scenarios, seeds, args.jobs, args.cache)
     wall = time.perf_counter() - t0

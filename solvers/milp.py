@@ -25,8 +25,9 @@ Limits and determinism
   improve, :meth:`plan` raises :class:`solvers.milp_model.IncompletePlanError`, so
   :func:`fcplan.scheduling.solve` falls back to greedy for that replan (``status="fallback"``).
 
-CP-SAT needs integral rows, which the model has; the real objective coefficients are scaled by
-CP-SAT itself (its reported bound can be loose by its working precision, about 1e-5 relative).
+CP-SAT needs integral rows, which the model has, and gets the objective as integers: the
+model's coefficients are whole multiples of ``1 / OBJECTIVE_SCALE`` (1e-4 penalty units), so
+CP-SAT, HiGHS and the brute force optimise the very same objective exactly.
 
 Examples
 --------
@@ -49,6 +50,7 @@ from ortools.sat.python import cp_model
 
 from fcplan.scheduling import SolveStats
 from solvers.milp_model import IncompletePlanError, MilpModel, MilpSchedulerBase, SolverLimits
+from solvers.milp_model.types import OBJECTIVE_SCALE
 
 __all__ = ["MilpScheduler", "solve_cpsat"]
 
@@ -87,7 +89,7 @@ class MilpScheduler(MilpSchedulerBase):
 
 def _cp_model(model: MilpModel, hint: np.ndarray | None) -> cp_model.CpModel:
     """The CP-SAT model of ``model``, written straight into its proto (variables ``0..n-1``
-    with domains ``[0, ub]``, one linear row each, the floating-point objective, the hint)."""
+    with domains ``[0, ub]``, one linear row each, the integral objective, the hint)."""
     md = cp_model.CpModel()
     proto = md.proto
     for u in model.ub.astype(np.int64).tolist():
@@ -102,11 +104,12 @@ def _cp_model(model: MilpModel, hint: np.ndarray | None) -> cp_model.CpModel:
         lin.vars.extend(ind[ptr[r] : ptr[r + 1]])
         lin.coeffs.extend(coef[ptr[r] : ptr[r + 1]])
         lin.domain.extend([_INT_MIN, b])
+    # the integral objective: minimise -(scale c) x, reported as -(that) / scale
     nz = np.flatnonzero(model.c)
-    obj = proto.floating_point_objective
+    obj = proto.objective
     obj.vars.extend(nz.tolist())
-    obj.coeffs.extend(model.c[nz].tolist())
-    obj.maximize = True
+    obj.coeffs.extend((-np.rint(model.c[nz] * OBJECTIVE_SCALE)).astype(np.int64).tolist())
+    obj.scaling_factor = -1.0 / OBJECTIVE_SCALE
     if hint is not None:
         on = np.flatnonzero(np.asarray(hint) > 0.5)
         proto.solution_hint.vars.extend(on.tolist())

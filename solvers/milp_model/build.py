@@ -36,6 +36,7 @@ from solvers.milp_model.types import (
     COVER,
     DUMP,
     FREEZE,
+    OBJECTIVE_SCALE,
     ROUTE,
     SEARCH,
     WATCH,
@@ -268,6 +269,7 @@ def build_milp_model(
     n_r, n_b, n_z = len(rs.agent), swept.size, labels.size
     mat, b, families = model_rows(rs.agent, rs.tasks, rs.cover[:, swept], cl, dump, sees, labels)
     c = np.concatenate([rs.value, ctx.block_value[swept] / p.cover_levels, freeze_coef])
+    c = np.round(c * OBJECTIVE_SCALE) / OBJECTIVE_SCALE  # exact for every backend
     size = {
         "variables": int(c.size),
         "routes": int(n_r),

@@ -13,6 +13,7 @@ __all__ = [
     "COVER",
     "FREEZE",
     "KIND_NAMES",
+    "OBJECTIVE_SCALE",
     "ROUTE",
     "DUMP",
     "SEARCH",
@@ -28,6 +29,9 @@ ROUTE, COVER, FREEZE = 0, 1, 2
 KIND_NAMES = ("route", "cover", "freeze")
 #: Route kinds (:attr:`MilpModel.route_kind`): fire dumps, a watch (hover over a fire), search.
 DUMP, WATCH, SEARCH = 0, 1, 2
+#: Objective coefficients are whole multiples of ``1 / OBJECTIVE_SCALE`` penalty units, so every
+#: backend (and the brute force) optimises the very same integral objective, exactly.
+OBJECTIVE_SCALE = 1e4
 
 
 def check_setting(name: str, value: Any, kind: type, lo: float, hi: float = math.inf) -> None:
@@ -170,7 +174,7 @@ class MilpModel:
     Attributes
     ----------
     c : ndarray, (n,) float64
-        Objective coefficients (maximised).
+        Objective coefficients (maximised), whole multiples of ``1 / OBJECTIVE_SCALE``.
     A_ub : scipy.sparse.csr_array, (m, n) float64
         Constraint matrix; every entry is integral.
     b_ub : ndarray, (m,) float64
