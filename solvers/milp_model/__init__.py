@@ -59,6 +59,7 @@ Constraints (all ``A_ub [y; x; u] <= b_ub``, integral)::
     sum_{r of agent a} y_r <= 1                      (agent: one route each)
     sum_{r dumps on k} y_r <= 1                      (dump_once: one dump per fire task)
     sum_{r watches c} y_r <= 1                       (watch_once: one watcher per fire)
+    sum_{r searches b first} y_r <= 1                (search_once: one searcher heads for b)
     x_b - sum_r round(L s_rb) y_r <= 0,  x_b <= L     (cover: a block is found once)
     u_c - sum_{r dumps in c} y_r <= 0                (freeze_dump)
     u_c - sum_{r senses c} y_r <= 0                  (freeze_watch)

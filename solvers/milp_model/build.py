@@ -8,7 +8,8 @@ Examples
 >>> g = synthetic_task_graph(3, 6, np.random.default_rng(0))
 >>> m = build_milp_model(g)
 >>> m.n_routes == m.size["routes"], set(m.row_kind) <= {
-...     "agent", "dump_once", "watch_once", "cover", "freeze_dump", "freeze_watch"}
+...     "agent", "dump_once", "watch_once", "search_once", "cover", "freeze_dump",
+...     "freeze_watch"}
 (True, True)
 """
 
@@ -112,8 +113,12 @@ def _agent_routes(ctx: _Context, a: int) -> list[tuple[int, np.ndarray, np.ndarr
         score_b = straight_cover(g, a, ends, ctx.blocks, z, t0, p) @ ctx.block_value
         score = np.zeros(g.n_tasks)
         score[ctx.blocks] = score_b
-        cands = top_candidates(score, roles.ok1[a] & ~ctx.fire, p.search_candidates)
-        out.append((SEARCH, *enumerate_routes(g, a, cands, p.search_slots, t0)))
+        ok = roles.ok1[a] & ~ctx.fire
+        near = top_candidates(score, ok & (direct <= t0 + p.search_reach_s), p.search_candidates)
+        far = top_candidates(score, ok, p.search_candidates)
+        cands = np.r_[near, far[~np.isin(far, near)]]
+        first = np.arange(cands.size) < near.size
+        out.append((SEARCH, *enumerate_routes(g, a, cands, p.search_slots, t0, first)))
     return out
 
 
@@ -267,7 +272,9 @@ def build_milp_model(
     cl, dump, sees = _fire_visits(ctx, rs)
     labels, freeze_coef = _freeze(ctx, rs, cl, dump, sees)
     n_r, n_b, n_z = len(rs.agent), swept.size, labels.size
-    mat, b, families = model_rows(rs.agent, rs.tasks, rs.cover[:, swept], cl, dump, sees, labels)
+    mat, b, families = model_rows(
+        rs.agent, rs.tasks, rs.cover[:, swept], cl, dump, sees, labels, rs.kind == SEARCH
+    )
     c = np.concatenate([rs.value, ctx.block_value[swept] / p.cover_levels, freeze_coef])
     c = np.round(c * OBJECTIVE_SCALE) / OBJECTIVE_SCALE  # exact for every backend
     size = {

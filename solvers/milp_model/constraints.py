@@ -1,6 +1,6 @@
 """The model's rows, all ``A_ub x <= b_ub`` with integral entries, by family (see
-:mod:`solvers.milp_model`): ``agent``, ``dump_once``, ``watch_once``, ``cover``, ``freeze_dump``
-and ``freeze_watch``.
+:mod:`solvers.milp_model`): ``agent``, ``dump_once``, ``watch_once``, ``search_once``, ``cover``,
+``freeze_dump`` and ``freeze_watch``.
 
 Examples
 --------
@@ -8,7 +8,7 @@ Examples
 >>> agent = np.array([0, 0, 1]); tasks = np.array([[0], [1], [0]])
 >>> dump = np.ones((3, 1), bool); cl = np.zeros((3, 1), np.int64)
 >>> mat, b, fam = model_rows(agent, tasks, np.zeros((3, 0), np.int64), cl, dump,
-...                          np.zeros((3, 1), bool), np.zeros(0, np.int64))
+...                          np.zeros((3, 1), bool), np.zeros(0, np.int64), np.zeros(3, bool))
 >>> fam, mat.toarray().tolist(), b.tolist()
 (('agent', 'dump_once'), [[1.0, 1.0, 0.0], [1.0, 0.0, 1.0]], [1.0, 1.0])
 """
@@ -77,6 +77,7 @@ def model_rows(
     dump: np.ndarray,
     sees: np.ndarray,
     labels: np.ndarray,
+    search: np.ndarray,
 ) -> tuple[sp.csr_array, np.ndarray, tuple[str, ...]]:
     """The constraint matrix, right-hand sides and row families.
 
@@ -92,6 +93,8 @@ def model_rows(
         Connected fire of each route entry, and whether the entry dumps on it / senses it.
     labels : ndarray, (Z,)
         Connected fire of each freeze variable.
+    search : ndarray, (R,) bool
+        Search routes.
     """
     n_r, n_b, n_z = agent.size, cover.shape[1], labels.size
     rows = _Rows()
@@ -105,6 +108,9 @@ def model_rows(
     watch_only = sees & ~dump
     rr, jj = np.nonzero(watch_only)
     rows.add(cluster[rr, jj], rr, np.ones(rr.size), 1, "watch_once", min_terms=2)
+    # each search block the first task of at most one search route
+    lead = np.flatnonzero(search)
+    rows.add(tasks[lead, 0], lead, np.ones(lead.size), 1, "search_once", min_terms=2)
     # cover[b] <= sum_r share[r, b] y_r
     rb, bb = np.nonzero(cover)
     rows.add(

@@ -92,10 +92,16 @@ def _orders(m: int, length: int) -> np.ndarray:
 
 
 def enumerate_routes(
-    graph: TaskGraph, agent: int, cands: np.ndarray, length: int, t0: float
+    graph: TaskGraph,
+    agent: int,
+    cands: np.ndarray,
+    length: int,
+    t0: float,
+    first: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every route of ``agent`` over the candidate task rows ``cands`` with at most ``length``
-    tasks that fits its budget (module docstring).
+    tasks that fits its budget (module docstring); with ``first`` (bool, one per candidate),
+    only routes that start at a candidate marked True.
 
     Returns
     -------
@@ -110,6 +116,8 @@ def enumerate_routes(
     if m == 0 or length < 1:
         return np.zeros((0, length), np.int64), np.zeros((0, length)), np.zeros(0)
     order = _orders(m, length)  # (P, L) local indices
+    if first is not None:
+        order = order[np.asarray(first, dtype=bool)[order[:, 0]]]
     d_start = graph.start_task_distance[agent, cands]
     d_home = graph.task_home_distance[agent, cands]
     d_between = graph.task_distance[np.ix_(cands, cands)]

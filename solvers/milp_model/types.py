@@ -80,6 +80,10 @@ class MilpParams:
     search_horizon_s : float
         Look-ahead ``H_s`` (s) of a sweep: a block passed ``t`` seconds from now counts with
         weight ``(H_s - t)+ / H_s`` (the agent replans long before a far sweep happens).
+    search_reach_s : float
+        A search route starts at a block the agent reaches within this many seconds (>= 0):
+        the first leg is the step taken before the next replan, the later legs the look-ahead
+        (any of the best ``search_candidates`` blocks).
     fire_candidates, search_candidates, watch_candidates : int
         Per agent, the fire tasks it may dump on, the search blocks and the fire tasks it may
         watch, best single-task value first (1..64 each).
@@ -119,6 +123,7 @@ class MilpParams:
     search_slots: int = 2
     horizon_s: float = 30.0
     search_horizon_s: float = 5.0
+    search_reach_s: float = 0.75
     fire_candidates: int = 6
     search_candidates: int = 10
     watch_candidates: int = 3
@@ -140,6 +145,7 @@ class MilpParams:
         check_setting("search_slots", self.search_slots, int, 1, 4)
         check_setting("horizon_s", self.horizon_s, float, 1e-3)
         check_setting("search_horizon_s", self.search_horizon_s, float, 1e-3)
+        check_setting("search_reach_s", self.search_reach_s, float, 0.0)
         for name in ("fire_candidates", "search_candidates", "watch_candidates"):
             check_setting(name, getattr(self, name), int, 1, 64)
         check_setting("prune_confidence", self.prune_confidence, float, 0.0, 1.0)
@@ -200,8 +206,8 @@ class MilpModel:
     altitude : ndarray, (R,) float64
         Altitude to fly the route at (NaN: agents without a camera).
     row_kind : tuple of str
-        Constraint family of each row (``agent``, ``dump_once``, ``watch_once``, ``cover``,
-        ``freeze_dump``, ``freeze_watch``).
+        Constraint family of each row (``agent``, ``dump_once``, ``watch_once``,
+        ``search_once``, ``cover``, ``freeze_dump``, ``freeze_watch``).
     agent_ids, task_ids : tuple of str
         Of the graph the model was built for.
     params : MilpParams
