@@ -114,7 +114,8 @@ def plan_objective(
 def in_route_space(graph: TaskGraph, params: MilpParams, agent: int, route: list[int]) -> bool:
     """Whether the model could enumerate ``route`` (task rows) for ``agent`` (every task a
     candidate): one kind of task, suited to the role, at most ``slots`` dumps within the tank,
-    one watched fire, or at most ``search_slots`` blocks, distinct, and flyable (``route_ok``)."""
+    one watched fire, or at most ``search_slots`` blocks starting within ``search_reach_s``,
+    distinct, and flyable (``route_ok``)."""
     roles = agent_roles(graph)
     fire = graph.task_kind[route] == TaskKind.FIRE
     if not route or len(set(route)) != len(route) or 0 < fire.sum() < len(route):
@@ -122,7 +123,8 @@ def in_route_space(graph: TaskGraph, params: MilpParams, agent: int, route: list
     if not roles.ok1[agent, route].all() or not graph.route_ok(agent, route):
         return False
     if not fire[0]:
-        return len(route) <= params.search_slots
+        reach = graph.start_task_distance[agent, route[0]] / graph.agent_speed[agent]
+        return len(route) <= params.search_slots and reach <= params.search_reach_s
     if roles.dumper[agent]:
         return len(route) <= min(params.slots, int(roles.tank[agent]))
     return len(route) == 1

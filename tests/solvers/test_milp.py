@@ -62,6 +62,7 @@ def check_plan(g: TaskGraph, plan: Plan, params: MilpParams | None = None) -> No
     roles = agent_roles(g)
     dumped: set[str] = set()
     watched: set[int] = set()
+    heading: set[str] = set()
     for a, route in plan.routes.items():
         i = g.agent_index[a]
         assert 0 < len(route) <= max(p.slots, p.search_slots)
@@ -70,6 +71,10 @@ def check_plan(g: TaskGraph, plan: Plan, params: MilpParams | None = None) -> No
         assert len(kinds) == 1, f"{a} mixes fires and search blocks"
         if kinds == {TaskKind.SEARCH}:
             assert g.agent_can_sense[i] and len(route) <= p.search_slots
+            assert route[0] not in heading, f"two searchers head for {route[0]}"
+            heading.add(route[0])
+            t_first = g.start_task_distance[i, g.task_index[route[0]]] / g.agent_speed[i]
+            assert t_first <= agent_roles(g).t0[i] + p.search_reach_s + 1e-9
         elif roles.dumper[i]:
             assert len(route) <= min(p.slots, roles.tank[i])
             assert not dumped & set(route), f"{a} dumps where another agent dumps"
