@@ -19,8 +19,10 @@ Usage::
 
 Examples
 --------
->>> _cells("motion #1   4   1800   13426 (14181)   74.5")
+>>> _cells("motion #1   4   1800   13426 ( 14181)   74.5")
 ('motion #1', [4.0, 1800.0, 13426.0, 14181.0, 74.5])
+>>> _cells("   24   random     1187    1637")
+('24 random', [1187.0, 1637.0])
 """
 
 from __future__ import annotations
@@ -39,8 +41,10 @@ _NUM = re.compile(r"^\(?[-+]?\d[\d,]*\.?\d*(e[-+]?\d+)?\)?%?x?$", re.IGNORECASE)
 
 def _cells(line: str) -> tuple[str, list[float]]:
     """Split a line into its label (the words before the first number) and its numbers."""
-    words = line.split()
+    words = line.replace("( ", "(").split()
     label: list[str] = []
+    if len(words) > 1 and _NUM.match(words[0]) and not _NUM.match(words[1]):
+        label, words = words[:2], words[2:]  # a row keyed by a number and a word: "1 random"
     values: list[float] = []
     for w in words:
         if _NUM.match(w) and (values or not w.startswith("#")):

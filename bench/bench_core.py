@@ -10,31 +10,26 @@ Prints median microseconds per tick:
   fronts (the way the 2020 reference structures its loop, without its history-intensity cost);
 * the per-tick path the environments need (issue 4): ``World.step`` + ``Belief.update`` in us per
   tick with an idle team and with the team following greedy plans (replanned every second; the
-  scheduler's time is excluded), and ``build_task_graph`` in us per replan, on #1 and #24. With
-  ``--baseline REF`` the same loop also runs the core modules (world, team, fire, belief,
-  taskgraph) of git revision ``REF``, imported side by side in the same process, and prints the
-  speed-ups.
+  scheduler's time is excluded), and a task graph build (one per-episode
+  :class:`fcplan.taskgraph.TaskGraphBuilder`) in us per replan, on #1 and #24.
+
+Old against new: run this script on two source trees, interleaved, with ``bench/ab.py``, e.g.
+``python bench/ab.py ../fcplan-old . bench/bench_core.py --quick --rounds 5``.
 
 Usage::
 
     python bench/bench_core.py            # full run (about a minute)
     python bench/bench_core.py --quick    # fewer ticks and repeats
-    python bench/bench_core.py --only-tick --baseline 57bc5c6   # per-tick path, old vs new
+    python bench/bench_core.py --only-tick   # only the per-tick path
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
 import math
 import platform
-import re
 import statistics
-import subprocess
-import sys
-import tempfile
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -151,37 +146,6 @@ def scaling(ticks: int) -> None:
     print()
 
 
-CORE_MODULES = ("world", "team", "fire", "belief", "taskgraph")
-
-
-def load_baseline(ref: str):
-    """The core modules of git revision ``ref``, importable as package ``fcplan_baseline``.
-
-    Returns the (World, Belief, build_task_graph) of that revision; every other module (scenario,
-    plan, schedulers, trace) is the current one.
-    """
-    root = Path(__file__).resolve().parents[1]
-    tmp = Path(tempfile.mkdtemp(prefix="fcplan_baseline_"))
-    pkg = tmp / "fcplan_baseline"
-    pkg.mkdir()
-    (pkg / "__init__.py").write_text("")
-    pattern = re.compile(r"\bfcplan\.(" + "|".join(CORE_MODULES) + r")\b")
-    for mod in CORE_MODULES:
-        src = subprocess.run(
-            ["git", "show", f"{ref}:fcplan/{mod}.py"],
-            cwd=root,
-            check=True,
-            capture_output=True,
-            text=True,
-        ).stdout
-        (pkg / f"{mod}.py").write_text(pattern.sub(r"fcplan_baseline.\1", src))
-    sys.path.insert(0, str(tmp))
-    world = importlib.import_module("fcplan_baseline.world")
-    belief = importlib.import_module("fcplan_baseline.belief")
-    taskgraph = importlib.import_module("fcplan_baseline.taskgraph")
-    return world.World, belief.Belief, taskgraph.build_task_graph
-
-
 def tick_loop(impl, scenario, greedy: bool, seed: int = 0) -> tuple[float, float]:
     """One episode; return (us per World.step + Belief.update, us per build_task_graph).
 
@@ -190,9 +154,10 @@ def tick_loop(impl, scenario, greedy: bool, seed: int = 0) -> tuple[float, float
     from fcplan.plan import plan_commands
     from fcplan.scheduling import make_scheduler, solve
 
-    world_cls, belief_cls, build = impl
+    world_cls, belief_cls, builder_cls = impl
     world = world_cls().reset(scenario, seed)
     belief = belief_cls(scenario)
+    build = builder_cls(scenario).build
     scheduler = make_scheduler("greedy")
     commands = None
     t_step = t_graph = 0.0
@@ -207,7 +172,7 @@ def tick_loop(impl, scenario, greedy: bool, seed: int = 0) -> tuple[float, float
         n += 1
         if n % 10 == 0:
             t0 = clock()
-            graph = build(scenario, world.team, belief)
+            graph = build(world.team, belief)
             t_graph += clock() - t0
             graphs += 1
             if greedy:
@@ -216,21 +181,19 @@ def tick_loop(impl, scenario, greedy: bool, seed: int = 0) -> tuple[float, float
     return t_step / n * 1e6, t_graph / max(graphs, 1) * 1e6
 
 
-def bench_tick(repeats: int, baseline: str | None) -> None:
-    """Per-tick path of the environments, optionally against a baseline revision."""
+def bench_tick(repeats: int) -> None:
+    """Per-tick path of the environments."""
     import scipy.ndimage  # noqa: F401  (imported lazily on the first fire cluster: not per call)
 
     from fcplan.belief import Belief
-    from fcplan.taskgraph import build_task_graph
+    from fcplan.taskgraph import TaskGraphBuilder
     from fcplan.world import World
 
-    impls = {"current": (World, Belief, build_task_graph)}
-    if baseline:
-        impls[baseline] = load_baseline(baseline)
+    impls = {"current": (World, Belief, TaskGraphBuilder)}
     print("## Per-tick path (issue 4): World.step + Belief.update, build_task_graph")
     print(f"(best of {repeats} episodes of 1,800 ticks, implementations interleaved)")
     head = f"{'scenario':<9} {'team':<7} {'impl':<10} {'us/tick':>8} {'graph us':>9}"
-    print(head + ("   tick x   graph x" if baseline else ""))
+    print(head)
     for name in ("1", "24"):
         sc = fcplan.load_scenario(name)
         for greedy in (False, True):
@@ -243,11 +206,7 @@ def bench_tick(repeats: int, baseline: str | None) -> None:
             med = {k: (min(r[0] for r in v), min(r[1] for r in v)) for k, v in runs.items()}
             team = "greedy" if greedy else "idle"
             for key, (us, gus) in med.items():
-                line = f"{sc.name:<9} {team:<7} {key:<10} {us:>8.1f} {gus:>9.1f}"
-                if baseline and key == baseline:
-                    cur = med["current"]
-                    line += f"   {us / cur[0]:>5.2f}x  {gus / cur[1]:>5.2f}x"
-                print(line)
+                print(f"{sc.name:<9} {team:<7} {key:<10} {us:>8.1f} {gus:>9.1f}")
     print()
 
 
@@ -255,9 +214,6 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only-tick", action="store_true", help="only the per-tick path section")
-    ap.add_argument(
-        "--baseline", metavar="REF", help="git revision whose core modules to compare against"
-    )
     args = ap.parse_args()
     ticks = 300 if args.quick else 1800
     print(
@@ -267,7 +223,7 @@ def main() -> None:
     if not args.only_tick:
         bench_scenarios(["practice", "1", "12", "24"], ticks, 1 if args.quick else 3)
         scaling(100 if args.quick else 300)
-    bench_tick(1 if args.quick else 5, args.baseline)
+    bench_tick(1 if args.quick else 5)
 
 
 if __name__ == "__main__":

@@ -7,7 +7,7 @@ For scenarios #1 and #24, whole episodes (180 steps of 1 s = 10 ticks each):
   does); the scheduler's own time is reported apart and excluded from env steps/s.
 
 Time per step is split into: the simulator (``World.step`` + ``Belief.update`` for the step's
-ticks, plus the reward sum), the task graph (``build_task_graph``), and the env's own code
+ticks, plus the reward sum), the task graph (``TaskGraphBuilder.build``), and the env's own code
 (candidates with the graph's distance tables, masks, feature tables, decoding actions, the
 validity check, commands, observation and info dicts). Baseline measured in the same run: the bare replan loop
 without any env (the same ticks and graph builds, commands from the same recorded plans), whose
@@ -29,13 +29,12 @@ import time
 
 import numpy as np
 
-import fcplan.env.task as task_mod
 from fcplan import load_scenario, make_scheduler
 from fcplan.belief import Belief
 from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import plan_to_actions
 from fcplan.plan import plan_commands
-from fcplan.taskgraph import build_task_graph
+from fcplan.taskgraph import TaskGraphBuilder
 from fcplan.world import World
 
 
@@ -59,8 +58,8 @@ class _Timer:
 def run_env(scenario, policy: str, episodes: int, *, validate: bool = True) -> dict:
     """Play ``episodes`` episodes; return totals (s) and step counts."""
     sim, graph, sched_t = _Timer(), _Timer(), _Timer()
-    orig_build, orig_adv = task_mod.build_task_graph, TaskEnv._advance
-    task_mod.build_task_graph = graph.wrap(orig_build)
+    orig_build, orig_adv = TaskGraphBuilder.build, TaskEnv._advance
+    TaskGraphBuilder.build = graph.wrap(orig_build)  # type: ignore[method-assign]
     TaskEnv._advance = sim.wrap(orig_adv)
     try:
         env = TaskEnv(scenario, k=8, validate=validate)
@@ -89,7 +88,7 @@ def run_env(scenario, policy: str, episodes: int, *, validate: bool = True) -> d
                 steps += 1
             wall += time.perf_counter() - t0
     finally:
-        task_mod.build_task_graph, TaskEnv._advance = orig_build, orig_adv
+        TaskGraphBuilder.build, TaskEnv._advance = orig_build, orig_adv  # type: ignore[method-assign]
     return {
         "steps": steps,
         "wall": wall,
@@ -110,8 +109,9 @@ def run_bare(scenario, episodes: int) -> dict:
         t0 = time.perf_counter()
         world = World().reset(scenario, ep)
         belief = Belief(scenario)
+        builder = TaskGraphBuilder(scenario)
         while not world.done:
-            g = build_task_graph(scenario, world.team, belief)
+            g = builder.build(world.team, belief)
             t1 = time.perf_counter()
             plan = sched.plan(g, time_limit=None, rng=world.controller_rng)
             sched_t += time.perf_counter() - t1
@@ -155,8 +155,9 @@ def hot_parts(scenario, steps: int = 60) -> dict[str, float]:
             out.append((time.perf_counter() - t0) / n * 1e6)
         return min(out)
 
-    build = best(lambda: build_task_graph(scenario, team, belief))
-    fresh = best(lambda: rank_candidates(build_task_graph(scenario, team, belief), 8))
+    builder = env.mission.graph_builder
+    build = best(lambda: builder.build(team, belief))
+    fresh = best(lambda: rank_candidates(builder.build(team, belief), 8))
     return {
         "candidates": fresh - build,
         "task features": best(lambda: task_features(g, c, goal)),

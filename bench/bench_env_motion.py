@@ -9,6 +9,10 @@ replans and action choices are the ``policy us`` column), and prints, per env st
 * ``steps/s``: ``env.step`` calls per second (choosing the actions is timed apart, ``policy us``);
 * for the scenario envs, ``world us`` (the ``World.step`` inside) and ``env overhead us`` (the rest:
   action decoding, observation crops, masks and agent vectors for the whole team, reward);
+* ``step+policy us``: choosing the actions and stepping, the whole cost of a step of the loop.
+  Compare the ``greedy`` rows of two versions by this column: where the follower's belief update
+  is counted (in ``policy us`` before the :class:`fcplan.mission.Mission` loop, inside
+  ``env.step`` since, as the env's mission keeps the belief) moves time between the others;
 * ``overhead, world stubbed``: the same episode replayed with ``World.step`` replaced by a stub
   that returns the recorded tick results, so ``env.step`` times the environment's own work
   alone (the figure least disturbed by other load on the machine).
@@ -180,7 +184,7 @@ def main(argv=None) -> int:
           f"clock: {'thread CPU time' if args.cpu else 'wall'}")  # fmt: skip
     header = (
         f"{'env':22s} {'agents':>6s} {'steps':>6s} {'steps/s':>14s} {'env.step us':>14s} "
-        f"{'world us':>14s} {'env overhead us':>16s} {'policy us':>9s}"
+        f"{'world us':>14s} {'env overhead us':>16s} {'policy us':>9s} {'step+policy us':>14s}"
     )
     print(header)
     rows = {}
@@ -198,6 +202,7 @@ def main(argv=None) -> int:
         rec = run_env(make, n_eps, cap, expert="greedy" if name.endswith("greedy") else None)
         st_med, st_best = blocks_us(rec.step_ns)
         pol, _ = blocks_us(rec.policy_ns)
+        both, _ = blocks_us([s + p for s, p in zip(rec.step_ns, rec.policy_ns, strict=True)])
         n_agents = len(make().possible_agents)
         if rec.world_ns:
             w_med, w_best = blocks_us(rec.world_ns)
@@ -210,7 +215,7 @@ def main(argv=None) -> int:
         rate = f"{1e6 / st_med:7.0f} ({1e6 / st_best:5.0f})"
         print(
             f"{name:22s} {n_agents:6d} {len(rec.step_ns):6d} {rate:>14s} "
-            f"{st_med:7.1f} ({st_best:5.1f}) {wcol:>14s} {ocol:>16s} {pol:9.1f}"
+            f"{st_med:7.1f} ({st_best:5.1f}) {wcol:>14s} {ocol:>16s} {pol:9.1f} {both:14.1f}"
         )
         rows[name] = st_med
     for name, sc in (("motion #1", 1), ("motion #24", 24)):

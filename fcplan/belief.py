@@ -26,10 +26,15 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-__all__ = ["Belief"]
+if TYPE_CHECKING:
+    from fcplan.scenario import Scenario
+    from fcplan.world import StepInfo
+
+__all__ = ["Belief", "ClairvoyantBelief"]
 
 
 class Belief:
@@ -42,7 +47,7 @@ class Belief:
         Side of the coarse coverage cells in px.
     """
 
-    def __init__(self, scenario, coverage_px: int = 20) -> None:
+    def __init__(self, scenario: Scenario, coverage_px: int = 20) -> None:
         w = scenario.world_size
         self.world_size = w
         self.ticks_per_second = scenario.ticks_per_second
@@ -57,14 +62,13 @@ class Belief:
         n_s = sum(1 for a in scenario.agents if a.role.can_sense)
         #: per sensing agent: its last field of view, the coarse box it covered, and the tick of
         #: a deferred write of that box (None: nothing deferred)
-        self._last_rect: list[list | None] = [None] * n_s
+        self._last_rect: list[list[float] | None] = [None] * n_s
         self._last_box: list[tuple[int, int, int, int]] = [(0, 0, 0, 0)] * n_s
         self._pending: list[int | None] = [None] * n_s
         self._lazy = True
         self.n_pruned = 0
         self.tick = 0
         self._tick_covered = 0
-        self.new_fire_since_plan = False
         #: rows of the agents that carry a camera (perception and hybrid)
         self._sensing_rows = [i for i, a in enumerate(scenario.agents) if a.role.can_sense]
 
@@ -83,7 +87,7 @@ class Belief:
         np.divmod(k, self.world_size, out=(out[:, 0], out[:, 1]))
         return out
 
-    def update(self, info) -> None:
+    def update(self, info: StepInfo) -> None:
         """Fold one tick's observations (a :class:`fcplan.world.StepInfo`) into the belief."""
         self.tick = info.tick
         if info.sensed.size:
@@ -92,7 +96,6 @@ class Belief:
             if fresh.size:
                 self._known_mask[fresh] = True
                 self._known = np.concatenate([self._known, fresh])
-                self.new_fire_since_plan = True
         if info.pruned.size:
             self._known_mask[info.pruned] = False
             self.n_pruned += int(info.pruned.size)
@@ -132,8 +135,9 @@ class Belief:
             if lazy and rect == last[slot]:
                 pending[slot] = tick
                 continue
-            if pending[slot] is not None:
-                _raise_to(cov, boxes[slot], pending[slot])
+            t = pending[slot]
+            if t is not None:
+                _raise_to(cov, boxes[slot], t)
                 pending[slot] = None
             i0, i1, j0, j1 = box = _coarse_box(rect, c, nc)
             cov[i0:i1, j0:j1] = tick
@@ -191,7 +195,7 @@ class Belief:
         return out.reshape(nb, nb)
 
 
-def _coarse_box(rect, c: int, nc: int) -> tuple[int, int, int, int]:
+def _coarse_box(rect: list[float], c: int, nc: int) -> tuple[int, int, int, int]:
     """Coarse cells ``[i0, i1) x [j0, j1)`` whose centres lie in ``rect = [x0, x1, y0, y1]``:
     cell j has centre (j + 0.5) c, inside [a, b] iff ceil(a/c - 0.5) <= j <= floor(b/c - 0.5)."""
     x0, x1, y0, y1 = rect
@@ -217,7 +221,7 @@ def _raise_to(cov: np.ndarray, box: tuple[int, int, int, int], tick: int) -> Non
 
 
 @lru_cache(maxsize=32)
-def _block_layout(w: int, c: int, nc: int, block_px: int):
+def _block_layout(w: int, c: int, nc: int, block_px: int) -> tuple[Any, ...]:
     """How coarse coverage cells fall into ``block_px`` blocks (constant per map): block count
     per side, block of each coarse cell, coarse cells per block (at least 1: divisors), blocks
     holding no coarse cell centre, for those the coarse cell under the block's centre, and when
@@ -233,7 +237,7 @@ def _block_layout(w: int, c: int, nc: int, block_px: int):
     centre = (np.arange(nb) + 0.5) * block_px
     ci = np.minimum((centre // c).astype(np.int64), nc - 1)
     centre_cells = ci[empty // nb] * nc + ci[empty % nb]
-    perm = None
+    perm: np.ndarray | int | None = None
     if empty.size == 0 and (counts == counts[0]).all():
         by_block = np.argsort(key, kind="stable")  # blocks in order, raster order within
         perm = by_block.reshape(nb * nb, -1).T.ravel().copy()
@@ -248,3 +252,40 @@ def _block_layout(w: int, c: int, nc: int, block_px: int):
     for a in (key, counts, empty, centre_cells):
         a.flags.writeable = False
     return nb, key, counts, empty, centre_cells, perm
+
+
+class ClairvoyantBelief:
+    """The team's belief plus the true fire: what a clairvoyant planner (the ``oracle``
+    reference, never a legal policy) builds its task graphs from.
+
+    ``known`` holds every cell that is truly burning now (the team's known cells plus the ones it
+    has not sensed yet); ``last_seen`` and the coverage stay the team's own, so a fire nobody has
+    sensed has never been seen (its fire task is as stale as can be) and still has to be sensed
+    before a dump puts it out, as the world's rules require. A read-only view: it changes nothing.
+
+    Examples
+    --------
+    >>> from fcplan import World, load_scenario
+    >>> world = World().reset(load_scenario(1), seed=0)
+    >>> belief = Belief(world.scenario)
+    >>> for _ in range(30):
+    ...     belief.update(world.step())
+    >>> view = ClairvoyantBelief(belief, world.fire.state.reshape(-1))
+    >>> bool(view.known.size >= belief.known.size), view.tick == belief.tick
+    (True, True)
+    """
+
+    def __init__(self, belief: Belief, fire_state: np.ndarray) -> None:
+        from fcplan.fire import BURNING
+
+        self._belief = belief
+        self.tick = belief.tick
+        self.world_size = belief.world_size
+        self.last_seen = belief.last_seen
+        true = np.flatnonzero(fire_state == BURNING)
+        k = belief.known
+        self.known = np.concatenate([k, np.setdiff1d(true, k, assume_unique=True)])
+
+    def coverage_age_s(self, block_px: int) -> np.ndarray:
+        """The team's own coverage ages (:meth:`Belief.coverage_age_s`)."""
+        return self._belief.coverage_age_s(block_px)

@@ -1,23 +1,27 @@
-"""Argument types and errors shared by the ``fcplan`` sub-commands.
+"""The ``fcplan`` sub-commands' argument types and errors, under their first import path.
 
-Every sub-command module (``fcplan.cli`` and the modules it lists in ``COMMAND_MODULES``) uses these
-so that bad arguments read the same everywhere: one line naming the argument and the allowed range,
-exit status 2.
+They are defined in :mod:`fcplan.cli.util`; this module exports the same objects.
 
 Examples
 --------
->>> positive_int("3")
-3
->>> seed_list("0-2")
-[0, 1, 2]
+>>> from fcplan.cli import util
+>>> CliError is util.CliError and seed is util.seed
+True
 """
 
 from __future__ import annotations
 
-import argparse
-import math
-
-from fcplan.errors import FcplanError
+from fcplan.cli.util import (
+    CliError,
+    Parser,
+    check_output,
+    name_list,
+    positive_float,
+    positive_int,
+    scenario_list,
+    seed,
+    seed_list,
+)
 
 __all__ = [
     "CliError",
@@ -30,82 +34,3 @@ __all__ = [
     "seed",
     "seed_list",
 ]
-
-
-class CliError(FcplanError):
-    """A bad command-line argument; ``fcplan`` prints it on one line and exits 2."""
-
-
-class Parser(argparse.ArgumentParser):
-    """An ``ArgumentParser`` whose errors raise :class:`CliError` instead of exiting."""
-
-    def error(self, message: str):  # one line, exit 2 (handled in fcplan.cli.main)
-        raise CliError(f"{self.prog}: {message}")
-
-
-def positive_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
-    return v
-
-
-def seed(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}")
-    return v
-
-
-def positive_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}")
-    return v
-
-
-def scenario_list(text: str) -> list:
-    from fcplan.experiments.compare import RangeError, parse_range
-
-    try:
-        return parse_range(text)
-    except RangeError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def seed_list(text: str) -> list:
-    from fcplan.experiments.compare import RangeError, parse_range
-
-    try:
-        return parse_range(text, names=False)
-    except RangeError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def name_list(text: str) -> list[str]:
-    names = [t.strip() for t in text.split(",")]
-    if not text.strip() or any(not t for t in names):
-        raise argparse.ArgumentTypeError(f"expected comma-separated names, got {text!r}")
-    return list(dict.fromkeys(names))
-
-
-def check_output(path: str | None, option: str) -> None:
-    """Fail before a long run, not after it, when an output file cannot be written."""
-    if path is None:
-        return
-    from pathlib import Path
-
-    p = Path(path)
-    if p.is_dir():
-        raise CliError(f"{option} {path}: is a directory")
-    if not p.parent.is_dir():
-        raise CliError(f"{option} {path}: no such directory {str(p.parent)!r}")

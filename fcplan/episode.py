@@ -1,10 +1,12 @@
-"""The replan loop: run a scheduler on a scenario for one episode and score it.
+"""One scored episode: run a scheduler on a scenario and score it.
 
-Every ``replan_period`` simulated seconds, and at once when the team senses fire outside every
-fire task of the current plan, the loop builds the task graph from the belief, asks the scheduler
-for a plan (:func:`fcplan.scheduling.solve`: validated, with a greedy fallback), and turns it into
-agent commands. Between replans the world runs on the last plan. The episode ends after the
-scenario's duration and is scored with both metric definitions.
+:func:`run_episode` plays a :class:`fcplan.mission.Mission` to its end: every ``replan_period``
+simulated seconds, and at once when the team senses fire outside every fire task of the current
+plan, it builds the task graph from the belief, asks the scheduler for a plan
+(:func:`fcplan.scheduling.solve`: validated, with a greedy fallback), and turns it into agent
+commands; between replans the world runs on the last plan. The episode ends after the scenario's
+duration and is scored with both metric definitions (:func:`fcplan.metrics.compute_all`) into an
+:class:`EpisodeResult`.
 
 Examples
 --------
@@ -18,18 +20,22 @@ Examples
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fcplan.belief import Belief
-from fcplan.metrics import Metrics, compute_all
-from fcplan.plan import plan_commands
-from fcplan.scheduling import Scheduler, SolveStats, make_scheduler, solve
-from fcplan.taskgraph import TaskGraphParams, TaskKind, build_task_graph
+from fcplan.metrics import Metrics, Outcomes, compute_all, compute_outcomes
+from fcplan.mission import Mission, ScenarioLike, as_scenario
+from fcplan.scenario import Scenario
+from fcplan.scheduling import Scheduler, SolveStats, make_scheduler
+from fcplan.taskgraph import TaskGraphParams
 from fcplan.trace import Trace
-from fcplan.world import World
+
+if TYPE_CHECKING:
+    from fcplan.recording import Recorder
 
 __all__ = ["run_episode", "EpisodeResult"]
 
@@ -72,17 +78,28 @@ class EpisodeResult:
         return np.array([s.wall_time_s for s in self.solves], dtype=np.float64)
 
     @property
+    def outcomes(self) -> Outcomes:
+        """Time to containment, burned area and facility damage (:mod:`fcplan.metrics.outcomes`)."""
+        return compute_outcomes(self.trace)
+
+    @property
     def fallbacks(self) -> int:
         """Number of replans where the scheduler failed and greedy stood in."""
         return sum(s.status == "fallback" for s in self.solves)
 
-    def summary(self) -> dict:
+    def summary(self) -> dict[str, Any]:
         """Flat dict of the headline numbers (for tables)."""
-        out = {"scenario": self.scenario, "scheduler": self.scheduler, "seed": self.seed}
+        out: dict[str, Any] = {
+            "scenario": self.scenario,
+            "scheduler": self.scheduler,
+            "seed": self.seed,
+        }
         for name, m in self.metrics.items():
             for k, v in m.as_dict().items():
                 if k != "definition":
                     out[f"{name}.{k}"] = v
+        for k, v in self.outcomes.as_dict().items():
+            out[f"outcome.{k}"] = v
         st = self.solve_times_s
         statuses = [s.status for s in self.solves]
         rounds = [s.size["rounds"] for s in self.solves if "rounds" in s.size]
@@ -103,7 +120,7 @@ class EpisodeResult:
 
 
 def run_episode(
-    scenario,
+    scenario: ScenarioLike,
     scheduler: Scheduler | str,
     seed: int | None = 0,
     *,
@@ -111,9 +128,10 @@ def run_episode(
     time_limit: float | None = None,
     graph_params: TaskGraphParams | None = None,
     event_replans: bool = True,
-    record=None,
+    record: str | os.PathLike[str] | None = None,
+    latency: str | None = None,
 ) -> EpisodeResult:
-    """Play one episode of ``scenario`` with ``scheduler``.
+    """Play one episode of ``scenario`` with ``scheduler`` (a :class:`fcplan.mission.Mission`).
 
     Parameters
     ----------
@@ -132,74 +150,40 @@ def run_episode(
         Also replan at once when fire is sensed outside every current fire task.
     record : str or os.PathLike, optional
         Write a complete recording of the episode to this ``.npz`` file (:mod:`fcplan.recording`).
+    latency : {None, "wall", "ticks:N"}
+        Planning takes time in the world: a plan applies that many ticks after its replan, the
+        team flying its last orders meanwhile (:meth:`fcplan.mission.Mission.run`). None (the
+        default) stops the world while the scheduler thinks, as the manual's game does.
 
     Returns
     -------
     EpisodeResult
     """
-    from fcplan.scenario import Scenario, load_scenario
-
-    if not isinstance(scenario, Scenario):
-        scenario = load_scenario(scenario)
+    scenario = as_scenario(scenario)
     if isinstance(scheduler, str):
         scheduler = make_scheduler(scheduler)
-    if not replan_period > 0:
-        raise ValueError(f"replan_period must be > 0 simulated seconds, got {replan_period!r}")
     t0 = time.perf_counter()
-    world = World().reset(scenario, seed)
-    belief = Belief(scenario)
-    rng = world.controller_rng
-    tps = scenario.ticks_per_second
-    period = max(int(round(replan_period * tps)), 1)
-    solves: list[SolveStats] = []
-    replan_ticks: list[int] = []
-    tile_keys = np.zeros(0, dtype=np.int64)
-    tile = None
-    commands = None
-    next_periodic = 0
-    new_fire = False
     recorder = None
     if record is not None:
-        from fcplan.recording import Recorder, scheduler_settings
-
         settings = dict(
             replan_period=replan_period,
             time_limit=time_limit,
             event_replans=event_replans,
             graph_params=graph_params,
-            scheduler=scheduler_settings(scheduler),
+            latency=latency,
         )
-        recorder = Recorder(
-            scenario, seed, source=getattr(scheduler, "name", "?"), settings=settings
-        )
-    while not world.done:
-        if world.tick >= next_periodic or new_fire:
-            graph = build_task_graph(scenario, world.team, belief, graph_params)
-            plan = solve(scheduler, graph, time_limit=time_limit, rng=rng)
-            commands = plan_commands(plan, graph)
-            solves.append(plan.stats)
-            replan_ticks.append(world.tick)
-            tile = graph.tile_px
-            fires = graph.task_kind == TaskKind.FIRE
-            tile_keys = _tile_keys(graph.task_pos[fires], tile, scenario.world_size)
-            if world.tick >= next_periodic:
-                next_periodic = world.tick + period
-            new_fire = False
-            if recorder is not None:
-                recorder.on_replan(world.tick, plan)
-        if recorder is not None:
-            recorder.on_commands(world.tick, commands)
-        info = world.step(commands)
-        if recorder is not None:
-            recorder.on_step(world, info)
-        commands = None
-        belief.update(info)
-        if event_replans and info.newly_sensed.size and tile is not None:
-            w = scenario.world_size
-            xy = np.stack([info.newly_sensed // w, info.newly_sensed % w], axis=1)
-            new_fire = bool((~np.isin(_tile_keys(xy, tile, w), tile_keys)).any())
-    trace = world.trace()
-    if recorder is not None:
+        recorder = _recorder(scenario, scheduler, seed, settings)
+    mission = Mission(
+        scenario,
+        seed,
+        replan_period=replan_period,
+        event_replans=event_replans,
+        graph_params=graph_params,
+        observers=() if recorder is None else (recorder,),
+    )
+    mission.run(scheduler, time_limit=time_limit, latency=latency)
+    trace = mission.world.trace()
+    if recorder is not None and record is not None:
         recorder.save(record)
     return EpisodeResult(
         scenario=scenario.name,
@@ -207,13 +191,18 @@ def run_episode(
         seed=seed if isinstance(seed, (int, np.integer)) or seed is None else None,
         metrics=compute_all(trace),
         trace=trace,
-        solves=solves,
-        replan_ticks=np.asarray(replan_ticks, dtype=np.int64),
+        solves=mission.solves,
+        replan_ticks=mission.replan_ticks,
         wall_time_s=time.perf_counter() - t0,
-        ticks=world.tick,
+        ticks=mission.tick,
     )
 
 
-def _tile_keys(xy: np.ndarray, tile: tuple[float, float], w: int) -> np.ndarray:
-    ny = int(np.ceil(w / tile[1])) + 1
-    return (xy[:, 0] // tile[0]).astype(np.int64) * ny + (xy[:, 1] // tile[1]).astype(np.int64)
+def _recorder(
+    scenario: Scenario, scheduler: Scheduler, seed: int | None, settings: dict[str, Any]
+) -> Recorder:
+    """The recorder of an episode played with ``settings`` (plus the scheduler's own)."""
+    from fcplan.recording import Recorder, scheduler_settings
+
+    settings = dict(settings, scheduler=scheduler_settings(scheduler))
+    return Recorder(scenario, seed, source=getattr(scheduler, "name", "?"), settings=settings)

@@ -15,7 +15,14 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["FcplanError", "ScenarioError", "PlanError", "UnknownNameError"]
+__all__ = [
+    "FcplanError",
+    "ScenarioError",
+    "PlanError",
+    "UnknownNameError",
+    "EnvError",
+    "LegacyError",
+]
 
 _MISSING = object()
 
@@ -44,6 +51,7 @@ class ScenarioError(FcplanError, ValueError):
         self.problem = problem
         self.got = None if got is _MISSING else got
         self.source = source
+        self._got = got
         msg = f"{field}: {problem}"
         if got is not _MISSING:
             msg += f" (got {got!r})"
@@ -55,10 +63,7 @@ class ScenarioError(FcplanError, ValueError):
         """Return the same error attributed to ``source`` (a file path or scenario name)."""
         if self.source:
             return self
-        err = ScenarioError.__new__(ScenarioError)
-        FcplanError.__init__(err, f"{source}: {self.args[0]}")
-        err.field, err.problem, err.got, err.source = self.field, self.problem, self.got, source
-        return err
+        return ScenarioError(self.field, self.problem, got=self._got, source=source)
 
 
 class PlanError(FcplanError, ValueError):
@@ -71,3 +76,13 @@ class UnknownNameError(FcplanError, KeyError):
 
     def __str__(self) -> str:  # KeyError would quote the message
         return str(self.args[0])
+
+
+class EnvError(FcplanError, ValueError):
+    """Bad environment argument or action (the message names the argument/agent and the
+    allowed range). Also importable as ``fcplan.env.EnvError``."""
+
+
+class LegacyError(FcplanError, ValueError):
+    """A legacy file (the 2020 GUI's pickles) is unsafe, missing, or does not have the documented
+    structure. Also importable as ``fcplan.legacy.LegacyError``."""

@@ -1,38 +1,69 @@
 """FARSITE wildfire: propagating fronts over a 1-px cell grid, vectorised over all fronts.
 
 Each fire region starts with ``fronts`` ignition points drawn uniformly (integer pixels) in its
-ignition box. Every tick every live front takes one FARSITE step (FIRECOMMANDER.md 1.4)::
+ignition box. Every **fire step** every live front moves once (FIRECOMMANDER.md 1.4;
+:mod:`fcplan.farsite` has the formulas)::
 
-    U ~ N(U_avg, 2)          Theta ~ N(theta_avg, 2 rad)      (fresh draws per front per tick)
     R = fuel * terrain[round(x), round(y)]                    (terrain ~ U(0, 1), fixed per episode)
-    LB = 0.936 exp(0.2566 U) + 0.461 exp(-0.1548 U) - 0.397
-    HB = (LB + sqrt|LB^2 - 1|) / (LB - sqrt|LB^2 - 1|)
-    C = 0.5 (R - R / HB)
-    x += C sin(Theta) dt,   y += C cos(Theta) dt              (dt = 10 / ticks_per_second)
+    C = R * (C/R)(U)                                          (FARSITE spread rate, U: wind speed)
+    x += C sin(Theta),   y += C cos(Theta)                    (Theta: wind direction)
 
-This is the manual's FARSITE model, ``dq/dt = C(R, U) D(Theta)`` with the spread rate
-``C = R (1 - LB / (LB + sqrt(LB^2 - 1)))`` (``eq:qdot1``, ``eq:C``), identical for ``LB >= 1``, with the reference code's
-exponents (the manual rounds them to 0.256 and 0.154). Units: px (1 px = 1 m), wind speed in the
-scenario's units, angles in radians; the step is per tick at 10 ticks per second, scaled by ``dt``
-at other rates. A front moves about ``0.24 * fuel`` px per tick at wind 5 on its first tick,
-drifting weakly along the wind azimuth (theta = 0 is +y, screen down; 90 degrees is +x).
+This is the manual's FARSITE model, ``dq/dt = C(R, U) D(Theta)``, with the reference code's
+exponents. Units: px (1 px = 1 m), angles in radians (theta = 0 is +y, screen down; 90 degrees is
++x). A front moves about ``0.24 * fuel`` px on its first step at wind 5.
+
+**The fire's clock.** A fire step is 0.1 simulated second (the original's per-frame step at
+fcplan's reference 10 frames per second), whatever ``ticks_per_second`` ``r``: tick ``t`` runs
+steps ``floor(10 (t - 1) / r) + 1 .. floor(10 t / r)``, two per tick at 5 Hz, one at 10 Hz, one
+every 2nd (4th) tick at 20 (40) Hz. The wind is drawn per step, so without pruning the fire at
+any rate is, bit for bit, the 10 Hz fire seen at the ticks' times. Per simulated second, a front
+on fuel ``R`` has (wind 5: ``E[C/R] = 0.475``, ``E[(C/R)^2] = 0.227``; ``E[sin Theta] = e^-2 sin
+theta_avg``):
+
+* a mean drift velocity of ``10 * 0.475 e^-2 R = 0.643 R`` px/s along the wind azimuth;
+* a diffusion: the position's variance grows by ``10 * 0.227 R^2 / 2 = 1.14 R^2`` px^2 per second
+  per axis, linearly in time (the steps are independent given the terrain);
+* lingering: ``R`` is read at the front's cell, so on low fuel a front takes small steps and needs
+  about ``1 / (1.14 R^2)`` s to wander 1 px; this makes the mean step over a run 4-5 times smaller
+  than the first step (FIRECOMMANDER.md 1.4).
+
+Why the step is fixed rather than scaled to the tick: the terrain is independent from one 1-px cell
+to the next and a front reads it once per step, so the front's path has no continuous-time limit
+that keeps these statistics. Scaling each step by ``dt = 10 / r`` (fcplan before this rule) shrank
+the random walk's variance per second by ``dt``; scaling the random part by ``sqrt(dt)`` keeps the
+variance on constant fuel but not the drift, as fronts linger longer in low-fuel cells when steps
+shrink (drift after 180 s at 5/10/20/40 Hz: 252/172/103/67 px, against 173 px at every rate with
+the fixed step); and cells burn where fronts land, so the burnt area depends on how finely the
+path is sampled (``bench/bench_tick_rate.py --alternatives``).
+
+**Wind.** ``Scenario.wind_model`` (``[fire] wind_model``) picks how ``U`` and ``Theta`` are drawn
+(:mod:`fcplan.farsite`): ``"fresh"`` draws ``U ~ N(U_avg, 2)`` and ``Theta ~ N(theta_avg, 2 rad)``
+for every front every step; ``"tables"`` is the original's model: each region draws a table of
+``W`` speeds and one of ``W`` directions (``W``: the map side) once per episode, and every step
+each front picks an entry of each. Both have the same mean drift, but the tables give each episode
+its own wind bias: after 1,800 steps the spread between episodes of the fronts' drift along the
+wind is 1.51 times the fresh model's for scenario #1's region (1,000 seeds; 1.3 with 5 fronts, 2.1
+with 30: the bias does not average out over fronts; ``bench/bench_wind.py``).
 
 What fcplan keeps and fixes (ARCHITECTURE.md "Fire"):
 
 * There is no branching: each front is one point; the fire grows as the trail of cells the fronts
   visit. Every cell a front lands in burns; the ignition cells burn as soon as their region
-  activates (after its delay), which the 2020 code forgot.
+  activates (the first step at or after its delay; the tick that runs it), which the 2020 code
+  forgot.
 * A front standing in a pruned cell is frozen forever; pruned cells never re-ignite.
-* A front leaving the map dies (the 2020 code kept a phantom front at (0, 0)).
+* A front leaving the map dies (the 2020 code kept a phantom front at (0, 0)). fcplan moves every
+  live front and kills those that land outside ``[0, W)``; the original tests ``0 < x <= W - 1``
+  (and the same for y) *before* stepping and skips a front that fails, so its fronts die one
+  step later, a front landing at exactly ``x = 0`` or ``y = 0`` dies there, and the strip
+  ``W - 1 < x < W`` (1 px) is outside its map but inside fcplan's.
 * One terrain field is shared by all regions (it is the map's fuel pattern); each region scales it
   by its fuel coefficient.
-* Random numbers: two normals are drawn for *every* front every tick, live or not, so the fire's
-  random stream never depends on what the agents do (common random numbers across schedulers).
-  :func:`wind_draws` is that rule for one tick; :class:`Fire` computes it for blocks of ticks at
-  once (:func:`fcplan._fast.fire.draw_ahead`), bit for bit as tick by tick.
-* ``C/R`` is read from a table of :func:`spread_rate_ratio` (linear interpolation: error below
-  1e-5; below 1.5e-4 for steps of more than 256 moving fronts, except within 0.002 of the two
-  kinks of ``sqrt|LB^2 - 1|`` at ``U = 0`` and ``U = -6.219``, where it stays below 0.0065; a wind draw lands there with probability about 1e-5).
+* The wind of *every* front is drawn every step, live or not, so the fire's random stream never
+  depends on what the agents do (common random numbers across schedulers); :class:`Fire` draws
+  it for blocks of steps at once (:mod:`fcplan._fast.fire`), bit for bit as step by step.
+* ``C/R`` is tabulated (:func:`~fcplan.farsite.ratio_tabulated`) in the fresh model, exact per
+  table entry in the tables model.
 * Intensity is not used by any rule. It is kept as a grid of front visits (``visits``); the
   Gaussian heat field of the manual is computed on demand by :meth:`Fire.intensity`.
 
@@ -48,8 +79,14 @@ Examples
 >>> fire = Fire([region], world_size=1200, ticks_per_second=10, rng=np.random.default_rng(0))
 >>> for _ in range(50):
 ...     _ = fire.step()
->>> int(fire.n_burning) > 10
-True
+>>> int(fire.n_burning) > 10, fire.n_steps
+(True, 50)
+>>> slow = Fire([region], 1200, ticks_per_second=5, rng=np.random.default_rng(0),
+...             wind_model="tables")
+>>> for _ in range(25):
+...     _ = slow.step()
+>>> slow.n_steps, slow.wind_tables.shape
+(50, (1, 2, 1200))
 """
 
 from __future__ import annotations
@@ -60,77 +97,31 @@ from typing import Any
 
 import numpy as np
 
-from fcplan._fast.fire import advance_whole, draw_ahead, ignite_cells
+from fcplan._fast.fire import advance_whole, draw_ahead, draw_ahead_tables, ignite_cells
 from fcplan._fast.fire import unique as _unique
+from fcplan.farsite import (
+    INTERP_MAX,
+    WIND_DIR_SD_RAD,
+    WIND_SPEED_SD,
+    interp_ratio,
+    ratio_tabulated,
+    spread_rate_ratio,
+    wind_draws,
+    wind_tables,
+)
+from fcplan.scenario.parts import DEFAULT_WIND_MODEL, WIND_MODELS
 
-try:  # np.interp without its argument checks (same compiled routine, same results)
-    from numpy._core.multiarray import interp as _interp
-except ImportError:  # numpy < 2
-    from numpy.core.multiarray import interp as _interp  # type: ignore[no-redef]
-
-__all__ = ["Fire", "spread_rate_ratio", "wind_draws", "INTENSITY_COEFF"]
-__all__ += ["UNBURNT", "BURNING", "PRUNED"]
+__all__ = ["Fire", "spread_rate_ratio", "wind_draws", "INTENSITY_COEFF", "STEPS_PER_SECOND"]
+__all__ += ["UNBURNT", "BURNING", "PRUNED", "WIND_SPEED_SD", "WIND_DIR_SD_RAD"]
 
 #: ``259.833 (h / cos(alpha))^2.174 / 1000`` with h = 3 m, alpha = pi/3 (manual Eq. intensity).
 INTENSITY_COEFF = 259.833 * (3.0 / math.cos(math.pi / 3)) ** 2.174 / 1000.0
-WIND_SPEED_SD = 2.0
-WIND_DIR_SD_RAD = 2.0
-REFERENCE_TPS = 10
+#: Fire steps per simulated second, at every tick rate (see "The fire's clock").
+STEPS_PER_SECOND = 10
 #: Cell states in :attr:`Fire.state`.
 UNBURNT, BURNING, PRUNED = 0, 1, 2
 #: Side (px) of the blocks in :attr:`Fire.block_burning`.
 BLOCK = 16
-
-
-def _lb(u: np.ndarray | float) -> np.ndarray:
-    """FARSITE length-to-breadth ratio LB(U) (reference exponents 0.2566 and 0.1548)."""
-    return 0.936 * np.exp(0.2566 * u) + 0.461 * np.exp(-0.1548 * u) - 0.397
-
-
-def spread_rate_ratio(wind_speed: np.ndarray | float) -> np.ndarray:
-    """FARSITE ``C / R`` as a function of wind speed ``U`` (0 at U = 0, about 0.487 at U = 5).
-
-    Examples
-    --------
-    >>> round(float(spread_rate_ratio(5.0)), 3)
-    0.487
-    """
-    lb = _lb(np.asarray(wind_speed, dtype=np.float64))
-    s = np.sqrt(np.abs(lb * lb - 1.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv_hb = np.where(lb - s != 0.0, (lb - s) / (lb + s), 1.0)
-    return 0.5 * (1.0 - inv_hb)
-
-
-def wind_draws(
-    rng: np.random.Generator, wind_avg: np.ndarray, theta_avg: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One tick's wind for every front: ``U ~ N(U_avg, 2)`` and ``Theta ~ N(theta_avg, 2 rad)``.
-
-    The two normals of every front are drawn as one ``(2, n)`` array (speeds, then directions).
-    :class:`Fire` computes this for blocks of ticks ahead, bit for bit as successive calls.
-
-    Parameters
-    ----------
-    rng : numpy.random.Generator
-    wind_avg, theta_avg : ndarray, (n,) float64
-        Mean wind speed and direction (rad) of each front.
-
-    Returns
-    -------
-    u, sin_theta, cos_theta : ndarray, (n,) float64
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> u, s, c = wind_draws(np.random.default_rng(0), np.full(3, 5.0), np.zeros(3))
-    >>> u.shape, bool(np.allclose(s**2 + c**2, 1.0))
-    ((3,), True)
-    """
-    z = rng.standard_normal((2, wind_avg.size))
-    u = z[0] * WIND_SPEED_SD + wind_avg
-    theta = z[1] * WIND_DIR_SD_RAD + theta_avg
-    return u, np.sin(theta), np.cos(theta)
 
 
 class Fire:
@@ -144,9 +135,12 @@ class Fire:
     world_size : int
         Map side ``W`` in px (cells).
     ticks_per_second : int
-        Simulation rate; per-tick motion is rescaled so that motion per second is rate-free.
+        Simulation rate; the fire takes :data:`STEPS_PER_SECOND` steps per simulated second at
+        any rate (module docstring, "The fire's clock").
     rng : numpy.random.Generator
         The fire's own random stream.
+    wind_model : {"fresh", "tables"}
+        How the wind is drawn (module docstring, "Wind").
 
     Attributes
     ----------
@@ -160,7 +154,14 @@ class Fire:
         ``UNBURNT`` (0), ``BURNING`` (1) or ``PRUNED`` (2) per cell. Pruned cells never burn
         again and freeze fronts standing in them.
     visits : ndarray, (W, W) uint32
-        Front-ticks spent in each cell (the accumulation behind :meth:`intensity`).
+        Front-steps spent in each cell (the accumulation behind :meth:`intensity`).
+    tick, n_steps : int
+        Ticks and fire steps taken.
+    start_step : ndarray, (R,) int64
+        Per region, ``ceil(10 delay_s)``: it activates on fire step ``max(1, start_step)``.
+    wind_tables : ndarray, (R, 2, W) float64 or None
+        Per region, the wind speeds (``[:, 0]``) and directions (``[:, 1]``, rad) of the tables
+        model; None in the fresh model.
     """
 
     _block = BLOCK  # (read by the kernels of fcplan._fast.fire, which cannot import this module)
@@ -171,16 +172,21 @@ class Fire:
         world_size: int,
         ticks_per_second: int,
         rng: np.random.Generator,
+        *,
+        wind_model: str = DEFAULT_WIND_MODEL,
     ) -> None:
+        if wind_model not in WIND_MODELS:
+            raise ValueError(f"wind_model must be one of {WIND_MODELS} (got {wind_model!r})")
+        self.wind_model = wind_model
         w = int(world_size)
         self.world_size = w
         self._w_float = np.float64(w)
         self._w_bits = self._w_float.view(np.uint64)
         self._stride = np.array([w, 1], dtype=np.int64)  # (x, y) -> flat x w + y
         self.ticks_per_second = int(ticks_per_second)
-        self.dt = REFERENCE_TPS / self.ticks_per_second
         self.rng = rng
         self.tick = 0
+        self.n_steps = 0
         n_per = np.array([int(r.fronts) for r in regions], dtype=np.int64)
         self.region = np.repeat(np.arange(len(regions), dtype=np.int16), n_per)
         n = int(n_per.sum())
@@ -199,8 +205,8 @@ class Fire:
         self._fuel = per[self.region, 0]
         self._wind = per[self.region, 1]
         self._theta = per[self.region, 2]
-        self.delay_ticks = np.array(
-            [math.ceil(r.delay_s * self.ticks_per_second - 1e-9) for r in regions], np.int64
+        self.start_step = np.array(
+            [math.ceil(r.delay_s * STEPS_PER_SECOND - 1e-9) for r in regions], np.int64
         )
         self.region_active = np.zeros(len(regions), dtype=bool)
         self._set_next_wake()
@@ -208,29 +214,21 @@ class Fire:
         self.terrain = rng.random((w + 1, w + 1), dtype=np.float32)
         self._terrain_flat = self.terrain.reshape(-1)
         self._t_stride = np.array([w + 1, 1], dtype=np.int64)  # rounded (x, y) -> terrain index
-        # A front moves less than C = fuel dt R/2 px per axis in a tick (terrain < 1, C/R < 1/2:
-        # LB(U) >= 0.77 keeps HB > 1). Fronts stand in burning cells, inside ``burn_box``, so
-        # while the box keeps this far from the edges no front can leave the map.
-        self._edge_margin = 0.5 * float(per[:, 0].max(initial=0.0)) * self.dt + 1.0
+        # A front moves less than C = fuel R/2 px per axis in a step (terrain < 1, C/R < 1/2).
+        # Fronts stand in burning cells, inside ``burn_box``, so while the box keeps this far
+        # from the edges no front can leave the map.
+        self._edge_margin = 0.5 * float(per[:, 0].max(initial=0.0)) + 1.0
         #: (W, W) uint8 cell state: UNBURNT, BURNING or PRUNED.
         self.state = np.zeros((w, w), dtype=np.uint8)
         self._visits = np.zeros((w, w), dtype=np.uint32)
         self._state_flat = self.state.reshape(-1)
         self._visits_flat = self._visits.reshape(-1)
-        # the cells of the moving fronts are queued here tick after tick (one copy per tick) and
+        # the cells of the moving fronts are queued here step after step (one copy per step) and
         # added to the grid in one np.add.at when full or when someone reads ``visits``
         self._visit_queue = np.zeros(_VISIT_ROWS * max(n, 1), dtype=np.int64)
         self._n_visits = 0
-        self._move = np.empty((2, n))  # per-tick buffer: the moves of all fronts
-        # The position-free part of the FARSITE step (draws, wind, C/R, sin and cos of Theta) for
-        # the next ``_pre_len`` ticks of every front, filled in one go by _refill (row t: tick t
-        # of the block, the result of wind_draws).
-        self._pre_len = max(1, min(_PRE_TICKS, _PRE_VALUES // max(n, 1)))
-        self._pre_t = self._pre_len  # next row to use (all used: refill first)
-        self._pre_z = np.empty((self._pre_len, 2, n))
-        self._pre_sc = np.empty((self._pre_len, 2, n))
-        self._pre_u = self._pre_z[:, 0]  # (wind speeds overwrite the draws: a view)
-        self._pre_ratio = np.empty((self._pre_len, n)) if n <= _INTERP_MAX else None
+        self._move = np.empty((2, n))  # per-step buffer: the moves of all fronts
+        self._init_wind(per)
         #: (n,) int64 flat index of each front's current cell (valid while alive).
         self.cell = np.where(
             self.alive,
@@ -255,6 +253,29 @@ class Fire:
         #: (``x0 > x1``) when nothing burns. Lets callers skip areas without a numpy call.
         self.burn_box = [w, -1, w, -1]
 
+    def _init_wind(self, per: np.ndarray) -> None:
+        """The wind tables (tables model) and the buffers of the wind drawn ahead: the
+        position-free part of the FARSITE step (draws, U, C/R, sin and cos of Theta) for the next
+        ``_pre_len`` steps of every front, filled in one go by :meth:`_refill` (row t: step t of
+        the block, the result of :func:`~fcplan.farsite.wind_draws` or
+        :func:`~fcplan.farsite.wind_from_tables`)."""
+        n, w = self.n_fronts, self.world_size
+        self.wind_tables = None
+        tables = self.wind_model == "tables"
+        if tables:  # entries as flat arrays, with C/R, sin and cos per entry
+            self.wind_tables = wind_tables(self.rng, per[:, 1], per[:, 2], w)
+            u = np.ascontiguousarray(self.wind_tables[:, 0]).reshape(-1)
+            theta = np.ascontiguousarray(self.wind_tables[:, 1]).reshape(-1)
+            self._tab = (u, np.sin(theta), np.cos(theta), spread_rate_ratio(u))
+            self._tab_base = self.region.astype(np.int64) * w  # row of each front's tables
+        self._pre_len = max(1, min(_PRE_TICKS, _PRE_VALUES // max(n, 1)))
+        self._pre_t = self._pre_len  # next row to use (all used: refill first)
+        self._pre_z = np.empty((self._pre_len, 2, n))
+        self._pre_sc = np.empty((self._pre_len, 2, n))
+        self._pre_u = self._pre_z[:, 0]  # (wind speeds overwrite the draws: a view)
+        with_ratio = n <= INTERP_MAX or tables
+        self._pre_ratio = np.empty((self._pre_len, n)) if with_ratio else None
+
     # ------------------------------------------------------------------ queries
     @property
     def x(self) -> np.ndarray:
@@ -276,7 +297,7 @@ class Fire:
 
     @property
     def visits(self) -> np.ndarray:
-        """(W, W) uint32 front-ticks spent in each cell (up to date; writable)."""
+        """(W, W) uint32 front-steps spent in each cell (up to date; writable)."""
         if self._n_visits:
             self._flush_visits()
         return self._visits
@@ -287,7 +308,7 @@ class Fire:
 
     @property
     def live(self) -> np.ndarray:
-        """(n,) bool: fronts that move this tick (alive and their region active)."""
+        """(n,) bool: fronts that move on the next step (alive and their region active)."""
         return self.alive & self.region_active[self.region]
 
     @property
@@ -371,19 +392,33 @@ class Fire:
         return fresh
 
     def step(self) -> np.ndarray:
-        """Advance one tick; return the flat indices of the cells that started burning.
+        """Advance one tick: take the fire steps due by its end (:meth:`_fire_step`); return the
+        flat indices of the cells that started burning."""
+        self.tick += 1
+        stop = self.tick * STEPS_PER_SECOND // self.ticks_per_second
+        k = self.n_steps
+        if stop == k + 1:  # (one step per tick: 10 ticks per second)
+            return self._fire_step()
+        if stop == k:  # (no fire step in this tick: above 10 ticks per second)
+            return _EMPTY
+        parts = [p for p in (self._fire_step() for _ in range(stop - k)) if p.size]
+        return np.concatenate(parts) if len(parts) > 1 else (parts[0] if parts else _EMPTY)
 
-        1. Regions whose delay has passed activate: their ignition cells burn
-           (:meth:`_wake_regions`).
-        2. Every live, unfrozen front takes one FARSITE step with this tick's wind
+    def _fire_step(self) -> np.ndarray:
+        """Take one fire step (0.1 simulated second); return the flat indices of the cells that
+        started burning.
+
+        1. Regions whose delay has passed (``start_step <= n_steps``) activate: their ignition
+           cells burn (:meth:`_wake_regions`).
+        2. Every live, unfrozen front takes one FARSITE step with this step's wind
            (:meth:`_advance_moving`).
         3. Fronts that left the map die.
         4. Every other moved front lands in a cell: a pruned cell freezes it for good, an
            unburnt cell starts burning.
         """
-        self.tick += 1
-        new = self._wake_regions() if self.tick >= self._next_wake else _EMPTY
-        t = self._pre_t  # this tick's row of the wind drawn ahead
+        self.n_steps += 1
+        new = self._wake_regions() if self.n_steps >= self._next_wake else _EMPTY
+        t = self._pre_t  # this step's row of the wind drawn ahead
         if t == self._pre_len:
             self._refill()
             t = 0
@@ -395,7 +430,7 @@ class Fire:
             return new
         all_moving = self._all_moving
         ratio = self._pre_ratio
-        # the visits of this tick: the cells the moving fronts stand in
+        # the visits of this step: the cells the moving fronts stand in
         k = self._n_visits
         if k + self.n_fronts > self._visit_queue.size:
             self._flush_visits()
@@ -408,14 +443,14 @@ class Fire:
             self._n_visits = k + idx.size
         # 2. The rule moves the moving fronts only. The whole-array kernel is bit-identical and
         # cheaper when every front moves, or when C/R of every front was drawn ahead (fires up to
-        # _INTERP_MAX fronts: C/R's method depends on how many fronts move).
+        # INTERP_MAX fronts: C/R's method depends on how many fronts move).
         masked = not all_moving and ratio is not None
         if all_moving or masked:
-            ratio_t = _ratio(self._pre_u[t]) if ratio is None else ratio[t]
+            ratio_t = ratio_tabulated(self._pre_u[t]) if ratio is None else ratio[t]
             xy = advance_whole(self, t, ratio_t, all_moving)
         else:
             xy = self._advance_moving(idx, t)
-        # 3. No front can leave the map this tick while the burn box keeps _edge_margin from the
+        # 3. No front can leave the map this step while the burn box keeps _edge_margin from the
         # edges (moving fronts stand in burning cells); the box does not change until step 4.
         (x0, x1, y0, y1), m, w = self.burn_box, self._edge_margin, self.world_size
         inside = None
@@ -463,7 +498,7 @@ class Fire:
         """Activate the regions whose delay has passed; return their ignition cells that started
         burning."""
         new = _EMPTY
-        waking = (~self.region_active) & (self.delay_ticks <= self.tick)
+        waking = (~self.region_active) & (self.start_step <= self.n_steps)
         if waking.any():
             self.region_active |= waking
             self._moving = None
@@ -475,16 +510,16 @@ class Fire:
         """One FARSITE step of the moving fronts ``idx`` with row ``t`` of the wind drawn ahead;
         return their new positions, ``(2, k)``, also written back into the fronts.
 
-        ``R = fuel terrain[round(x), round(y)]``, ``C = R dt (C/R)(U)``, then
+        ``R = fuel terrain[round(x), round(y)]``, ``C = R (C/R)(U)``, then
         ``x += C sin(Theta)`` and ``y += C cos(Theta)``.
         """
         idx2 = self._m_idx2  # idx in the flat (2 n) positions: 1-D takes, not 2-D fancy indexing
         xy = self._xy.reshape(-1)[idx2].reshape(2, -1)
         sin_cos = self._pre_sc[t].reshape(-1)[idx2].reshape(2, -1)
         pre_ratio = self._pre_ratio
-        ratio = _ratio(self._pre_u[t][idx]) if pre_ratio is None else pre_ratio[t][idx]
+        ratio = ratio_tabulated(self._pre_u[t][idx]) if pre_ratio is None else pre_ratio[t][idx]
         terrain = self._terrain_flat[self._t_stride @ np.rint(xy).astype(np.int64)]
-        c = terrain * self._m_fuel_dt * ratio
+        c = terrain * self._m_fuel * ratio
         xy += np.multiply(sin_cos, c)
         self._xy.reshape(-1)[idx2] = xy.reshape(-1)
         return xy
@@ -495,15 +530,19 @@ class Fire:
         self._moving = None
 
     def _refill(self) -> None:
-        """Compute the wind of the next ``_pre_len`` ticks of every front at once: row ``t`` is
-        what :func:`wind_draws` would give on tick ``t`` of the block, bit for bit."""
-        pre = (self._pre_z, self._pre_sc, self._pre_ratio)
+        """Compute the wind of the next ``_pre_len`` steps of every front at once: row ``t`` is
+        what :func:`wind_draws` (or :func:`~fcplan.farsite.wind_from_tables`, with the exact C/R
+        of each table entry) would give on step ``t`` of the block, bit for bit."""
+        z, sc, ratio, rng = self._pre_z, self._pre_sc, self._pre_ratio, self.rng
+        if self.wind_tables is not None and ratio is not None:  # (always drawn ahead)
+            draw_ahead_tables(rng, z, sc, ratio, self._tab_base, self.world_size, *self._tab)
+            return
         sd = (WIND_SPEED_SD, WIND_DIR_SD_RAD)
-        draw_ahead(self.rng, *pre, self._wind, self._theta, *sd, _interp_ratio)
+        draw_ahead(rng, z, sc, ratio, self._wind, self._theta, *sd, interp_ratio)
 
     def _set_next_wake(self) -> None:
-        """Tick at which the next inactive region activates (never: a huge number)."""
-        waiting = self.delay_ticks[~self.region_active]
+        """Step at which the next inactive region activates (never: a huge number)."""
+        waiting = self.start_step[~self.region_active]
         self._next_wake = int(waiting.min()) if waiting.size else _NEVER
 
     def _refresh_moving(self) -> np.ndarray:
@@ -513,11 +552,11 @@ class Fire:
         self._moving = idx
         self._all_moving = idx.size == self.n_fronts
         self._m_idx2 = np.concatenate([idx, idx + self.n_fronts])  # rows 0 and 1 of (2, n)
-        self._m_fuel_dt = self._fuel[idx] * self.dt
-        fuel_dt = self._fuel * self.dt
+        self._m_fuel = self._fuel[idx]
+        fuel = self._fuel.copy()
         idle = self.frozen | ~self.alive | ~self.region_active[self.region]
-        fuel_dt[idle] = 0.0
-        self._fuel_dt_masked = fuel_dt  # (n,): 0 for the fronts that do not move
+        fuel[idle] = 0.0
+        self._fuel_masked = fuel  # (n,): 0 for the fronts that do not move
         # coordinates of the idle fronts inside the map, as the step's check counts them
         self._idle_inside = int(np.count_nonzero(self._xy[:, idle].view(np.uint64) < self._w_bits))
         return idx
@@ -545,54 +584,12 @@ class Fire:
 
 
 _EMPTY = np.zeros(0, dtype=np.int64)
-
-
-def _ratio_grid() -> np.ndarray:
-    """Wind speeds at which C/R is tabulated: uniform, plus log-spaced points around the kinks
-    where LB(U) = 1 (there sqrt|LB^2 - 1| has an infinite slope)."""
-    from scipy.optimize import brentq
-
-    base = np.linspace(-40.0, 60.0, 20001)
-    gb = _lb(base) ** 2 - 1.0
-    pieces = [base]
-    for k in np.flatnonzero(np.sign(gb[:-1]) != np.sign(gb[1:])):
-        root = brentq(lambda u: _lb(u) ** 2 - 1.0, base[k], base[k + 1], xtol=1e-14)
-        off = np.logspace(-12, 0, 1500)
-        pieces += [root - off, root + off, np.array([root])]
-    return np.unique(np.concatenate(pieces))
-
-
-# C/R tabulated once (accuracy: module docstring): np.interp on a grid refined around the kinks,
-# and a uniform 0.001 grid indexed directly for large batches (np.interp's search is slow there).
-_U_GRID = _ratio_grid()
-_RATIO_TABLE = spread_rate_ratio(_U_GRID)
-_U_LO, _U_STEP, _U_N = -40.0, 1e-3, 100_001
-_UNI_TABLE = spread_rate_ratio(_U_LO + _U_STEP * np.arange(_U_N))
-_UNI_SLOPE = np.diff(_UNI_TABLE, append=_UNI_TABLE[-1])
-
-
-def _interp_ratio(u: np.ndarray) -> np.ndarray:
-    """Tabulated :func:`spread_rate_ratio` of a 1-D array by linear interpolation."""
-    return _interp(u, _U_GRID, _RATIO_TABLE, None, None)
-
-
-def _ratio(u: np.ndarray) -> np.ndarray:
-    """Tabulated :func:`spread_rate_ratio` for the per-tick hot path."""
-    if u.size <= _INTERP_MAX:
-        return _interp(u, _U_GRID, _RATIO_TABLE, None, None)
-    pos = (u - _U_LO) * (1.0 / _U_STEP)
-    np.clip(pos, 0.0, _U_N - 1.0, out=pos)
-    i = pos.astype(np.int64)
-    return _UNI_TABLE[i] + (pos - i) * _UNI_SLOPE[i]
-
-
 _ONE = np.uint32(1)
 _ONE32 = np.int32(1)
 _NEVER = 2**62
 _ZERO = np.float64(0.0)  # numpy scalars compare faster than Python numbers
 _UNBURNT8, _BURNING8, _PRUNED8 = np.uint8(UNBURNT), np.uint8(BURNING), np.uint8(PRUNED)
 _SMALL = 32  # up to this many fresh cells, _ignite works on Python ints
-_PRE_TICKS = 64  # ticks of draws and position-free terms computed ahead in one go ...
-_PRE_VALUES = 4096  # ... fewer for large fires: at most about this many fronts x ticks
-_INTERP_MAX = 256  # C/R by np.interp up to this many moving fronts (see _ratio)
-_VISIT_ROWS = 256  # ticks of front visits queued before they are added to the grid
+_PRE_TICKS = 64  # steps of draws and position-free terms computed ahead in one go ...
+_PRE_VALUES = 4096  # ... fewer for large fires: at most about this many fronts x steps
+_VISIT_ROWS = 256  # steps of front visits queued before they are added to the grid

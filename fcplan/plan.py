@@ -25,7 +25,12 @@ from fcplan.errors import PlanError
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Command
 
-__all__ = ["Plan", "validate_plan", "plan_commands"]
+__all__ = ["Plan", "validate_plan", "plan_commands", "MAX_ROUTE_LENGTH"]
+
+#: Most task visits in one agent's route. Validation refuses longer routes before looking at
+#: their tasks, so a runaway scheduler cannot make an episode crawl (a route of 10^6 goals used
+#: to turn a 20 s episode into 62 s); routes are replanned every period anyway.
+MAX_ROUTE_LENGTH = 1000
 
 
 @dataclass(frozen=True)
@@ -71,9 +76,21 @@ def validate_plan(plan: Plan, graph: TaskGraph) -> None:
     battery, and an active agent can reach its first task and still fly home on what it has left.
     The battery rule is the graph's (:attr:`fcplan.taskgraph.TaskGraph.in_round_trip` and
     :attr:`fcplan.taskgraph.TaskGraph.reachable`), which schedulers can read before they plan.
+    Every route is a sequence of at most :data:`MAX_ROUTE_LENGTH` task ids, checked first.
+
+    Examples
+    --------
+    >>> from fcplan.taskgraph import synthetic_task_graph
+    >>> g = synthetic_task_graph(2, 4, np.random.default_rng(0))
+    >>> agent = g.agent_ids[0]
+    >>> validate_plan(Plan(routes={agent: (g.task_ids[0],) * 1001}), g)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fcplan.errors.PlanError: agent ...: route of 1001 tasks is longer than MAX_ROUTE_LENGTH (1000)
     """
     if not isinstance(plan, Plan):
         raise PlanError(f"a scheduler must return a Plan, got {type(plan).__name__}")
+    _check_route_lengths(plan)
     try:
         if _plan_ok(plan, graph):
             return
@@ -83,6 +100,28 @@ def validate_plan(plan: Plan, graph: TaskGraph) -> None:
 
 
 _NUMBER = (int, float, np.integer, np.floating)
+
+
+def _check_route_lengths(plan: Plan) -> None:
+    """Every route is a sized sequence of at most :data:`MAX_ROUTE_LENGTH` items (before any
+    per-item work)."""
+    routes = plan.routes
+    if not isinstance(routes, Mapping):
+        raise PlanError(
+            f"plan routes must be a mapping of agent id -> route, got {type(routes).__name__}"
+        )
+    for agent, route in routes.items():
+        try:
+            n = len(route)
+        except TypeError:
+            raise PlanError(
+                f"agent {agent!r}: route must be a sequence of task ids, not {type(route).__name__}"
+            ) from None
+        if n > MAX_ROUTE_LENGTH:
+            raise PlanError(
+                f"agent {agent}: route of {n} tasks is longer than MAX_ROUTE_LENGTH "
+                f"({MAX_ROUTE_LENGTH})"
+            )
 
 
 def _plan_ok(plan: Plan, graph: TaskGraph) -> bool:

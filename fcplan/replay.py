@@ -16,8 +16,12 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from typing import TYPE_CHECKING, Any
 
 from fcplan.cliutil import CliError, check_output, positive_float, positive_int
+
+if TYPE_CHECKING:
+    from fcplan.recording import Recording
 
 __all__ = ["add_parser", "run", "has_display"]
 
@@ -34,7 +38,7 @@ def _non_negative(text: str) -> float:
     return v
 
 
-def add_parser(sub) -> None:
+def add_parser(sub: Any) -> None:
     """Add the ``replay`` sub-command to ``sub``."""
     p = sub.add_parser("replay", help="watch a recording, or write it as an MP4/GIF video")
     p.add_argument("path", help="recording (.npz) from fcplan run --record or fcplan play")
@@ -110,7 +114,7 @@ class _Progress:
         print(f"\rrendering frame {done}/{total}", end="", file=sys.stderr, flush=True)
 
 
-def play_window(rec, args: argparse.Namespace) -> int:
+def play_window(rec: Recording, args: argparse.Namespace) -> int:
     """Play ``rec`` in a pygame window at ``args.fps`` and ``args.speed``."""
     try:
         os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")

@@ -14,7 +14,21 @@ solver did.
 
 Schedulers are found by name: built-ins and third-party packages register a factory in the
 ``fcplan.schedulers`` entry-point group (``name = "module:Factory"``); :func:`register_scheduler`
-adds one at run time (handy in notebooks).
+adds one at run time (handy in notebooks). The built-ins are listed once, in the entry-point
+table of fcplan's ``pyproject.toml``: an installed fcplan reads it from its package metadata, a
+source checkout without metadata (``PYTHONPATH=.``) from the ``pyproject.toml`` next to the package.
+
+Settings. :func:`make_scheduler` is the one place where a scheduler spec (``"name:key=value"``
+or a name plus keyword settings) becomes a scheduler, for every command and API: an unknown
+name, an unknown setting, a malformed spec, and *any* exception a factory raises while checking
+its settings become one :class:`~fcplan.errors.FcplanError` line naming the scheduler, the
+setting and the reason (``scheduler 'milp': bad setting slots=0: slots must be >= 1``).
+Factories check their settings at construction with :func:`int_setting`,
+:func:`float_setting`, :func:`bool_setting` and :func:`choice_setting` (types, ranges, NaN), which
+raise :class:`SettingError`. A scheduler whose plans may depend on the wall clock offers a
+``deterministic`` setting (work limits instead of time limits, fixed seeds, one worker);
+:func:`supports_deterministic` tells whether a factory takes it, which is how comparisons and
+sweeps turn it on by default.
 
 Examples
 --------
@@ -27,10 +41,16 @@ True
 
 from __future__ import annotations
 
+import functools
+import inspect
+import math
+import re
 import time
-from collections.abc import Callable
+import tomllib
+from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass, field, replace
-from importlib.metadata import entry_points
+from importlib.metadata import EntryPoint, PackageNotFoundError, distribution, entry_points
+from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -43,7 +63,14 @@ __all__ = [
     "Scheduler",
     "SolveStats",
     "STATUSES",
+    "SettingError",
     "make_scheduler",
+    "scheduler_factory",
+    "supports_deterministic",
+    "int_setting",
+    "float_setting",
+    "bool_setting",
+    "choice_setting",
     "parse_scheduler_spec",
     "register_scheduler",
     "available_schedulers",
@@ -53,17 +80,11 @@ __all__ = [
 #: Possible :attr:`SolveStats.status` values.
 STATUSES = ("optimal", "feasible", "time_limit", "fallback", "heuristic")
 
-#: Built-in schedulers, used when the package's entry points are not installed (source checkout).
-_BUILTIN = {
-    "greedy": "solvers.greedy:GreedyScheduler",
-    "idle": "solvers.baselines:IdleScheduler",
-    "random": "solvers.baselines:RandomScheduler",
-    "routing": "solvers.routing:RoutingScheduler",
-    "milp": "solvers.milp:MilpScheduler",
-    "milp-cvxpy": "solvers.milp_cvxpy:MilpCvxpyScheduler",
-    "cbba": "solvers.cbba:CBBAScheduler",
-}
+#: The entry-point group schedulers register in.
+GROUP = "fcplan.schedulers"
+_PYPROJECT = Path(__file__).resolve().parents[1] / "pyproject.toml"
 _RUNTIME: dict[str, Callable[..., Any]] = {}
+_MISSING = object()
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,25 +139,40 @@ class Scheduler(Protocol):
         ...
 
 
-def _entry_points() -> dict[str, Any]:
-    return {ep.name: ep for ep in entry_points(group="fcplan.schedulers")}
+@functools.cache
+def _source_table(pyproject: Path) -> dict[str, str]:
+    """The ``fcplan.schedulers`` entry-point table of a source checkout's ``pyproject.toml``
+    (empty when there is none)."""
+    try:
+        doc = tomllib.loads(pyproject.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return {}
+    return dict(doc.get("project", {}).get("entry-points", {}).get(GROUP, {}))
+
+
+def _entry_points() -> dict[str, EntryPoint]:
+    """Scheduler name -> entry point, for every entry point in :data:`GROUP`.
+
+    Without fcplan's package metadata (a source checkout on ``PYTHONPATH``) the built-ins come
+    from ``pyproject.toml``; installed third-party entry points are added either way.
+    """
+    table = {ep.name: ep for ep in entry_points(group=GROUP)}
+    try:
+        distribution("fcplan")
+    except PackageNotFoundError:
+        source = _source_table(_PYPROJECT)
+        table = {**{n: EntryPoint(n, v, GROUP) for n, v in source.items()}, **table}
+    return table
 
 
 def available_schedulers() -> list[str]:
     """Names of every known scheduler (entry points, built-ins and run-time registrations)."""
-    return sorted(set(_BUILTIN) | set(_entry_points()) | set(_RUNTIME))
+    return sorted(set(_entry_points()) | set(_RUNTIME))
 
 
 def register_scheduler(name: str, factory: Callable[..., Scheduler]) -> None:
     """Register ``factory(**settings) -> Scheduler`` under ``name`` for this process."""
     _RUNTIME[name] = factory
-
-
-def _load(target: str) -> Callable[..., Scheduler]:
-    from importlib import import_module
-
-    module, _, attr = target.partition(":")
-    return getattr(import_module(module), attr)
 
 
 def parse_scheduler_spec(spec: str) -> tuple[str, dict[str, Any]]:
@@ -176,36 +212,244 @@ def _parse_value(text: str) -> Any:
     return text
 
 
-def make_scheduler(name: str, **settings: Any) -> Scheduler:
-    """Create a scheduler by registered name, passing ``settings`` to its factory.
+class SettingError(FcplanError, ValueError):
+    """A scheduler setting of the wrong type or out of range.
 
-    ``name`` may carry settings as a spec, ``"routing:deterministic=true"``
-    (:func:`parse_scheduler_spec`); keyword ``settings`` override those.
+    Factories raise it from their constructor (the helpers :func:`int_setting`,
+    :func:`float_setting`, :func:`bool_setting` and :func:`choice_setting` do);
+    :func:`make_scheduler` adds the scheduler's name. The message is one line:
+    ``scheduler 'greedy': bad setting route_length=0: must be an integer in 1..1000``.
+
+    Parameters
+    ----------
+    setting : str
+        The setting's name.
+    reason : str
+        What is wrong and what is allowed.
+    value : Any, optional
+        The offending value.
+    scheduler : str, optional
+        The scheduler's registered name.
+    """
+
+    def __init__(
+        self, setting: str, reason: str, *, value: Any = _MISSING, scheduler: str | None = None
+    ) -> None:
+        self.setting, self.reason, self.value, self.scheduler = setting, reason, value, scheduler
+        what = setting if value is _MISSING else f"{setting}={_show(value)}"
+        head = f"scheduler {scheduler!r}: " if scheduler else ""
+        super().__init__(f"{head}bad setting {what}: {reason}")
+
+    def for_scheduler(self, scheduler: str) -> SettingError:
+        """The same error naming ``scheduler``."""
+        return SettingError(self.setting, self.reason, value=self.value, scheduler=scheduler)
+
+
+def _show(value: Any) -> str:
+    """A setting's value for a message: short, one line."""
+    text = repr(value) if not isinstance(value, str) else value
+    text = text.replace("\n", " ")
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def int_setting(name: str, value: Any, lo: int, hi: int | None = None) -> int:
+    """``value`` as an int in ``lo..hi`` (bools and non-integral numbers refused).
+
+    Examples
+    --------
+    >>> int_setting("route_length", 3, 1, 1000)
+    3
+    >>> int_setting("route_length", 0, 1, 1000)
+    Traceback (most recent call last):
+    ...
+    fcplan.scheduling.SettingError: bad setting route_length=0: must be an integer in 1..1000
+    """
+    allowed = f"an integer in {lo}..{hi}" if hi is not None else f"an integer >= {lo}"
+    ok = isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+    if not ok or value < lo or (hi is not None and value > hi):
+        raise SettingError(name, f"must be {allowed}", value=value)
+    return int(value)
+
+
+def float_setting(
+    name: str,
+    value: Any,
+    lo: float,
+    hi: float = math.inf,
+    *,
+    lo_open: bool = False,
+    hi_open: bool = False,
+    unit: str = "",
+) -> float:
+    """``value`` as a finite float in the interval ``lo..hi`` (open ends as asked; NaN, infinities
+    and bools refused). ``hi=math.inf`` leaves it unbounded above (but finite).
+
+    Examples
+    --------
+    >>> float_setting("fresh_s", 2, 0, lo_open=True)
+    2.0
+    >>> float_setting("time_limit", float("nan"), 0, lo_open=True, unit=" s")
+    Traceback (most recent call last):
+    ...
+    fcplan.scheduling.SettingError: bad setting time_limit=nan: must be a finite number > 0 s
+    """
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)
+    )
+    v = float(value) if ok else math.nan
+    inside = (
+        math.isfinite(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+    )
+    if not inside:
+        raise SettingError(
+            name, f"must be {_interval(lo, hi, lo_open, hi_open)}{unit}", value=value
+        )
+    return v
+
+
+def _interval(lo: float, hi: float, lo_open: bool, hi_open: bool) -> str:
+    if math.isinf(hi):
+        return f"a finite number {'>' if lo_open else '>='} {lo:g}"
+    return f"a number in {'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+
+
+def bool_setting(name: str, value: Any) -> bool:
+    """``value`` as a bool (only ``True``/``False``; ``"true"`` in a spec is already a bool)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise SettingError(name, "must be true or false", value=value)
+    return bool(value)
+
+
+def choice_setting(name: str, value: Any, choices: Iterable[str]) -> str:
+    """``value`` if it is one of ``choices``."""
+    options = tuple(choices)
+    if not isinstance(value, str) or value not in options:
+        raise SettingError(name, f"must be one of {', '.join(options)}", value=value)
+    return value
+
+
+def scheduler_factory(name: str) -> Callable[..., Scheduler]:
+    """The factory registered under ``name`` (run-time registrations first).
 
     Raises
     ------
     fcplan.errors.UnknownNameError
         If no scheduler has that name (the message lists the known ones).
     """
+    if not isinstance(name, str):
+        raise FcplanError(f"schedulers are given by registered name, got {_show(name)}")
+    if name in _RUNTIME:
+        return _RUNTIME[name]
+    eps = _entry_points()
+    if name not in eps:
+        raise UnknownNameError(
+            f"unknown scheduler {name!r}; known schedulers: {', '.join(available_schedulers())}"
+        )
+    try:
+        return eps[name].load()
+    except Exception as exc:  # noqa: BLE001 - a broken plug-in is one line too
+        raise FcplanError(
+            f"scheduler {name!r} cannot be loaded: {type(exc).__name__}: {_show(str(exc))}"
+        ) from None
+
+
+def _accepted(factory: Callable[..., Any]) -> tuple[str, ...] | None:
+    """Keyword settings ``factory`` accepts, or None when it takes ``**kwargs`` (or hides its
+    signature)."""
+    try:
+        params = inspect.signature(factory).parameters.values()
+    except (TypeError, ValueError):
+        return None
+    if any(p.kind is p.VAR_KEYWORD for p in params):
+        return None
+    kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    return tuple(p.name for p in params if p.kind in kinds)
+
+
+def supports_deterministic(name: str) -> bool:
+    """Whether the scheduler ``name`` takes a ``deterministic`` setting.
+
+    A factory says so with a ``supports_deterministic`` attribute, or else by having a
+    ``deterministic`` parameter. Comparisons and sweeps pass ``deterministic=True`` to exactly
+    these schedulers unless the wall-time mode is chosen.
+
+    Examples
+    --------
+    >>> supports_deterministic("routing"), supports_deterministic("greedy")
+    (True, False)
+    """
+    factory = scheduler_factory(name.split(":")[0].strip())
+    flag = getattr(factory, "supports_deterministic", None)
+    if isinstance(flag, bool):
+        return flag
+    accepted = _accepted(factory)
+    return accepted is not None and "deterministic" in accepted
+
+
+def make_scheduler(name: str, **settings: Any) -> Scheduler:
+    """Create a scheduler by registered name, passing ``settings`` to its factory.
+
+    ``name`` may carry settings as a spec, ``"routing:deterministic=true"``
+    (:func:`parse_scheduler_spec`); keyword ``settings`` override those. This is the one
+    validation path of scheduler specs (see the module docstring).
+
+    Raises
+    ------
+    fcplan.errors.UnknownNameError
+        If no scheduler has that name (the message lists the known ones).
+    SettingError
+        An unknown setting, or one the factory refuses (any exception it raises), named with
+        the scheduler and the reason, on one line.
+    fcplan.errors.FcplanError
+        A malformed spec.
+
+    Examples
+    --------
+    >>> make_scheduler("greedy:route_length=0")
+    Traceback (most recent call last):
+    ...
+    fcplan.scheduling.SettingError: scheduler 'greedy': bad setting route_length=0: must be an integer in 1..1000
+    """
+    if not isinstance(name, str):
+        raise FcplanError(f"schedulers are given by registered name, got {_show(name)}")
     if ":" in name:
         name, spec_settings = parse_scheduler_spec(name)
         settings = {**spec_settings, **settings}
-    if name in _RUNTIME:
-        factory = _RUNTIME[name]
-    else:
-        eps = _entry_points()
-        if name in eps:
-            factory = eps[name].load()
-        elif name in _BUILTIN:
-            factory = _load(_BUILTIN[name])
-        else:
-            raise UnknownNameError(
-                f"unknown scheduler {name!r}; known schedulers: {', '.join(available_schedulers())}"
-            )
+    name = name.strip()
+    factory = scheduler_factory(name)
+    accepted = _accepted(factory)
+    if accepted is not None:
+        for key, value in settings.items():
+            if key not in accepted:
+                known = ", ".join(accepted) or "none"
+                raise SettingError(
+                    key, f"unknown setting; {name} takes: {known}", value=value, scheduler=name
+                )
     try:
         return factory(**settings)
-    except TypeError as exc:
-        raise FcplanError(f"scheduler {name!r}: bad settings {settings}: {exc}") from None
+    except SettingError as exc:
+        raise exc.for_scheduler(name) from None
+    except Exception as exc:  # noqa: BLE001 - any refusal of the settings is one line
+        raise _setting_error(name, settings, exc) from None
+
+
+def _setting_error(name: str, settings: dict[str, Any], exc: Exception) -> FcplanError:
+    """A factory's exception as a :class:`SettingError` naming the setting it is about: the
+    first setting its message mentions, else the only one given (a plain one-line
+    :class:`~fcplan.errors.FcplanError` when no setting was given)."""
+    reason = " ".join(str(exc).split()) or type(exc).__name__
+    if len(reason) > 200:
+        reason = reason[:197] + "..."
+    if not settings:
+        return FcplanError(f"scheduler {name!r} cannot be created: {type(exc).__name__}: {reason}")
+    if not isinstance(exc, (ValueError, TypeError)):  # say what kind of failure it was
+        reason = f"{type(exc).__name__}: {reason}"
+    named = [k for k in settings if re.search(rf"(?<![\w]){re.escape(k)}(?![\w])", reason)]
+    if named or len(settings) == 1:
+        key = (named or list(settings))[0]
+        return SettingError(key, reason, value=settings[key], scheduler=name)
+    given = ", ".join(f"{k}={_show(v)}" for k, v in settings.items()) or "none"
+    return SettingError(f"settings ({given})", reason, scheduler=name)
 
 
 _FALLBACK: Scheduler | None = None
@@ -246,5 +490,7 @@ def solve(
         stats = plan.stats if isinstance(plan.stats, SolveStats) else SolveStats()
     wall = time.perf_counter() - t0
     overrun = max(wall - time_limit, 0.0) if time_limit is not None else 0.0
-    stats = replace(stats, wall_time_s=wall, time_limit_s=time_limit, overrun_s=overrun)
+    # every replan records the graph's size (the scheduler's own size keys win)
+    size = {"agents": graph.n_agents, "tasks": graph.n_tasks, **stats.size}
+    stats = replace(stats, wall_time_s=wall, time_limit_s=time_limit, overrun_s=overrun, size=size)
     return plan.with_stats(stats)

@@ -20,7 +20,10 @@ map, m of altitude, battery units, simulated seconds.
   ``2 tan(pi/6) z`` (about ``1.1547 z``) high (y); cell ``(i, j)`` is inside when ``|i - x| <= z``
   and ``|j - y| <= 0.57735 z`` (inclusive, as the reference).
 * **Sensing confidence.** ``c = 1 - 0.6 (z - lo) / (hi - lo)`` (1 when ``lo == hi``): 100% at the
-  lowest altitude, 40% at the highest (manual, sensing).
+  lowest altitude, 40% at the highest (manual, sensing). ``c`` is the probability per 10 Hz tick
+  to sense a burning cell in view; at ``r`` ticks per second a tick senses it with
+  :func:`per_tick_probability` ``1 - (1 - c)^(10 / r)``, so that the probability to have sensed a
+  cell after ``T`` seconds in view, ``1 - (1 - c)^(10 T)``, does not depend on the rate.
 * **Battery.** Flying drains 0.1 per px and hovering ``0.05 s`` per tick (the manual's "0.1 per
   unit length, 0.05 per iteration"). An active agent heads home (and later resumes its route) as
   soon as ``B <= 0.1 |home - p| + 0.2 v s + 0.1 s``: after one more step, which can also lengthen
@@ -33,6 +36,11 @@ map, m of altitude, battery units, simulated seconds.
   its route (or flies back to the last goal it was holding), after a commanded return (or the
   3-second rule) it stays idle.
 * **3-second rule.** An action agent hovering at its last goal for 3 s goes home and idles.
+
+Per simulated second, distance flown, climb, battery drain and the 3-second clock do not depend on
+the tick rate. What does, by at most one tick: an agent snaps onto a goal within one step of it
+and starts the next leg on the next tick, so each goal costs on average half a tick (0.1 s at 5 Hz,
+0.05 s at 10 Hz), and the battery reserve keeps one step's margin.
 
 Teams of up to :data:`SMALL_TEAM` agents run bit-identical kernels of these rules on Python numbers
 (:mod:`fcplan._fast.team`); the numpy methods here are the rules' specification.
@@ -54,6 +62,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import Any
 
 import numpy as np
 
@@ -65,6 +74,7 @@ from fcplan.scenario.model import (
 from fcplan.scenario.model import Role, Scenario
 
 __all__ = ["Mode", "Command", "Team", "fov_half_extent", "sensing_confidence"]
+__all__ += ["per_tick_probability"]
 
 FOV_TAN_X = 1.0  # tan(pi/4): half-width per metre of altitude (exact, not 0.999...)
 FOV_TAN_Y = math.tan(math.pi / 6)  # half-height per metre of altitude
@@ -72,6 +82,7 @@ DRAIN_PER_PX = 0.1
 DRAIN_PER_HOVER_TICK = 0.05  # at 10 ticks/s
 CLIMB_PER_TICK = 5.0  # m per tick at 10 ticks/s
 ACTION_IDLE_LIMIT_S = 3.0
+REFERENCE_TPS = 10  # the rate at which the manual's per-frame quantities hold
 #: teams up to this many agents move on Python floats (:mod:`fcplan._fast.team`)
 SMALL_TEAM = 16
 
@@ -139,6 +150,24 @@ def sensing_confidence(z: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndar
     return np.clip(c, 0.4, 1.0)
 
 
+def per_tick_probability(p: Any, ticks_per_second: int) -> Any:
+    """Probability per tick at ``ticks_per_second`` with the hazard of ``p`` per 10 Hz tick.
+
+    ``1 - (1 - p)^(10 / ticks_per_second)``, and ``p`` itself (the same object) at 10 ticks per
+    second. Works on floats and arrays.
+
+    Examples
+    --------
+    >>> per_tick_probability(0.4, 10), round(per_tick_probability(0.4, 20), 4)
+    (0.4, 0.2254)
+    >>> round(1 - (1 - per_tick_probability(0.4, 40)) ** 4, 12)  # one 10 Hz tick's worth
+    0.4
+    """
+    if ticks_per_second == REFERENCE_TPS:
+        return p
+    return 1.0 - (1.0 - p) ** (REFERENCE_TPS / ticks_per_second)
+
+
 _IDLE, _ACTIVE, _RETURNING, _HOMING = (int(m) for m in Mode)
 _ROLE_ACTION = int(Role.ACTION)
 _NO_ROWS = np.zeros(0, dtype=np.int64)
@@ -189,6 +218,7 @@ class Team:
         self._index = {a: i for i, a in enumerate(self.ids)}
         n = len(agents)
         self.n = n
+        self.ticks_per_second = scenario.ticks_per_second
         self.tick_scale = 10.0 / scenario.ticks_per_second  # 10 Hz quantities -> this rate
         self.dt_s = 1.0 / scenario.ticks_per_second
         self.role = np.array([int(a.role) for a in agents], dtype=np.int8)
@@ -271,9 +301,15 @@ class Team:
         return fov_rects_small(self)
 
     def sensing_confidence(self) -> np.ndarray:
-        """(N,) probability to sense each burning cell in view (0 for agents that cannot sense)."""
+        """(N,) probability per 10 Hz tick to sense each burning cell in view (0 for agents that
+        cannot sense)."""
         c = 1.0 - 0.6 * (self.z - self.alt_lo) * self._inv_span
         return np.minimum(np.maximum(c, 0.4), 1.0) * self.can_sense
+
+    def sensing_probability(self) -> np.ndarray:
+        """(N,) probability per tick at this rate to sense each burning cell in view:
+        :func:`per_tick_probability` of :meth:`sensing_confidence`."""
+        return per_tick_probability(self.sensing_confidence(), self.ticks_per_second)
 
     def return_cost(self) -> np.ndarray:
         """(N,) battery needed to fly straight home from where each agent is."""

@@ -16,11 +16,18 @@ range(1, 1801, 10)
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from fcplan.errors import FcplanError
+
+if TYPE_CHECKING:
+    from fcplan.recording import Recording
+
+#: called as ``progress(done, total)`` after each frame
+Progress = Callable[[int, int], None]
 
 __all__ = ["VideoError", "replay_ticks", "write_video", "VIDEO_SUFFIXES"]
 
@@ -85,8 +92,8 @@ def _pad(img: np.ndarray, multiple: int) -> np.ndarray:
 
 
 def write_video(
-    recording,
-    path: str | os.PathLike,
+    recording: Recording,
+    path: str | os.PathLike[str],
     *,
     fps: float = 10.0,
     speed: float = 1.0,
@@ -94,7 +101,7 @@ def write_video(
     show_truth: bool = False,
     start_s: float = 0.0,
     end_s: float | None = None,
-    progress=None,
+    progress: Progress | None = None,
 ) -> int:
     """Render a recording's ticks to an MP4 or GIF file; return the number of frames.
 
@@ -128,7 +135,9 @@ def write_video(
     return encode(images, path, fps, len(ticks), progress)
 
 
-def _write_mp4(images: Iterable[np.ndarray], path: str, fps: float, total: int, progress) -> int:
+def _write_mp4(
+    images: Iterable[np.ndarray], path: str, fps: float, total: int, progress: Progress | None
+) -> int:
     try:
         import imageio.v2 as imageio
         import imageio_ffmpeg  # noqa: F401  (the ffmpeg binary imageio needs)
@@ -160,7 +169,9 @@ def _write_mp4(images: Iterable[np.ndarray], path: str, fps: float, total: int, 
     return n
 
 
-def _write_gif(images: Iterable[np.ndarray], path: str, fps: float, total: int, progress) -> int:
+def _write_gif(
+    images: Iterable[np.ndarray], path: str, fps: float, total: int, progress: Progress | None
+) -> int:
     try:
         from PIL import Image
     except ImportError:
@@ -178,7 +189,9 @@ def _write_gif(images: Iterable[np.ndarray], path: str, fps: float, total: int, 
         out = idx if prev is None else np.where(idx == prev, _GIF_CLEAR, idx).astype(np.uint8)
         prev = idx
         frame = Image.fromarray(out, mode="P")
-        frame.putpalette(palette.getpalette()[: 3 * _GIF_COLORS] + [0, 0, 0] * (256 - _GIF_COLORS))
+        colors = palette.getpalette()
+        assert colors is not None  # (a quantized image has a palette)
+        frame.putpalette(colors[: 3 * _GIF_COLORS] + [0, 0, 0] * (256 - _GIF_COLORS))
         frames.append(frame)
         if progress is not None:
             progress(len(frames), total)

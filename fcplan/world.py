@@ -36,15 +36,23 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from fcplan._fast.team import sensing_confidence_of
 from fcplan._fast.world import scan_box as _scan_box
 from fcplan._fast.world import step_info_builder
 from fcplan.fire import _BURNING8, Fire, _unique
-from fcplan.team import Command, Team
-from fcplan.trace import Trace
+from fcplan.team import Command, Team, per_tick_probability
+from fcplan.trace import TRACE_FIELDS, Trace
+
+if TYPE_CHECKING:
+    from fcplan.scenario import Scenario
+
+#: What seeds an episode: an int, a SeedSequence, a Generator, or None (fresh OS entropy).
+Seed = int | np.integer | np.random.SeedSequence | np.random.Generator | None
 
 __all__ = ["World", "StepInfo"]
 
@@ -100,25 +108,31 @@ class World:
         (the trace copies them lazily, from the last change on).
     """
 
-    def __init__(self, scenario=None, seed=None) -> None:
-        self.scenario = None
+    scenario: Scenario  # set by the first reset()
+
+    def __init__(self, scenario: Scenario | None = None, seed: Seed = None) -> None:
+        # (a flag, not a look into __dict__: reading an instance's __dict__ makes Python 3.11+
+        # materialise it, and every attribute access of the per-tick path gets slower)
+        self._started = False
         if scenario is not None:
             self.reset(scenario, seed)
 
     # ------------------------------------------------------------------ setup
-    def reset(self, scenario=None, seed=None) -> World:
+    def reset(self, scenario: Scenario | None = None, seed: Seed = None) -> World:
         """Start a new episode (same scenario if none is given); return ``self``."""
         if scenario is None:
-            scenario = self.scenario
-            if scenario is None:
+            if not self._started:
                 raise ValueError("World.reset needs a scenario the first time")
+            scenario = self.scenario
         self.scenario = scenario
         self.seed = seed
         streams = _spawn(seed, 4)
         rng_fire, self.rng_sense, self.rng_prune, self.controller_rng = streams
         w = scenario.world_size
         self.world_size = w
-        self.fire = Fire(scenario.regions, w, scenario.ticks_per_second, rng_fire)
+        self.fire = Fire(
+            scenario.regions, w, scenario.ticks_per_second, rng_fire, wind_model=scenario.wind_model
+        )
         self.team = Team(scenario)
         self._tps = scenario.ticks_per_second
         self._sensing_rows = np.flatnonzero(self.team.can_sense).tolist()
@@ -143,24 +157,14 @@ class World:
         self.n_sensed_ever = 0
         self.tick = 0
         self._alloc_trace(scenario.n_ticks)
+        self._started = True
         return self
 
     def _alloc_trace(self, rows: int) -> None:
-        n, f = self.team.n, self.n_facilities
-        rows = max(rows, 1)
-        self._rows = {
-            "active": np.zeros(rows, np.int64),
-            "pruned": np.zeros(rows, np.int64),
-            "sensed_active": np.zeros(rows, np.int64),
-            "sensed_ever": np.zeros(rows, np.int64),
-            "facility_burning": np.zeros((rows, f), np.int64),
-            "facility_pruned": np.zeros((rows, f), np.int64),
-            "xyz": np.zeros((rows, n, 3), np.float64),
-            "battery": np.zeros((rows, n), np.float64),
-            "tank": np.zeros((rows, n), np.int16),
-            "mode": np.zeros((rows, n), np.int8),
-            "dumps": np.zeros((rows, n), np.int16),
-        }
+        """Allocate ``rows`` trace rows of every :data:`fcplan.trace.TRACE_FIELDS` array, by the
+        field's row name (agent fields without their ``agent_`` prefix)."""
+        dims = {"T": max(rows, 1), "N": self.team.n, "F": self.n_facilities}
+        self._rows: dict[str, np.ndarray] = {f.name: f.zeros(dims) for f in TRACE_FIELDS}
         self._n_recorded = 0  # trace rows recorded (ticks stepped since the reset)
         self._fac_rows = 0  # facility trace rows written so far (see _sync_facility_rows)
         self._record_views()
@@ -195,7 +199,7 @@ class World:
         self._sync_facility_rows()
         return self._rows[name][start:stop].sum(axis=0)
 
-    def ignite(self, xy) -> np.ndarray:
+    def ignite(self, xy: npt.ArrayLike) -> np.ndarray:
         """Set cells burning by hand (spot fires, tests); return the flat indices that ignited.
 
         Parameters
@@ -215,7 +219,7 @@ class World:
     # ------------------------------------------------------------------ dynamics
     def step(self, commands: Mapping[str | int, Command] | None = None) -> StepInfo:
         """Advance one tick with optional per-agent commands; return what happened."""
-        if self.scenario is None:
+        if not self._started:
             raise ValueError("World.step before World.reset")
         team, fire = self.team, self.fire
         if commands:  # (Team.apply does nothing without commands: the call is saved)
@@ -228,8 +232,8 @@ class World:
         rects = team.fov_rects_list()
         sensed, newly = self._sense(rects)
         if True in team.armed.tolist():  # (else _prune finds no dump: the call is saved)
-            pruned, dumped = self._prune(rects)
-            dumped = tuple(dumped)
+            pruned, dumped_rows = self._prune(rects)
+            dumped: tuple[int, ...] = tuple(dumped_rows)
         else:
             pruned, dumped = _EMPTY, ()
         self._record(tick - 1)
@@ -279,7 +283,8 @@ class World:
             flat = self._cells(state[x0:x1, y0:y1] == _BURNING8, x0, y0)
             if flat.size == 0:
                 continue
-            keep = self.rng_sense.random(flat.size) < sensing_confidence_of(team, i)
+            p = per_tick_probability(sensing_confidence_of(team, i), self._tps)
+            keep = self.rng_sense.random(flat.size) < p
             if np.count_nonzero(keep):
                 parts.append(flat[keep])
         if not parts:
@@ -375,7 +380,7 @@ class World:
         """Cache the trace arrays :meth:`_record` writes every tick (the xy and z parts of ``xyz``
         apart; not the facility rows, see :meth:`_sync_facility_rows`)."""
         r = self._rows
-        self._row_views = (
+        self._row_views: tuple[Any, ...] = (
             len(r["active"]),
             r["active"],
             r["pruned"],
@@ -428,7 +433,7 @@ class World:
         self._n_recorded = k + 1
 
 
-def _spawn(seed, n: int) -> list[np.random.Generator]:
+def _spawn(seed: Seed, n: int) -> list[np.random.Generator]:
     """``n`` independent generators from an int, SeedSequence, Generator or None."""
     if isinstance(seed, np.random.Generator):
         return list(seed.spawn(n))

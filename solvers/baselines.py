@@ -1,5 +1,9 @@
 """Lower baselines: ``idle`` does nothing, ``random`` sends each agent to a random task.
 
+``idle`` takes no settings; ``random`` takes ``keep_probability``, a number in [0, 1] checked at
+construction (a wrong type or NaN is a one-line :class:`fcplan.scheduling.SettingError`). Neither
+depends on the wall clock: ``random`` draws from the episode's controller stream only.
+
 Examples
 --------
 >>> from fcplan import run_episode
@@ -14,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from fcplan.plan import Plan
-from fcplan.scheduling import SolveStats
+from fcplan.scheduling import SolveStats, float_setting
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
 
@@ -25,6 +29,7 @@ class IdleScheduler:
     """Never moves anyone: the score of doing nothing."""
 
     name = "idle"
+    deterministic = True
 
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Return the empty plan."""
@@ -42,9 +47,10 @@ class RandomScheduler:
     """
 
     name = "random"
+    deterministic = True
 
     def __init__(self, keep_probability: float = 0.5) -> None:
-        self.keep_probability = float(keep_probability)
+        self.keep_probability = float_setting("keep_probability", keep_probability, 0.0, 1.0)
 
     def plan(
         self, graph: TaskGraph, *, time_limit: float | None = None, rng: np.random.Generator

@@ -20,6 +20,23 @@ Each replan, in this order:
 Agents on a forced return (battery or tank) are planned from their depot slot with a full
 battery: they resume the new route after recharging.
 
+Settings are checked at construction (:func:`fcplan.scheduling.int_setting` and friends): a wrong
+type, NaN or a value outside its range is a one-line :class:`fcplan.scheduling.SettingError`.
+
+==================== ======= ============ ===============================================
+setting              type    range        meaning
+==================== ======= ============ ===============================================
+route_length         int     1..1000      fire tasks per action agent per replan
+search_route_length  int     1..1000      search blocks per searching perception agent
+fresh_s              float   > 0          seconds a sensed fire stays fresh
+watch_altitude       float   (0, 10000]   m, clipped to each agent's bounds
+search_altitude      float   (0, 10000]   m, clipped to each agent's bounds
+max_watch_fraction   float   [0, 1]       share of perception agents that may watch
+spread_px            float   >= 0         px around a taken block that are discounted
+==================== ======= ============ ===============================================
+
+The plans never depend on the wall clock or the time limit (``deterministic`` is always True).
+
 Examples
 --------
 >>> from fcplan import run_episode
@@ -34,8 +51,8 @@ from typing import Any
 
 import numpy as np
 
-from fcplan.plan import Plan
-from fcplan.scheduling import SolveStats
+from fcplan.plan import MAX_ROUTE_LENGTH, Plan
+from fcplan.scheduling import SolveStats, float_setting, int_setting
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
 
@@ -65,6 +82,8 @@ class GreedyScheduler:
     """
 
     name = "greedy"
+    #: The plans never depend on the wall clock (there is no time-limited search).
+    deterministic = True
 
     def __init__(
         self,
@@ -76,13 +95,19 @@ class GreedyScheduler:
         max_watch_fraction: float = 0.5,
         spread_px: float = 250.0,
     ) -> None:
-        self.route_length = int(route_length)
-        self.search_route_length = int(search_route_length)
-        self.fresh_s = float(fresh_s)
-        self.watch_altitude = float(watch_altitude)
-        self.search_altitude = float(search_altitude)
-        self.max_watch_fraction = float(max_watch_fraction)
-        self.spread_px = float(spread_px)
+        self.route_length = int_setting("route_length", route_length, 1, MAX_ROUTE_LENGTH)
+        self.search_route_length = int_setting(
+            "search_route_length", search_route_length, 1, MAX_ROUTE_LENGTH
+        )
+        self.fresh_s = float_setting("fresh_s", fresh_s, 0.0, lo_open=True, unit=" s")
+        self.watch_altitude = float_setting(
+            "watch_altitude", watch_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
+        )
+        self.search_altitude = float_setting(
+            "search_altitude", search_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
+        )
+        self.max_watch_fraction = float_setting("max_watch_fraction", max_watch_fraction, 0.0, 1.0)
+        self.spread_px = float_setting("spread_px", spread_px, 0.0, unit=" px")
 
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:

@@ -1,8 +1,10 @@
-"""Tests for fcplan.fire: FARSITE statistics, delays, pruning, map edges, determinism."""
+"""Tests for fcplan.fire: FARSITE statistics, the fire's clock, delays, pruning, map edges,
+wind models, determinism."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -37,13 +39,35 @@ def test_mean_first_step_is_about_quarter_fuel_at_wind_5():
         assert 0.22 * fuel < mean < 0.26 * fuel, mean
 
 
-def test_step_rescales_with_tick_rate():
-    """At 20 ticks/s a front moves half as far per tick as at 10 ticks/s."""
-    a = Fire([region(fronts=40_000)], 1200, 10, np.random.default_rng(2))
-    b = Fire([region(fronts=40_000)], 1200, 20, np.random.default_rng(2))
-    sa = np.hypot(*first_step(a)).mean()
-    sb = np.hypot(*first_step(b)).mean()
-    assert abs(sb / sa - 0.5) < 0.02
+@pytest.mark.parametrize("tps", [1, 3, 5, 7, 10, 20, 40])
+def test_fire_takes_ten_steps_per_simulated_second_at_any_rate(tps):
+    """After tick t at r ticks/s the fire has taken floor(10 t / r) steps, and (without pruning)
+    its fronts, cells and visits are bit for bit those of the 10 Hz fire after as many steps."""
+    regions = [region(fronts=30), region(center=(300, 900), fronts=5, delay_s=1.25)]
+    ref = Fire(regions, 1200, 10, np.random.default_rng(2))
+    fire = Fire(regions, 1200, tps, np.random.default_rng(2))
+    for t in range(1, 6 * tps + 1):
+        fire.step()
+        assert fire.n_steps == 10 * t // tps
+        while ref.n_steps < fire.n_steps:
+            ref.step()
+        np.testing.assert_array_equal(fire._xy, ref._xy)
+        np.testing.assert_array_equal(fire.state, ref.state)
+    np.testing.assert_array_equal(fire.visits, ref.visits)
+
+
+@pytest.mark.parametrize(("tps", "wake_tick"), [(5, 8), (10, 15), (20, 30), (40, 60)])
+def test_region_wakes_on_the_first_step_after_its_delay(tps, wake_tick):
+    """A region delayed 1.45 s starts with step 15 (1.5 s): its ignition cells burn on the tick
+    that runs step 15 and its fronts have not moved before that step."""
+    fire = Fire([region(delay_s=1.45)], 1200, tps, np.random.default_rng(3))
+    assert fire.start_step.tolist() == [15]
+    start = fire._xy.copy()
+    for t in range(1, wake_tick):
+        assert fire.step().size == 0 and fire.n_burning == 0, t
+    np.testing.assert_array_equal(fire._xy, start)
+    assert fire.step().size > 0
+    assert fire.n_steps >= 15 and fire.region_active.all()
 
 
 def test_drift_follows_wind_azimuth():
@@ -164,9 +188,10 @@ def test_one_visit_gives_reference_peak_intensity():
 
 
 def test_tabulated_spread_ratio_matches_formula():
-    """The per-tick lookup tables of C/R agree with the FARSITE formula (1e-4 for small batches;
+    """The per-step lookup tables of C/R agree with the FARSITE formula (1e-4 for small batches;
     1.5e-4 for large ones away from the two kinks of sqrt|LB^2 - 1|, 0.0066 at them)."""
-    from fcplan.fire import _RATIO_TABLE, _U_GRID, _ratio
+    from fcplan.farsite import _RATIO_TABLE, _U_GRID
+    from fcplan.farsite import ratio_tabulated as _ratio
 
     u = np.linspace(-40, 60, 400_001)
     exact = spread_rate_ratio(u)
@@ -204,3 +229,27 @@ def test_front_stepping_into_a_pruned_cell_freezes_there_unburnt():
         fire.step()
     assert fire.frozen.any()
     assert (fire._state_flat[fire.cell[fire.frozen]] == PRUNED).all()
+
+
+def test_tables_model_draws_every_front_wind_from_its_region_tables():
+    """In the tables model each region has W speeds ~ N(U, 2) and W directions ~ N(theta, 2):
+    every front's wind of every step is one entry of its own region's tables."""
+    regions = [region(wind_speed=5), region(center=(300, 300), wind_speed=12, wind_dir_deg=90)]
+    fire = Fire(regions, 1000, 10, np.random.default_rng(13), wind_model="tables")
+    tables = fire.wind_tables
+    assert tables.shape == (2, 2, 1000)
+    assert abs(tables[1, 0].mean() - 12) < 0.3 and abs(tables[1, 0].std() - 2) < 0.2
+    assert abs(tables[1, 1].mean() - np.pi / 2) < 0.3 and abs(tables[1, 1].std() - 2) < 0.2
+    fire.step()
+    u, sin_t = fire._pre_u[:, :], fire._pre_sc[:, 0]
+    for r in (0, 1):
+        rows = fire.region == r
+        assert np.isin(u[:, rows], tables[r, 0]).all()
+        assert np.isin(sin_t[:, rows], np.sin(tables[r, 1])).all()
+    np.testing.assert_array_equal(fire._pre_ratio, spread_rate_ratio(u))
+
+
+def test_unknown_wind_model_is_refused():
+    """A wind model other than fresh or tables is a ValueError naming the allowed values."""
+    with pytest.raises(ValueError, match="fresh"):
+        Fire([region()], 1200, 10, np.random.default_rng(0), wind_model="gusty")

@@ -33,7 +33,7 @@ import pytest
 if __name__ == "__main__":  # (run as a script: make ``tests`` and ``fcplan`` importable)
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import fcplan.episode  # noqa: E402
+import fcplan.mission  # noqa: E402
 from fcplan import World, load_scenario, run_episode  # noqa: E402
 from fcplan.belief import Belief  # noqa: E402
 from fcplan.scheduling import make_scheduler  # noqa: E402
@@ -75,7 +75,9 @@ def digest_belief(d: Digests, b: Belief) -> None:
     d.add("belief.known", b.known)
     d.add("belief.known_last_seen", b._last_seen_flat[b.known])
     d.add("belief.coverage", b.coverage)
-    d.add("belief.scalars", np.array([b.tick, b.n_pruned, b.new_fire_since_plan], np.int64))
+    # (third: whether any fire was ever sensed, the flag the belief kept when the file was written)
+    ever = bool((b.last_seen >= 0).any())
+    d.add("belief.scalars", np.array([b.tick, b.n_pruned, ever], np.int64))
 
 
 def digest_graph(d: Digests, g) -> None:
@@ -112,7 +114,7 @@ def _scenario(name: str, duration_s: float | None, gate: str | None = None):
 
 @contextmanager
 def _recording_episode(d: Digests):
-    """Patch run_episode's World and Belief with recording subclasses."""
+    """Patch the World and Belief of run_episode's mission with recording subclasses."""
     holder: dict = {}
 
     class RecWorld(World):
@@ -136,8 +138,8 @@ def _recording_episode(d: Digests):
                 digest_belief(d, self)
 
     with (
-        mock.patch.object(fcplan.episode, "World", RecWorld),
-        mock.patch.object(fcplan.episode, "Belief", RecBelief),
+        mock.patch.object(fcplan.mission, "World", RecWorld),
+        mock.patch.object(fcplan.mission, "Belief", RecBelief),
     ):
         yield holder
 

@@ -289,3 +289,37 @@ def test_commands_drive_the_world():
     assert after < before
     assert g.task_kind[g.task_index["search:D-05"]] == TaskKind.SEARCH
     assert Role(int(g.agent_role[i])) is Role.PERCEPTION
+
+
+# ---------------------------------------------------------------------- route length cap
+def test_routes_longer_than_the_cap_are_refused_before_their_tasks_are_read():
+    """A route of more than MAX_ROUTE_LENGTH goals (even of valid tasks, even 10^6 of them) and
+    a route that is not a sized sequence (a generator) raise one-line PlanErrors naming the
+    agent; a route of exactly MAX_ROUTE_LENGTH valid goals passes."""
+    from fcplan.plan import MAX_ROUTE_LENGTH
+
+    g = start_graph()
+    p1 = "P1"
+    task = g.task_ids[int(np.flatnonzero(g.reachable[g.agent_index[p1]])[0])]
+    validate_plan(Plan(routes={p1: (task,) * MAX_ROUTE_LENGTH}), g)
+    raises_naming(Plan(routes={p1: (task,) * (MAX_ROUTE_LENGTH + 1)}), g, p1, "MAX_ROUTE_LENGTH")
+    raises_naming(Plan(routes={p1: ("no-such-task",) * 10**6}), g, p1, "1000000 tasks")
+    raises_naming(Plan(routes={p1: (t for t in [task])}), g, p1, "sequence")
+
+
+def test_solve_falls_back_on_a_runaway_route():
+    """solve() turns a scheduler's over-long route into a greedy fallback that names the cap."""
+    from fcplan.plan import MAX_ROUTE_LENGTH
+    from fcplan.scheduling import solve
+
+    g = start_graph()
+    task = g.task_ids[int(np.flatnonzero(g.reachable[g.agent_index["P1"]])[0])]
+
+    class Runaway:
+        name = "runaway"
+
+        def plan(self, graph, *, time_limit, rng):
+            return Plan(routes={"P1": (task,) * (10 * MAX_ROUTE_LENGTH)})
+
+    out = solve(Runaway(), g, time_limit=None, rng=np.random.default_rng(0))
+    assert out.stats.status == "fallback" and "MAX_ROUTE_LENGTH" in out.stats.message

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import importlib
 import math
+import tomllib
 from functools import lru_cache
+from importlib.metadata import PackageNotFoundError
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -88,6 +92,36 @@ def test_make_scheduler_finds_builtins(name):
     assert s.name == name
     assert name in available_schedulers()
     assert fcplan.make_scheduler is make_scheduler
+
+
+def _pyproject_table() -> dict[str, str]:
+    doc = tomllib.loads((Path(scheduling.__file__).parents[1] / "pyproject.toml").read_text())
+    return doc["project"]["entry-points"][scheduling.GROUP]
+
+
+def test_source_checkout_reads_the_pyproject_table(monkeypatch):
+    """Without fcplan's package metadata (a source checkout on PYTHONPATH, nothing installed)
+    the registry is exactly pyproject.toml's entry-point table, and its names make schedulers."""
+
+    def no_metadata(name):
+        raise PackageNotFoundError(name)
+
+    monkeypatch.setattr(scheduling, "distribution", no_metadata)
+    monkeypatch.setattr(scheduling, "entry_points", lambda group: [])
+    monkeypatch.setattr(scheduling, "_RUNTIME", {})
+    table = _pyproject_table()
+    assert available_schedulers() == sorted(table)
+    assert {"greedy", "idle", "random", "routing", "milp", "cbba"} <= set(table)
+    for name in BUILTINS:
+        assert make_scheduler(name).name == name
+
+
+def test_every_table_entry_names_a_scheduler_factory():
+    """Each pyproject.toml entry point loads a factory whose scheduler has the entry's name."""
+    for name, target in _pyproject_table().items():
+        module, _, attr = target.partition(":")
+        factory = getattr(importlib.import_module(module), attr)
+        assert factory().name == name
 
 
 @pytest.mark.parametrize("name", BUILTINS)
@@ -256,5 +290,111 @@ def test_scheduler_specs_carry_settings():
     assert make_scheduler("greedy:route_length=1", route_length=4).route_length == 4
     with pytest.raises(FcplanError, match="name:key=value"):
         make_scheduler("greedy:route_length")
-    with pytest.raises(FcplanError, match="bad settings"):
+    with pytest.raises(FcplanError, match="bad setting no_such_setting=1: unknown setting"):
         make_scheduler("greedy:no_such_setting=1")
+
+
+# ------------------------------------------------------------------ one validation path for specs
+def _one_line_setting_error(spec: str, setting: str) -> str:
+    from fcplan.scheduling import SettingError
+
+    with pytest.raises(SettingError) as exc:
+        make_scheduler(spec)
+    msg = str(exc.value)
+    assert "\n" not in msg and len(msg) < 400
+    assert exc.value.setting == setting and exc.value.scheduler == spec.split(":")[0]
+    assert msg.startswith(f"scheduler {spec.split(':')[0]!r}: bad setting {setting}")
+    return msg
+
+
+@pytest.mark.parametrize(
+    "spec, setting",
+    [
+        ("greedy:route_length=0", "route_length"),
+        ("greedy:route_length=2.5", "route_length"),
+        ("greedy:route_length=true", "route_length"),
+        ("greedy:route_length=x", "route_length"),
+        ("greedy:fresh_s=nan", "fresh_s"),
+        ("greedy:fresh_s=-1", "fresh_s"),
+        ("greedy:search_altitude=inf", "search_altitude"),
+        ("greedy:max_watch_fraction=1.5", "max_watch_fraction"),
+        ("greedy:spread_px=-0.1", "spread_px"),
+        ("greedy:search_route_length=0", "search_route_length"),
+        ("random:keep_probability=nan", "keep_probability"),
+        ("random:keep_probability=2", "keep_probability"),
+        ("idle:anything=1", "anything"),
+        ("routing:time_limit=nan", "time_limit"),
+        ("routing:time_limit=0", "time_limit"),
+        ("routing:time_limit=-1", "time_limit"),
+        ("milp:slots=0", "slots"),
+    ],
+)
+def test_bad_settings_are_one_line_setting_errors(spec, setting):
+    """Every refused setting (a helper's check, a factory's own ValueError, an unknown keyword)
+    comes out of make_scheduler as one SettingError line naming scheduler, setting and value."""
+    msg = _one_line_setting_error(spec, setting)
+    assert spec.split(":", 1)[1].split("=")[0] in msg
+
+
+def test_factory_exceptions_name_the_setting_they_mention():
+    """A factory raising a plain exception is reported against the setting its message names,
+    or the only setting given; without settings it is a 'cannot be created' line."""
+    from fcplan.scheduling import SettingError, register_scheduler
+
+    def picky(a: int = 1, b: int = 2):
+        if a < 0:
+            raise RuntimeError("a must be >= 0")
+        if b < 0:
+            raise ZeroDivisionError("nope")
+        raise OSError("broken plug-in")
+
+    register_scheduler("picky-test", picky)
+    with pytest.raises(SettingError, match="bad setting a=-1: RuntimeError: a must be >= 0"):
+        make_scheduler("picky-test", a=-1, b=3)
+    with pytest.raises(SettingError, match="bad setting b=-1: ZeroDivisionError: nope"):
+        make_scheduler("picky-test", b=-1)
+    with pytest.raises(FcplanError, match="cannot be created: OSError: broken plug-in"):
+        make_scheduler("picky-test")
+
+
+def test_setting_helpers_refuse_types_nan_and_ranges():
+    """int_setting refuses bools, floats and out-of-range ints; float_setting refuses NaN, inf,
+    bools, strings and values outside its (open or closed) interval; bool_setting and
+    choice_setting accept only their values."""
+    from fcplan.scheduling import (
+        SettingError,
+        bool_setting,
+        choice_setting,
+        float_setting,
+        int_setting,
+    )
+
+    assert int_setting("n", np.int64(3), 1, 5) == 3
+    for bad in (True, 2.0, "2", 0, 6, None):
+        with pytest.raises(SettingError):
+            int_setting("n", bad, 1, 5)
+    assert float_setting("x", 1, 0, 1) == 1.0
+    for bad in (float("nan"), float("inf"), True, "1", 0, 1.0):
+        with pytest.raises(SettingError):
+            float_setting("x", bad, 0, 1, lo_open=True, hi_open=True)
+    assert bool_setting("d", np.bool_(True)) is True
+    with pytest.raises(SettingError):
+        bool_setting("d", 1)
+    assert choice_setting("c", "a", ("a", "b")) == "a"
+    with pytest.raises(SettingError, match="one of a, b"):
+        choice_setting("c", "z", ("a", "b"))
+
+
+def test_supports_deterministic_reads_the_attribute_or_the_signature():
+    """supports_deterministic is True for factories with a deterministic parameter or a
+    supports_deterministic = True attribute, False otherwise (greedy, idle, random)."""
+    from fcplan.scheduling import register_scheduler, supports_deterministic
+
+    def with_flag(**settings):  # hides its signature
+        return make_scheduler("idle")
+
+    with_flag.supports_deterministic = True  # type: ignore[attr-defined]
+    register_scheduler("flagged-test", with_flag)
+    assert supports_deterministic("routing")
+    assert supports_deterministic("flagged-test:x=1")
+    assert not any(supports_deterministic(n) for n in ("greedy", "idle", "random"))

@@ -1,11 +1,12 @@
-"""Kernels of :class:`fcplan.fire.Fire`'s tick.
+"""Kernels of :class:`fcplan.fire.Fire`'s step.
 
 * :func:`draw_ahead` computes the position-free part of the FARSITE step (the two normal draws of
   every front, the wind speed ``U``, ``C/R`` of ``U``, ``sin`` and ``cos`` of ``Theta``) for a
-  block of ticks in a few numpy calls. The normals are drawn as one ``(T, 2, n)`` array, which
-  takes them from the generator in the order ``T`` per-tick draws of shape ``(2, n)`` would, and
-  element by element the arithmetic is the per-tick one (:func:`fcplan.fire.wind_draws`), so the
-  fronts move exactly as if everything were computed tick by tick.
+  block of steps in a few numpy calls. The normals are drawn as one ``(T, 2, n)`` array, which
+  takes them from the generator in the order ``T`` per-step draws of shape ``(2, n)`` would, and
+  element by element the arithmetic is the per-step one (:func:`fcplan.farsite.wind_draws`), so
+  the fronts move exactly as if everything were computed step by step. :func:`draw_ahead_tables`
+  is the same for the tables wind model (:func:`fcplan.farsite.wind_from_tables`).
 * :func:`advance_whole` is the FARSITE step over the whole ``(2, n)`` position array in place,
   without gathering the moving fronts: the fronts that do not move get a zero spread
   (``x + (+-0.0) == x``; positions are never ``-0.0``).
@@ -24,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["draw_ahead", "advance_whole", "ignite_cells", "unique"]
+__all__ = ["draw_ahead", "draw_ahead_tables", "advance_whole", "ignite_cells", "unique"]
 
 _EMPTY = np.zeros(0, dtype=np.int64)
 
@@ -40,7 +41,7 @@ def draw_ahead(
     dir_sd: float,
     ratio_of: Callable[[np.ndarray], np.ndarray],
 ) -> None:
-    """Fill the wind of the next ``T`` ticks of ``n`` fronts in place.
+    """Fill the wind of the next ``T`` steps of ``n`` fronts in place (fresh wind model).
 
     Parameters
     ----------
@@ -73,6 +74,50 @@ def draw_ahead(
         ratio[:] = ratio_of(u.reshape(-1)).reshape(u.shape)
 
 
+def draw_ahead_tables(
+    rng: np.random.Generator,
+    z: np.ndarray,
+    sin_cos: np.ndarray,
+    ratio: np.ndarray,
+    base: np.ndarray,
+    length: int,
+    tab_u: np.ndarray,
+    tab_sin: np.ndarray,
+    tab_cos: np.ndarray,
+    tab_ratio: np.ndarray,
+) -> None:
+    """:func:`draw_ahead` for the tables model: the wind of the next ``T`` steps of ``n`` fronts,
+    picked from their regions' tables, in place.
+
+    The table indices are drawn as one ``(T, 2, n)`` integer array, which takes them from the
+    generator in the order ``T`` per-step draws of shape ``(2, n)`` would
+    (:func:`fcplan.farsite.wind_from_tables`); the values are gathered from per-entry arrays.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+    z : ndarray, (T, 2, n) float64
+        ``z[:, 0]`` receives the wind speeds ``U`` (``z[:, 1]`` is left alone).
+    sin_cos : ndarray, (T, 2, n) float64
+        Receives ``sin(Theta)`` (``[:, 0]``) and ``cos(Theta)`` (``[:, 1]``).
+    ratio : ndarray, (T, n) float64
+        Receives ``C/R`` of ``U``.
+    base : ndarray, (n,) int64
+        Offset of each front's region in the flat tables (``region * length``).
+    length : int
+        Entries per table.
+    tab_u, tab_sin, tab_cos, tab_ratio : ndarray, (R * length,) float64
+        Per table entry: the speed, ``sin`` and ``cos`` of the direction, and ``C/R`` of the speed.
+    """
+    idx = rng.integers(0, length, size=z.shape)
+    idx += base
+    i_u, i_dir = idx[:, 0], idx[:, 1]
+    z[:, 0] = tab_u[i_u]
+    ratio[:] = tab_ratio[i_u]
+    sin_cos[:, 0] = tab_sin[i_dir]
+    sin_cos[:, 1] = tab_cos[i_dir]
+
+
 def advance_whole(fire: Any, t: int, ratio: np.ndarray, all_moving: bool) -> np.ndarray:
     """``Fire._advance_moving`` over every front, in place; return the ``(2, n)`` positions.
 
@@ -82,7 +127,7 @@ def advance_whole(fire: Any, t: int, ratio: np.ndarray, all_moving: bool) -> np.
     t : int
         Row of the drawn-ahead wind to use.
     ratio : ndarray, (n,) float64
-        ``C/R`` of every front this tick.
+        ``C/R`` of every front this step.
     all_moving : bool
         Every front moves; otherwise the fronts that do not move (dead, frozen, region inactive)
         get a zero spread and dead ones, just off the map, read a clipped terrain cell.
@@ -90,10 +135,10 @@ def advance_whole(fire: Any, t: int, ratio: np.ndarray, all_moving: bool) -> np.
     xy, sc = fire._xy, fire._pre_sc[t]
     cells = fire._t_stride @ np.rint(xy).astype(np.int64)
     if all_moving:
-        fuel, fuel_dt = fire._terrain_flat[cells], fire._m_fuel_dt
+        terrain, fuel = fire._terrain_flat[cells], fire._m_fuel
     else:
-        fuel, fuel_dt = fire._terrain_flat.take(cells, mode="clip"), fire._fuel_dt_masked
-    c = fuel * fuel_dt * ratio
+        terrain, fuel = fire._terrain_flat.take(cells, mode="clip"), fire._fuel_masked
+    c = terrain * fuel * ratio
     # x += C sin(Theta), y += C cos(Theta)
     xy += np.multiply(sc, c, out=fire._move)
     return xy

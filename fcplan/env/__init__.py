@@ -9,12 +9,25 @@ Two levels of control over the same simulator:
 ``mode="motion"`` (:mod:`fcplan.env.motion`)
     One step is one tick: moves, altitude, dump, with local field-of-view observations.
     :class:`PlanFollower` (:mod:`fcplan.env.motion_expert`) drives it with any scheduler's plans.
+    The 2020 MARL package's grid environments (``base``, ``cmplx1``, ``cmplx2``) are its presets
+    (:mod:`fcplan.env.presets`).
 
 Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with a centralised
 joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any
 registered scheduler, stored as npz without pickle) and :mod:`fcplan.env.bc` (a small numpy
 behaviour-cloning baseline). Everything is imported lazily, so ``import fcplan.env`` is cheap
-and does not need PettingZoo until an environment is made.
+and does not need PettingZoo until an environment is made; it registers the Gymnasium ids
+``fcplan/Task-v0``, ``fcplan/Motion-v0``, ``fcplan/MotionBase-v0``, ``fcplan/MotionCmplx1-v0``
+and ``fcplan/MotionCmplx2-v0`` (:mod:`fcplan.env.registration`).
+
+Standard integrations: the versioned PettingZoo modules :mod:`~fcplan.env.task_v0`,
+:mod:`~fcplan.env.motion_v0`, :mod:`~fcplan.env.base_v0`, :mod:`~fcplan.env.cmplx1_v0` and
+:mod:`~fcplan.env.cmplx2_v0` (``env()``, ``parallel_env()``, ``raw_env``;
+:mod:`fcplan.env.versions`); the options ``obs_layout="flat"`` and ``pad_actions=True``
+(:mod:`fcplan.env.wrappers`), which give the ``{"observation", "action_mask"}`` layout and equal
+action spaces that SuperSuit's vector wrappers need; ``render_mode="human"``
+(:mod:`fcplan.env.human`). :class:`~fcplan.errors.EnvError` is
+defined in :mod:`fcplan.errors` and exported here.
 
 Examples
 --------
@@ -30,9 +43,12 @@ Examples
 from __future__ import annotations
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from fcplan.errors import FcplanError
+from fcplan.errors import EnvError
+
+if TYPE_CHECKING:
+    from pettingzoo import AECEnv, ParallelEnv
 
 __all__ = [
     "EnvError",
@@ -47,15 +63,11 @@ __all__ = [
     "Demonstrations",
     "replay_actions",
     "PlanFollower",
+    "VERSIONED",
 ]
 
 #: Environment levels accepted by :func:`parallel_env`.
 MODES = ("task", "motion")
-
-
-class EnvError(FcplanError, ValueError):
-    """Bad environment argument or action (the message names the argument/agent and the
-    allowed range)."""
 
 
 _LAZY = {
@@ -70,7 +82,13 @@ _LAZY = {
 }
 
 
+#: the versioned PettingZoo modules, imported on first access as attributes
+VERSIONED = ("task_v0", "motion_v0", "base_v0", "cmplx1_v0", "cmplx2_v0")
+
+
 def __getattr__(name: str) -> Any:
+    if name in VERSIONED:
+        return import_module(f"fcplan.env.{name}")
     if name in _LAZY:
         value = getattr(import_module(_LAZY[name]), name)
         globals()[name] = value
@@ -78,38 +96,69 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'fcplan.env' has no attribute {name!r}")
 
 
-def parallel_env(scenario, mode: str = "task", **kwargs: Any):
+def parallel_env(
+    scenario: Any,
+    mode: str = "task",
+    *,
+    obs_layout: str = "dict",
+    pad_actions: bool = False,
+    render_mode: str | None = None,
+    **kwargs: Any,
+) -> ParallelEnv:
     """Make a PettingZoo ``ParallelEnv`` on ``scenario``.
 
     Parameters
     ----------
     scenario : Scenario or str or int
-        A scenario or a name/path for :func:`fcplan.load_scenario`.
+        A scenario or a name/path for :func:`fcplan.load_scenario` (at the motion level also a
+        preset name: ``"base"``, ``"cmplx1"``, ``"cmplx2"``).
     mode : {"task", "motion"}
         ``"task"``: :class:`fcplan.env.task.TaskEnv` (one step per replan period);
         ``"motion"``: :func:`fcplan.env.motion.parallel_env` (one step per tick).
+    obs_layout : {"dict", "flat"}
+        ``"flat"``: ``{"observation", "action_mask"}`` per agent
+        (:class:`fcplan.env.wrappers.FlatObservations`); ``"dict"`` (default): the env's own.
+    pad_actions : bool
+        Give every agent the team's largest ``Discrete`` space, extra actions masked
+        (:class:`fcplan.env.wrappers.PadActions`).
+    render_mode : {None, "rgb_array", "human"}
+        ``"human"`` shows the frames in a pygame window (:mod:`fcplan.env.human`).
     **kwargs
         Passed to the environment (see its module docstring).
 
     Raises
     ------
     EnvError
-        If ``mode`` is not one of :data:`MODES`.
+        If ``mode`` is not one of :data:`MODES`, or ``obs_layout`` is unknown.
     """
+    from fcplan.env.wrappers import split_options, wrap
+
+    inner_mode, human = split_options(render_mode)
+    if inner_mode is not None:
+        kwargs["render_mode"] = inner_mode
+    env: ParallelEnv
     if mode == "task":
         from fcplan.env.task import TaskEnv
 
-        return TaskEnv(scenario, **kwargs)
-    if mode == "motion":
+        env = TaskEnv(scenario, **kwargs)
+    elif mode == "motion":
         from fcplan.env.motion import parallel_env as motion_env
 
-        return motion_env(scenario, **kwargs)
-    raise EnvError(f"mode: must be one of {', '.join(MODES)} (got {mode!r})")
+        env = motion_env(scenario, **kwargs)
+    else:
+        raise EnvError(f"mode: must be one of {', '.join(MODES)} (got {mode!r})")
+    return wrap(env, obs_layout=obs_layout, pad_actions=pad_actions, human=human)
 
 
-def aec_env(scenario, mode: str = "task", **kwargs: Any):
+def aec_env(scenario: Any, mode: str = "task", **kwargs: Any) -> AECEnv:
     """The same environment as :func:`parallel_env`, as a PettingZoo ``AECEnv``
     (``pettingzoo.utils.parallel_to_aec``)."""
     from pettingzoo.utils import parallel_to_aec
 
     return parallel_to_aec(parallel_env(scenario, mode, **kwargs))
+
+
+# Gymnasium ids (fcplan/Task-v0 ...): registered on import, see fcplan.env.registration
+from fcplan.env.registration import register_envs as _register_envs  # noqa: E402
+
+_register_envs()

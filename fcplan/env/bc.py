@@ -34,9 +34,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from fcplan.mission import ScenarioLike
+    from fcplan.scheduling import Scheduler
 
 __all__ = [
     "BCPolicy",
@@ -92,8 +96,9 @@ class BCPolicy:
         return np.argmax(self.logits(agent_obs, task_obs, mask), axis=1)
 
 
-def fit_bc(demo, *, l2: float = 1e-3, max_iter: int = 300) -> BCPolicy:
-    """Fit :class:`BCPolicy` to a :class:`~fcplan.env.demonstrations.Demonstrations` dataset."""
+def fit_bc(demo: Any, *, l2: float = 1e-3, max_iter: int = 300) -> BCPolicy:
+    """Fit :class:`BCPolicy` to a :class:`~fcplan.env.demonstrations.Demonstrations` dataset (or
+    anything with its ``agent_obs``, ``task_obs``, ``mask`` and ``action`` arrays)."""
     from scipy.optimize import minimize
 
     phi = _phi(demo.agent_obs, demo.task_obs)  # (N, k, P)
@@ -124,8 +129,8 @@ def fit_bc(demo, *, l2: float = 1e-3, max_iter: int = 300) -> BCPolicy:
 
 
 def dagger(
-    scheduler,
-    scenarios: Sequence,
+    scheduler: str | Scheduler,
+    scenarios: Sequence[ScenarioLike],
     seeds: Sequence[int],
     *,
     rounds: int = 2,
@@ -154,8 +159,10 @@ def dagger(
                 env.reset(seed=seed)
                 rng = env.world.controller_rng
                 while env.agents:
-                    plan = solve(expert, env.graph, time_limit=time_limit, rng=rng)
-                    data["action"].append(plan_to_actions(plan, env.graph, env.candidates))
+                    graph, cand = env.graph, env.candidates
+                    assert graph is not None and cand is not None  # (built by reset and step)
+                    plan = solve(expert, graph, time_limit=time_limit, rng=rng)
+                    data["action"].append(plan_to_actions(plan, graph, cand))
                     data["agent_obs"].append(env._agent_obs)
                     data["task_obs"].append(env._task_obs)
                     data["mask"].append(env._mask)
@@ -175,14 +182,16 @@ def random_policy(rng: np.random.Generator) -> Policy:
     return act
 
 
-def rollout(policy: Policy, scenario, seed: int, *, env_kwargs: dict[str, Any] | None = None):
+def rollout(
+    policy: Policy, scenario: ScenarioLike, seed: int, *, env_kwargs: dict[str, Any] | None = None
+) -> dict[str, Any]:
     """Play one episode of ``policy`` in the task env; return the final ``infos`` of agent 0."""
     from fcplan.env.task import TaskEnv
 
     env = TaskEnv(scenario, **(env_kwargs or {}))
     env.reset(seed=seed)
     ids = env.possible_agents
-    infos: dict = {}
+    infos: dict[str, Any] = {}
     while env.agents:
         act = policy(env._agent_obs, env._task_obs, env._mask)
         _, _, _, _, infos = env.step(dict(zip(ids, np.asarray(act).tolist(), strict=True)))
@@ -191,7 +200,7 @@ def rollout(policy: Policy, scenario, seed: int, *, env_kwargs: dict[str, Any] |
 
 def evaluate(
     policy: Policy,
-    scenario,
+    scenario: ScenarioLike,
     seeds: Sequence[int],
     *,
     env_kwargs: dict[str, Any] | None = None,
@@ -208,8 +217,8 @@ def evaluate(
 
 
 def scheduler_scores(
-    scheduler,
-    scenario,
+    scheduler: str | Scheduler,
+    scenario: ScenarioLike,
     seeds: Sequence[int],
     *,
     env_kwargs: dict[str, Any] | None = None,

@@ -38,11 +38,8 @@ How an env episode differs from ``run_episode`` with the same scheduler
     event replans when new fire is sensed, and no candidate limit. In the env each agent executes
     only the *first* task of its route per step (then hovers until the next step), with the env's
     altitude rule, periodic steps only, the top-``k`` candidates, and the env's conflict rule.
-    :func:`episode_gap` measures the resulting score difference. Measured on #1, #8, #12 and
-    #24 with seeds 0-1 (``k=8``, manual final score, mean of 8 episodes): greedy 267.5 through
-    the env vs 279.3 in ``run_episode`` (-11.8); milp 275.1 vs 262.8 (+12.3). Per episode the
-    difference ranges from -32 to +52 points; 0.3-4 % of the plans' first tasks fell outside the
-    top ``k`` and at most 3 conflicts occurred per episode.
+    :func:`episode_gap` measures the resulting score difference (figures in
+    ``bench/README.md``).
 
 Examples
 --------
@@ -70,7 +67,8 @@ from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import MappingCounts, plan_to_actions
 from fcplan.env.task_candidates import AGENT_FEATURES, TASK_FEATURES
 from fcplan.errors import FcplanError
-from fcplan.scheduling import make_scheduler, parse_scheduler_spec, solve
+from fcplan.mission import ScenarioLike, as_scenario
+from fcplan.scheduling import Scheduler, make_scheduler, parse_scheduler_spec, solve
 
 __all__ = [
     "Demonstrations",
@@ -138,9 +136,10 @@ class Demonstrations:
         """Write a compressed ``.npz`` (no pickled objects); return the path."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        meta = np.array(json.dumps(self.metadata, sort_keys=True))
+        entries: dict[str, Any] = {"metadata": np.array(json.dumps(self.metadata, sort_keys=True))}
+        entries.update(self.arrays)
         with open(path, "wb") as fh:
-            np.savez_compressed(fh, metadata=meta, **self.arrays)
+            np.savez_compressed(fh, **entries)
         return path
 
 
@@ -185,7 +184,7 @@ def _versions() -> dict[str, str]:
     return out
 
 
-def _scheduler(spec) -> tuple[Any, str, dict[str, Any]]:
+def _scheduler(spec: str | Scheduler) -> tuple[Scheduler, str, dict[str, Any]]:
     if isinstance(spec, str):
         name, settings = parse_scheduler_spec(spec)
         return make_scheduler(spec), name, settings
@@ -198,8 +197,8 @@ def _scheduler(spec) -> tuple[Any, str, dict[str, Any]]:
 
 
 def demonstrations(
-    scheduler,
-    scenarios: Iterable,
+    scheduler: str | Scheduler,
+    scenarios: Iterable[ScenarioLike],
     seeds: Iterable[int],
     path: str | Path | None = None,
     *,
@@ -225,19 +224,14 @@ def demonstrations(
     -------
     Demonstrations
     """
-    from fcplan.env.task import _load
-
     sched, name, settings = _scheduler(scheduler)
     env_kwargs = dict(env_kwargs or {})
     env_kwargs.pop("render_mode", None)
     seeds = [int(s) for s in seeds]
-    parts: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
-    episodes: list[dict[str, Any]] = []
-    scen_docs: dict[str, dict] = {}
-    counts = MappingCounts()
-    fallbacks = conflicts = 0
+    rollouts = _Rollouts(sched, time_limit)
+    scen_docs: dict[str, dict[str, Any]] = {}
     for sc in scenarios:
-        scenario = _load(sc)
+        scenario = as_scenario(sc)
         doc = scenario.to_dict()
         key = scenario.name
         while key in scen_docs and scen_docs[key] != doc:  # same name, other content
@@ -245,43 +239,7 @@ def demonstrations(
         scen_docs[key] = doc
         env = TaskEnv(scenario, **env_kwargs)
         for seed in seeds:
-            env.reset(seed=seed)
-            rng = env.world.controller_rng
-            ep = len(episodes)
-            n_a = env.n_agents
-            step = 0
-            while env.agents:
-                plan = solve(sched, env.graph, time_limit=time_limit, rng=rng)
-                fallbacks += plan.stats.status == "fallback"
-                act = plan_to_actions(plan, env.graph, env.candidates, counts)
-                parts["agent_obs"].append(env._agent_obs)
-                parts["task_obs"].append(env._task_obs)
-                parts["mask"].append(env._mask)
-                parts["action"].append(act)
-                _, rew, _, trunc, infos = env.step(
-                    dict(zip(env.possible_agents, act.tolist(), strict=True))
-                )
-                first = infos[env.possible_agents[0]]
-                conflicts += sum(infos[a]["conflict"] for a in env.possible_agents)
-                parts["reward"].append(np.full(n_a, rew[env.possible_agents[0]]))
-                parts["done"].append(np.full(n_a, trunc[env.possible_agents[0]]))
-                parts["episode"].append(np.full(n_a, ep))
-                parts["step"].append(np.full(n_a, step))
-                parts["agent"].append(np.arange(n_a))
-                step += 1
-            episodes.append(
-                {
-                    "scenario": key,
-                    "seed": seed,
-                    "steps": step,
-                    "metrics": first["metrics"],
-                    "return": first["return"],
-                }
-            )
-    arrays = {
-        k: (np.concatenate(v) if v else np.zeros((0,), dt)).astype(dt, copy=False)
-        for (k, dt), v in zip(_ARRAYS.items(), parts.values(), strict=True)
-    }
+            rollouts.play(env, key, seed)
     meta = {
         "format": "fcplan-demonstrations",
         "version": FORMAT_VERSION,
@@ -292,17 +250,73 @@ def demonstrations(
         "k": int(env_kwargs.get("k", 8)),
         "agent_features": list(AGENT_FEATURES),
         "task_features": list(TASK_FEATURES),
-        "mapping": dict(counts),
-        "conflicts": int(conflicts),
-        "fallbacks": int(fallbacks),
-        "episodes": episodes,
+        "mapping": dict(rollouts.counts),
+        "conflicts": int(rollouts.conflicts),
+        "fallbacks": int(rollouts.fallbacks),
+        "episodes": rollouts.episodes,
         "scenarios": scen_docs,
         "versions": _versions(),
     }
-    demo = Demonstrations(arrays, meta)
+    demo = Demonstrations(rollouts.arrays(), meta)
     if path is not None:
         demo.save(path)
     return demo
+
+
+class _Rollouts:
+    """The rows, mapping counts and episode records of a scheduler's env rollouts."""
+
+    def __init__(self, scheduler: Scheduler, time_limit: float | None) -> None:
+        self.scheduler, self.time_limit = scheduler, time_limit
+        self.parts: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
+        self.episodes: list[dict[str, Any]] = []
+        self.counts = MappingCounts()
+        self.fallbacks = self.conflicts = 0
+
+    def play(self, env: TaskEnv, scenario_key: str, seed: int) -> None:
+        """One episode of ``env`` with ``seed``: the scheduler's plan on the env's graph at each
+        step, mapped to actions one to one (module docstring)."""
+        parts, ids = self.parts, env.possible_agents
+        env.reset(seed=seed)
+        rng = env.world.controller_rng
+        ep, n_a = len(self.episodes), env.n_agents
+        step = 0
+        first: dict[str, Any] = {}
+        while env.agents:
+            graph, cand = env.graph, env.candidates
+            assert graph is not None and cand is not None  # (built by reset and step)
+            plan = solve(self.scheduler, graph, time_limit=self.time_limit, rng=rng)
+            self.fallbacks += getattr(plan.stats, "status", None) == "fallback"
+            act = plan_to_actions(plan, graph, cand, self.counts)
+            parts["agent_obs"].append(env._agent_obs)
+            parts["task_obs"].append(env._task_obs)
+            parts["mask"].append(env._mask)
+            parts["action"].append(act)
+            _, rew, _, trunc, infos = env.step(dict(zip(ids, act.tolist(), strict=True)))
+            first = infos[ids[0]]
+            self.conflicts += sum(infos[a]["conflict"] for a in ids)
+            parts["reward"].append(np.full(n_a, rew[ids[0]]))
+            parts["done"].append(np.full(n_a, trunc[ids[0]]))
+            parts["episode"].append(np.full(n_a, ep))
+            parts["step"].append(np.full(n_a, step))
+            parts["agent"].append(np.arange(n_a))
+            step += 1
+        self.episodes.append(
+            {
+                "scenario": scenario_key,
+                "seed": seed,
+                "steps": step,
+                "metrics": first["metrics"],
+                "return": first["return"],
+            }
+        )
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The dataset's arrays (module docstring), rows of every episode in order."""
+        return {
+            k: (np.concatenate(v) if v else np.zeros((0,), dt)).astype(dt, copy=False)
+            for (k, dt), v in zip(_ARRAYS.items(), self.parts.values(), strict=True)
+        }
 
 
 def _jsonable_kwargs(env_kwargs: dict[str, Any]) -> dict[str, Any]:

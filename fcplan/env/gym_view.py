@@ -13,6 +13,9 @@ Episode end         ``truncated`` at the scenario's duration (or ``max_steps``);
                     ``terminated`` is always False
 Info                ``tick``; per-agent ``illegal``/``conflict`` arrays; at the end
                     ``metrics`` (manual and reference2020 as dicts) and ``return``
+Render modes        ``"rgb_array"`` (the task env's frame) and ``"human"`` (that frame in a
+                    pygame window, :mod:`fcplan.env.human`)
+Gymnasium id        ``fcplan/Task-v0`` (:mod:`fcplan.env.registration`)
 ==================  ==================================================================
 
 Masked-out actions (an unmasked ``action_space.sample()``, as ``check_env`` does) act as the
@@ -37,12 +40,16 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from fcplan.env.human import HumanWindow, WindowedRender
 from fcplan.env.task import TaskEnv
+from fcplan.env.wrappers import split_options
+from fcplan.errors import EnvError
+from fcplan.mission import ScenarioLike
 
 __all__ = ["TaskGymEnv", "gym_env"]
 
 
-class TaskGymEnv(gymnasium.Env):
+class TaskGymEnv(WindowedRender, gymnasium.Env):
     """Centralised Gymnasium view of :class:`TaskEnv` (see the module docstring).
 
     Parameters
@@ -52,12 +59,19 @@ class TaskGymEnv(gymnasium.Env):
         :class:`TaskEnv` keyword arguments (``illegal_action`` is forced to ``"noop"``).
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 4}
 
-    def __init__(self, scenario, **kwargs: Any) -> None:
+    def __init__(self, scenario: ScenarioLike, **kwargs: Any) -> None:
         kwargs["illegal_action"] = "noop"
+        self.render_mode = kwargs.get("render_mode")
+        if self.render_mode not in (None, "rgb_array", "human"):
+            raise EnvError(
+                f"render_mode: must be None, 'rgb_array' or 'human' (got {self.render_mode!r})"
+            )
+        kwargs["render_mode"], human = split_options(self.render_mode)
+        #: the pygame window of ``render_mode="human"`` (else None)
+        self.window = HumanWindow("fcplan_task_v0", self.metadata["render_fps"]) if human else None
         self.env = TaskEnv(scenario, **kwargs)
-        self.render_mode = self.env.render_mode
         e = self.env
         a, k = e.n_agents, e.k
         sub = e.observation_space(e.possible_agents[0])
@@ -75,13 +89,16 @@ class TaskGymEnv(gymnasium.Env):
         e = self.env  # fresh arrays every step: no copies needed
         return {"agents": e._agent_obs, "tasks": e._task_obs, "action_mask": e._mask}
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         """Start an episode; ``seed`` as :meth:`TaskEnv.reset`."""
         super().reset(seed=seed)
         self.env.reset(seed=seed, options=options)
+        self._show()
         return self._obs(), {"tick": 0}
 
-    def step(self, action):
+    def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         """Apply the joint action; return ``(obs, reward, terminated, truncated, info)``."""
         e = self.env
         ids = e.possible_agents
@@ -96,16 +113,10 @@ class TaskGymEnv(gymnasium.Env):
         if "metrics" in first:
             info["metrics"] = first["metrics"]
             info["return"] = first["return"]
+        self._show()
         return self._obs(), float(rew[ids[0]]), False, bool(trunc[ids[0]]), info
 
-    def render(self):
-        """The task env's ``rgb_array`` frame (or None)."""
-        return self.env.render()
 
-    def close(self) -> None:
-        """Nothing to release."""
-
-
-def gym_env(scenario, **kwargs: Any) -> TaskGymEnv:
+def gym_env(scenario: ScenarioLike, **kwargs: Any) -> TaskGymEnv:
     """Make the Gymnasium view of the task level (keyword arguments as :class:`TaskEnv`)."""
     return TaskGymEnv(scenario, **kwargs)

@@ -4,7 +4,7 @@
 :class:`fcplan.World`: every UAV of the scenario is an agent and chooses a discrete move every
 tick. ``parallel_env(preset="base" | "cmplx1" | "cmplx2")`` (or the preset name in place of the
 scenario) returns one of the reference MARL package's three environments instead
-(:mod:`fcplan.env.motion_presets`).
+(:mod:`fcplan.env.presets`).
 
 Agents
     The scenario's agent ids in team order (``"P1", "P2", "A1", ...``). All agents stay until the
@@ -60,11 +60,11 @@ State
     ``fov``), staleness, perception-capable agents, action-capable agents, lakes, facilities.
 
 Reward
-    Shared by all agents: the manual's negative reward of this tick,
-    ``-(0.1 |active| + sum_f PC_f n_f) / tps`` (:func:`fcplan.metrics.negative_reward_rate`), so
-    the episode's return equals minus the manual's total negative reward. Optional shaping
-    (off by default): ``+ sense_bonus`` per newly sensed cell, ``+ prune_bonus`` per pruned cell,
-    ``- dump_cost`` per dump.
+    Shared by all agents: ``reward_fn`` of the tick (a :class:`fcplan.env.reward.RewardFn`; by
+    default :class:`~fcplan.env.reward.PenaltyReward`, the manual's negative reward of this tick,
+    ``-(0.1 |active| + sum_f PC_f n_f) / tps``), so the episode's return equals minus the manual's
+    total negative reward. Optional shaping (off by default): ``+ sense_bonus`` per newly sensed
+    cell, ``+ prune_bonus`` per pruned cell, ``- dump_cost`` per dump.
 
 Termination and truncation
     No termination; every agent is truncated when the scenario's duration has been simulated
@@ -75,13 +75,17 @@ Arguments
     ``cell_px`` (20), ``view`` (15, odd), ``stale_s`` (30.0), ``idle_rule`` (False: the
     3-second rule that sends an action agent hovering 3 s at its last goal home is switched
     off, since at this level hovering is the policy's choice), ``sense_bonus``, ``prune_bonus``,
-    ``dump_cost`` (0.0), ``render_mode`` (``None`` or ``"rgb_array"``), ``render_size`` (512).
+    ``dump_cost`` (0.0), ``reward_fn`` (None: :class:`~fcplan.env.reward.PenaltyReward`),
+    ``render_mode`` (``None`` or ``"rgb_array"``), ``render_size`` (512).
 
 Seeding
     ``reset(seed=s)`` resets the world with :meth:`fcplan.World.reset` ``(scenario, seed=s)``, so
     the fire draws the same random numbers as ``fcplan run SCENARIO --seed s``; ``reset()``
     without a seed continues with seeds drawn from the last seed. Same seed and actions give
-    identical episodes in any process. ``env.world`` is the live :class:`fcplan.World`.
+    identical episodes in any process. ``env.world`` is the live :class:`fcplan.World`, ticked by
+    ``env.mission`` (a :class:`fcplan.mission.Mission` that keeps no belief unless asked to, as
+    :mod:`fcplan.env.motion_expert` does). The observations are built by
+    :mod:`fcplan.env.motion_obs`.
 
 Examples
 --------
@@ -100,25 +104,26 @@ Examples
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
+from pettingzoo import ParallelEnv
 
-from fcplan.env import EnvError
-from fcplan.env.motion_grid import (
-    FACILITY,
-    KNOWN_N,
-    LAKE,
-    PRUNED_N,
-    CoarseMaps,
-)
-from fcplan.team import CLIMB_PER_TICK, DRAIN_PER_PX
+from fcplan.env.motion_grid import CoarseMaps
+from fcplan.env.motion_obs import N_AGENT_FEATURES, N_FOV, N_STATE, NEVER, MotionObs
+from fcplan.env.presets import PRESETS as _PRESET_REGISTRY
+from fcplan.env.presets import make_preset
+from fcplan.env.reward import PenaltyReward, RewardFn
+from fcplan.errors import EnvError
+from fcplan.mission import Mission, ScenarioLike, as_scenario
+from fcplan.team import CLIMB_PER_TICK
+from fcplan.world import StepInfo, World
 
 __all__ = ["MotionEnv", "parallel_env", "PRESETS", "ACTION_NAMES"]
 
 #: Preset names accepted by :func:`parallel_env`.
-PRESETS = ("base", "cmplx1", "cmplx2")
+#: names of the reference presets (:data:`fcplan.env.presets.PRESETS`)
+PRESETS = tuple(_PRESET_REGISTRY)
 
 #: Action names per role letter (``P`` perception, ``A`` action, ``H`` hybrid).
 ACTION_NAMES = {
@@ -140,26 +145,16 @@ _COND = {
     "descend": 6,
     "dump": 7,
 }
-_NEVER = 8
 _K_STAY, _K_MOVE, _K_ALTITUDE, _K_DUMP = range(4)
 _STAY_SPEC = (_K_STAY, 0.0, 0.0, 0.0)
-#: teams up to this size build agent vectors and masks in a Python loop (faster than numpy)
-_PY_AGENTS = 16
-_N_FOV = 7
-_N_STATE = 8
-# team modes (fcplan.team.Mode)
-_IDLE, _ACTIVE = 0, 1
-#: mode one-hot features (idle, active, returning, homing) per team mode
-_ONE_HOT = tuple(tuple(float(m == k) for k in range(4)) for m in range(4))
-#: stay, west, east, north, south of an agent flown home (only stay is legal)
-_HOMING_MOVES = (True, False, False, False, False)
-#: the action mask tuple of each role when every action is legal
-_ALL_LEGAL = {r: (True,) * len(names) for r, names in ACTION_NAMES.items()}
+_ACTIVE = 1  # fcplan.team.Mode.ACTIVE
 #: a move sets a goal this many steps away, so the agent never arrives (see MotionEnv.step)
 _GOAL_REACH = 1.5
 
 
-def parallel_env(scenario=None, *, preset: str | None = None, **kwargs: Any):
+def parallel_env(
+    scenario: ScenarioLike | None = None, *, preset: str | None = None, **kwargs: Any
+) -> Any:
     """Make a motion-level ``ParallelEnv`` on a scenario, or one of the reference presets.
 
     Parameters
@@ -168,7 +163,7 @@ def parallel_env(scenario=None, *, preset: str | None = None, **kwargs: Any):
         A scenario or a name/path for :func:`fcplan.load_scenario`; a preset name
         (``"base"``, ``"cmplx1"``, ``"cmplx2"``) selects that preset.
     preset : {"base", "cmplx1", "cmplx2"}, optional
-        The reference MARL environment to reproduce (:mod:`fcplan.env.motion_presets`).
+        The reference MARL environment to reproduce (:mod:`fcplan.env.presets`).
     **kwargs
         Arguments of :class:`MotionEnv` or of the preset.
 
@@ -187,21 +182,13 @@ def parallel_env(scenario=None, *, preset: str | None = None, **kwargs: Any):
     if preset is not None:
         if scenario is not None:
             raise EnvError("preset: give a scenario or a preset, not both")
-        from fcplan.env.motion_presets import make_preset
-
         return make_preset(preset, **kwargs)
     if scenario is None:
         raise EnvError("scenario: give a scenario (name, path or Scenario) or preset=")
     return MotionEnv(scenario, **kwargs)
 
 
-def _parallel_base():
-    from pettingzoo import ParallelEnv
-
-    return ParallelEnv
-
-
-class MotionEnv(_parallel_base()):
+class MotionEnv(ParallelEnv):
     """Motion-level environment on a fcplan scenario (module docstring: spaces, reward, rules)."""
 
     metadata = {
@@ -213,7 +200,7 @@ class MotionEnv(_parallel_base()):
 
     def __init__(
         self,
-        scenario,
+        scenario: ScenarioLike,
         *,
         cell_px: int = 20,
         view: int = 15,
@@ -224,12 +211,11 @@ class MotionEnv(_parallel_base()):
         dump_cost: float = 0.0,
         render_mode: str | None = None,
         render_size: int = 512,
+        reward_fn: RewardFn | None = None,
     ) -> None:
         from gymnasium import spaces
 
-        from fcplan.scenario import Scenario, load_scenario
-
-        sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+        sc = as_scenario(scenario)
         if int(cell_px) < 1:
             raise EnvError(f"cell_px: must be >= 1 (got {cell_px})")
         if int(view) < 1 or int(view) % 2 == 0:
@@ -257,7 +243,7 @@ class MotionEnv(_parallel_base()):
         # per agent and action: dx, dy (unit), dz sign, dump, is a move; and the column of the
         # condition table (see _masks) that makes it legal
         table = np.zeros((n, _MAX_ACTIONS, 5), dtype=np.float64)
-        cond_of = np.full((n, _MAX_ACTIONS), _NEVER, dtype=np.int64)
+        cond_of = np.full((n, _MAX_ACTIONS), NEVER, dtype=np.int64)
         for i, r in enumerate(letters):
             for a, name in enumerate(ACTION_NAMES[r]):
                 if name in _DIRS:
@@ -267,14 +253,6 @@ class MotionEnv(_parallel_base()):
                 table[i, a, 4] = name in _DIRS and name != "stay"
                 cond_of[i, a] = _COND[name]
         self._table = table
-        self._cond_of = cond_of
-        self._cond = np.zeros((n, _NEVER + 1), dtype=bool)
-        self._cond[:, 0] = True
-        self._roles = np.array(
-            [[a.role.can_sense, a.role.can_act] for a in sc.agents], dtype=np.float32
-        ).reshape(n, 2)
-        self._modes = np.arange(4)
-        self._inv_c = 1.0 / self.cell_px  # a Python float: the fastest scalar for numpy
         self._shaping = bool(self.sense_bonus or self.prune_bonus or self.dump_cost)
         self._action_spaces = {
             a: spaces.Discrete(int(k))
@@ -284,47 +262,54 @@ class MotionEnv(_parallel_base()):
         self._obs_spaces = {
             a: spaces.Dict(
                 {
-                    "fov": spaces.Box(0.0, 1.0, (_N_FOV, self.view, self.view), np.float32),
-                    "agent": spaces.Box(0.0, 1.0, (_N_AGENT_FEATURES,), np.float32),
+                    "fov": spaces.Box(0.0, 1.0, (N_FOV, self.view, self.view), np.float32),
+                    "agent": spaces.Box(0.0, 1.0, (N_AGENT_FEATURES,), np.float32),
                     "action_mask": spaces.Box(0, 1, (int(k),), np.int8),
                 }
             )
             for a, k in zip(self.possible_agents, self._n_actions, strict=True)
         }
-        self.state_space = spaces.Box(0.0, np.inf, (_N_STATE, nc, nc), np.float32)
-        self._maps = CoarseMaps(
+        self.state_space = spaces.Box(0.0, np.inf, (N_STATE, nc, nc), np.float32)
+        maps = CoarseMaps(
             sc, self.cell_px, self.view, seen_scale=1.0 / (self.stale_s * sc.ticks_per_second)
         )
-        self._arange = np.arange(n)
-        self._world = None
+        #: builds the observations and the state (fcplan.env.motion_obs)
+        self.observations = MotionObs(
+            sc, letters, self._n_actions, cond_of, self.cell_px, self.view, maps
+        )
+        self.reward_fn: RewardFn = reward_fn or PenaltyReward()
+        #: the episode (created by the first reset; keeps no belief unless asked to)
+        self.mission: Mission | None = None
+        self._world: World | None = None
+        self._last_info: StepInfo | None = None
         self._reseed: np.random.Generator | None = None
 
     # ------------------------------------------------------------------ spaces
-    def observation_space(self, agent):
+    def observation_space(self, agent: str) -> Any:
         """The ``Dict`` observation space of ``agent`` (the same object every call)."""
         return self._obs_spaces[agent]
 
-    def action_space(self, agent):
+    def action_space(self, agent: str) -> Any:
         """The ``Discrete`` action space of ``agent`` (the same object every call)."""
         return self._action_spaces[agent]
 
     @property
-    def world(self):
+    def world(self) -> World | None:
         """The underlying :class:`fcplan.World` (after :meth:`reset`)."""
         return self._world
 
     @property
-    def last_info(self):
+    def last_info(self) -> StepInfo | None:
         """The :class:`fcplan.world.StepInfo` of the last tick (None right after :meth:`reset`):
         what a scheduler-driven expert feeds its belief with
         (:mod:`fcplan.env.motion_expert`)."""
         return self._last_info
 
     # ------------------------------------------------------------------ episode
-    def reset(self, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, Any]]:
         """Start an episode; return ``(observations, infos)``."""
-        from fcplan.world import World
-
         if seed is not None:
             self._reseed = np.random.default_rng(seed)
         elif self._reseed is None:
@@ -332,50 +317,13 @@ class MotionEnv(_parallel_base()):
             seed = int(self._reseed.integers(2**63))
         else:
             seed = int(self._reseed.integers(2**63))
-        if self._world is None:
-            self._world = World()
-        world = self._world.reset(self.scenario, seed)
+        if self.mission is None:
+            self.mission = Mission(self.scenario, seed, event_replans=False, belief=False)
+        else:
+            self.mission.reset(seed)
+        self._world = world = self.mission.world
         self._team = team = world.team
         self._climb = CLIMB_PER_TICK * team.tick_scale
-        span = team.alt_hi - team.alt_lo
-        inv_span = np.where(span > 0, 1.0 / np.where(span > 0, span, 1.0), 0.0)
-        w = float(self.scenario.world_size)
-        self._w1 = w - 1.0
-        self._speed2 = team.speed[:, None].copy()
-        self._hi_lim = self._w1 - self._speed2
-        self._z_hi = team.alt_hi - 1e-9
-        self._z_lo = team.alt_lo + 1e-9
-        self._inv_w = 1.0 / w
-        self._inv_span = inv_span
-        self._inv_cap = 1.0 / team.battery_capacity
-        self._inv_tank = 1.0 / np.maximum(team.tank_capacity, 1)
-        self._drain_per_cap = DRAIN_PER_PX / team.battery_capacity
-        self._can_sense = team.can_sense.astype(np.float64)
-        vt = np.zeros((self._n, _N_AGENT_FEATURES), dtype=np.float32)
-        vt[:, 10:12] = self._roles
-        vt[:, 14] = team.speed / w
-        self._vec_template = vt
-        # per agent constants for the small-team loop of _agent_arrays
-        self._py = list(
-            zip(
-                team.home[:, 0].tolist(),
-                team.home[:, 1].tolist(),
-                team.alt_lo.tolist(),
-                inv_span.tolist(),
-                self._inv_cap.tolist(),
-                self._inv_tank.tolist(),
-                team.can_sense.astype(np.float64).tolist(),
-                team.can_act.astype(np.float64).tolist(),
-                (team.speed / w).tolist(),
-                self._drain_per_cap.tolist(),
-                team.speed.tolist(),
-                self._hi_lim[:, 0].tolist(),
-                self._z_hi.tolist(),
-                self._z_lo.tolist(),
-                self._letters,
-                strict=True,
-            )
-        )
         # per agent and action: (kind, goal dx, goal dy, altitude change)
         self._spec = [
             [
@@ -389,30 +337,24 @@ class MotionEnv(_parallel_base()):
             ]
             for i, sp in enumerate(team.speed.tolist())
         ]
-        self._n_actions_list = self._n_actions.tolist()
-        #: action mask tuples -> int8 arrays (copied into each observation)
-        self._mask_cache: dict[tuple, np.ndarray] = {}
-        self._maps.reset()
-        self._tick_rate = float(self.scenario.ticks_per_second)
+        self.observations.reset(world)
+        self.reward_fn.reset(world)
         self._n_ticks = self.scenario.n_ticks
-        self._penalties = world.facility_penalties
-        self._fb_last = None
-        self._fb_penalty = 0.0
-        self._pw = self.scenario.scoring.propagation_weight
         self.agents = list(self.possible_agents)
         self._last_info = None
-        return self._observe(), {a: {} for a in self.agents}
+        return self.observations.observe(), {a: {} for a in self.agents}
 
-    def step(self, actions: dict):
+    def step(self, actions: dict[str, Any]) -> tuple[dict[str, Any], ...]:
         """Advance one tick with ``{agent: action}``; missing agents stay."""
         if not self.agents:
             raise EnvError("step: the episode is over; call reset()")
-        team, world = self._team, self._world
+        team, world, view = self._team, self._world, self.observations
+        assert world is not None and self.mission is not None  # (agents: reset was called)
         goal, has_goal, mode, armed = team.goal, team.has_goal, team.mode, team.armed
         pos = None
         # (each mask tuple holds exactly the agent's actions: its length bounds the action)
         for i, (a, row, spec, free) in enumerate(
-            zip(self.possible_agents, self._mask_lists, self._spec, self._free_list, strict=True)
+            zip(self.possible_agents, view.mask_lists, self._spec, view.free_list, strict=True)
         ):
             v = actions.get(a, 0)
             try:
@@ -446,21 +388,15 @@ class MotionEnv(_parallel_base()):
                 team.z_target[i] = min(max(z, team.alt_lo[i]), team.alt_hi[i])
         if not self.idle_rule:
             team.hover_s.fill(0.0)
-        info = world.step()
+        info = self.mission.step()
         team.armed.fill(False)
-        self._maps.update(info, world)
+        view.update(info)
         self._last_info = info
-        # reward
-        fb = world.facility_burning.tolist()
-        if fb != self._fb_last:  # (facility counts change rarely: reuse the penalty sum)
-            self._fb_last = fb
-            self._fb_penalty = float(self._penalties @ world.facility_burning)
-        r = -(self._pw * world.fire.n_burning + self._fb_penalty)
-        r /= self._tick_rate
+        r = self.reward_fn(world, info.tick - 1)
         if self._shaping:
             r += self.sense_bonus * info.newly_sensed.size + self.prune_bonus * info.pruned.size
             r -= self.dump_cost * len(info.dumped)
-        obs = self._observe()
+        obs = view.observe()
         agents = self.agents
         rewards = dict.fromkeys(agents, r)
         terms = dict.fromkeys(agents, False)
@@ -476,160 +412,12 @@ class MotionEnv(_parallel_base()):
             truncs = dict.fromkeys(agents, False)
         return obs, rewards, terms, truncs, infos
 
-    # ------------------------------------------------------------------ observations
-    def _agent_arrays(self) -> tuple[np.ndarray, list, list, list]:
-        """``(vectors (n, 15) float32, masks, coarse x, coarse y)``: ``masks[i]`` is agent
-        ``i``'s fresh ``(n_actions,)`` int8 action mask. Also keeps the masks as tuples of bools
-        in ``self._mask_lists`` and the agents that take orders in ``self._free_list`` (read by
-        :meth:`step`). A plain Python loop over the agents for small teams (a few numpy calls
-        cost more than the whole loop there), numpy beyond :data:`_PY_AGENTS` agents; both give
-        identical results."""
-        team = self._team
-        inv_w = self._inv_w
-        if self._n > _PY_AGENTS:
-            vec, mask = self._agent_vectors(), self._masks()
-            self._free_list = self._free.tolist()
-            k = self._n_actions_list
-            self._mask_lists = [tuple(row[: k[i]]) for i, row in enumerate(mask.tolist())]
-            masks = [mask[i, : k[i]] for i in range(self._n)]
-            cell = (team.pos // self.cell_px).astype(np.int64)  # agents never leave the map
-            return vec, masks, cell[:, 0].tolist(), cell[:, 1].tolist()
-        cpx = self.cell_px
-        pos, z, zt = team.pos.tolist(), team.z.tolist(), team.z_target.tolist()
-        bat, tank, mode = team.battery.tolist(), team.tank.tolist(), team.mode.tolist()
-        tf = self._world.tick / self._n_ticks
-        cache = self._mask_cache
-        vecs: list = []
-        rows, masks, free_all, cxs, cys = [], [], [], [], []
-        for (
-            (hx, hy, lo, inv_span, inv_cap, inv_tank, sense, act, spw, drain, sp, hi_lim, z_hi,
-             z_lo, letter),
-            (x, y), zi, zti, bi, ti, m,
-        ) in zip(self._py, pos, z, zt, bat, tank, mode, strict=True):  # fmt: skip
-            zn = (zi - lo) * inv_span
-            free = m <= _ACTIVE
-            home = math.sqrt((hx - x) ** 2 + (hy - y) ** 2) * drain
-            conf = 1.0 - 0.6 * zn
-            vecs += (
-                x * inv_w,
-                y * inv_w,
-                zn,
-                bi * inv_cap,
-                ti * inv_tank,
-                home if home < 1.0 else 1.0,
-                *_ONE_HOT[m],
-                sense,
-                act,
-                tf,
-                ((conf if conf > 0.4 else 0.4) if sense else 0.0),
-                spw,
-            )
-            # the action table's order: stay, west, east, north, south, then role actions
-            if (
-                free
-                and sp <= x <= hi_lim
-                and sp <= y <= hi_lim
-                and (letter == "A" or z_lo < zti < z_hi)
-                and (letter == "P" or ti > 0)
-            ):  # (the usual case: everything is legal)
-                row = _ALL_LEGAL[letter]
-            else:
-                moves = (
-                    (True, x >= sp, x <= hi_lim, y >= sp, y <= hi_lim) if free else _HOMING_MOVES
-                )
-                if letter == "P":
-                    row = (*moves, zti < z_hi, zti > z_lo)
-                elif letter == "A":
-                    row = (*moves, free and ti > 0)
-                else:
-                    row = (*moves, zti < z_hi, zti > z_lo, free and ti > 0)
-            rows.append(row)
-            # (the tuple says its agent's role by its length: one cached array per tuple)
-            arr = cache.get(row)
-            if arr is None:
-                arr = cache[row] = np.array(row, dtype=np.int8)
-            masks.append(arr.copy())
-            free_all.append(free)
-            cxs.append(int(x // cpx))
-            cys.append(int(y // cpx))
-        self._free_list = free_all
-        self._mask_lists = rows
-        vec = np.array(vecs, dtype=np.float32).reshape(self._n, _N_AGENT_FEATURES)
-        return vec, masks, cxs, cys
-
-    def _masks(self) -> np.ndarray:
-        """(n, 8) int8 legal actions, from a (n, 8) table of conditions picked per action."""
-        team = self._team
-        mode = team.mode
-        free = mode <= _ACTIVE
-        self._free = free
-        cond = self._cond
-        pos, speed = team.pos, self._speed2
-        np.greater_equal(pos, speed, out=cond[:, 1:3])  # west, north stay inside
-        np.less_equal(pos, self._hi_lim, out=cond[:, 3:5])  # east, south
-        cond[:, 1:5] &= free[:, None]
-        np.less(team.z_target, self._z_hi, out=cond[:, 5])
-        np.greater(team.z_target, self._z_lo, out=cond[:, 6])
-        np.greater(team.tank, 0, out=cond[:, 7])
-        cond[:, 7] &= free
-        return cond[self._arange[:, None], self._cond_of].view(np.int8)
-
-    def _agent_vectors(self) -> np.ndarray:
-        team = self._team
-        v = self._vec_template.copy()
-        np.multiply(team.pos, self._inv_w, out=v[:, 0:2], casting="same_kind")
-        zn = team.z - team.alt_lo
-        zn *= self._inv_span
-        v[:, 2] = zn
-        np.multiply(team.battery, self._inv_cap, out=v[:, 3], casting="same_kind")
-        np.multiply(team.tank, self._inv_tank, out=v[:, 4], casting="same_kind")
-        d = team.home - team.pos
-        d *= d
-        home = d[:, 0] + d[:, 1]
-        np.sqrt(home, out=home)
-        home *= self._drain_per_cap
-        np.minimum(home, 1.0, out=v[:, 5], casting="same_kind")
-        np.equal(team.mode[:, None], self._modes, out=v[:, 6:10], casting="unsafe")
-        v[:, 12] = self._world.tick / self._n_ticks
-        # sensing confidence 1 - 0.6 z' (clipped to [0.4, 1]), 0 for agents without camera
-        zn *= -0.6
-        zn += 1.0
-        np.maximum(zn, 0.4, out=zn)
-        zn *= self._can_sense
-        v[:, 13] = zn
-        return v
-
-    def _observe(self) -> dict:
-        vec, masks, cx, cy = self._agent_arrays()
-        # (N, 7, V, V), a fresh array: known and pruned come scaled and clipped, the agents
-        # layer as "another agent is there", staleness clipped
-        fov = self._maps.observe(cx, cy, self._world.tick, _N_FOV)
-        # (indexing the arrays: iterating over them costs more)
-        return {
-            a: {"fov": fov[i], "agent": vec[i], "action_mask": masks[i]}
-            for i, a in enumerate(self.possible_agents)
-        }
-
     def state(self) -> np.ndarray:
         """Global state ``(8, nc, nc)`` float32 (module docstring)."""
-        maps, team = self._maps, self._team
-        inner = maps.inner
-        nc = maps.nc
-        s = np.zeros((_N_STATE, nc, nc), dtype=np.float32)
-        inv_c = 1.0 / self.cell_px
-        np.minimum(maps.burning_layer() * inv_c, 1.0, out=s[0])
-        np.minimum(inner[KNOWN_N] * inv_c, 1.0, out=s[1])
-        np.minimum(inner[PRUNED_N] * inv_c, 1.0, out=s[2])
-        s[3] = maps.staleness(self._world.tick)
-        cx, cy = maps.cells(team.pos)
-        np.add.at(s[4], (cx[team.can_sense], cy[team.can_sense]), 1.0)
-        np.add.at(s[5], (cx[team.can_act], cy[team.can_act]), 1.0)
-        s[6] = inner[LAKE]
-        s[7] = inner[FACILITY]
-        return s
+        return self.observations.state()
 
     # ------------------------------------------------------------------ render
-    def render(self):
+    def render(self) -> np.ndarray | None:
         """An ``(H, W, 3)`` uint8 image of the map, fire, agents and fields of view
         (``render_mode="rgb_array"``), else None."""
         if self.render_mode != "rgb_array" or self._world is None:

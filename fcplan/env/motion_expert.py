@@ -5,19 +5,19 @@ The motion level has no scheduler of its own: a scheduler plans tasks, not moves
 :class:`fcplan.env.motion.MotionEnv`, as a baseline to compare a learned motion policy with or
 as the expert of imitation learning:
 
-* **Belief.** It keeps the team's :class:`fcplan.belief.Belief`, fed every tick with the env's
-  :attr:`~fcplan.env.motion.MotionEnv.last_info`, exactly as :func:`fcplan.run_episode` does.
-* **Replans.** Every ``replan_period`` simulated seconds (periodic replans only) it builds the
-  task graph and asks the scheduler for a plan through :func:`fcplan.scheduling.solve` (so a
-  failing solver falls back to greedy), with the world's ``controller_rng``. Agents the plan does
-  not mention keep their route; agents sent home stop (the simulator flies agents home by
-  itself when their battery or tank runs out).
+* **Belief and replans.** The env's episode is a :class:`fcplan.mission.Mission`; the follower
+  asks it to keep the team's :class:`fcplan.belief.Belief` (updated every tick, exactly as in
+  :func:`fcplan.run_episode`) and to replan every ``replan_period`` simulated seconds (periodic
+  replans only). A replan is :meth:`Mission.replan <fcplan.mission.Mission.replan>`: the task
+  graph, the scheduler through :func:`fcplan.scheduling.solve` (so a failing solver falls back to
+  greedy), with the world's ``controller_rng``. Agents the plan does not mention keep their
+  route; agents sent home stop (the simulator flies agents home by itself when their battery or
+  tank runs out).
 * **Moves.** One action per agent and tick. At a goal (both offsets within half a step) an
   action or hybrid agent dumps once on a fire task (as an arrival arms one dump in the
   simulator), then takes the next goal. Otherwise a perception or hybrid agent whose commanded
-  altitude is off the plan's climbs or descends first (a wider view on the way: this scored
-  about 13 points more on average than climbing only at the goal, #1, #8, #12, #24 x 2 seeds),
-  then the agent steps toward its next goal along the axis with the larger offset (the other
+  altitude is off the plan's climbs or descends first (a wider view on the way), then the agent
+  steps toward its next goal along the axis with the larger offset (the other
   axis if that move is masked); with nothing to do it stays. Only legal actions (by the
   observation's ``action_mask``) are chosen.
 
@@ -41,11 +41,15 @@ Examples
 
 from __future__ import annotations
 
+from typing import Any
+
 from fcplan.belief import Belief
-from fcplan.env import EnvError
 from fcplan.env.motion import ACTION_NAMES, MotionEnv
-from fcplan.scheduling import Scheduler, make_scheduler, solve
-from fcplan.taskgraph import TaskGraphParams, TaskKind, build_task_graph
+from fcplan.errors import EnvError
+from fcplan.mission import Mission
+from fcplan.plan import Plan
+from fcplan.scheduling import Scheduler, make_scheduler
+from fcplan.taskgraph import TaskGraph, TaskGraphParams, TaskKind
 from fcplan.team import Mode
 
 __all__ = ["PlanFollower"]
@@ -80,7 +84,7 @@ class PlanFollower:
 
     def __init__(
         self,
-        env,
+        env: MotionEnv,
         scheduler: str | Scheduler,
         *,
         replan_period: float = 1.0,
@@ -93,10 +97,10 @@ class PlanFollower:
             raise EnvError(f"replan_period: must be > 0 simulated seconds (got {replan_period!r})")
         self.env = env
         self.scheduler = make_scheduler(scheduler) if isinstance(scheduler, str) else scheduler
+        self.replan_period = float(replan_period)
         self.time_limit = time_limit
         self.graph_params = graph_params
         sc = env.scenario
-        self._period = max(int(round(replan_period * sc.ticks_per_second)), 1)
         self._ids = list(env.possible_agents)
         self._row = {a: i for i, a in enumerate(self._ids)}
         letters = [
@@ -105,17 +109,20 @@ class PlanFollower:
         ]
         # action index by name, per agent
         self._act = [{name: k for k, name in enumerate(ACTION_NAMES[r])} for r in letters]
+        self.mission: Mission | None = None
         self.belief: Belief | None = None
-        self.plan = None
+        self.plan: Plan | None = None
         self.replans = 0
 
     def reset(self) -> None:
-        """Forget routes and belief; call after ``env.reset()``."""
-        if self.env.world is None:
+        """Forget routes and belief, replan at once; call after ``env.reset()``."""
+        mission = self.env.mission
+        if mission is None:
             raise EnvError("PlanFollower.reset: reset the env first")
-        self.belief = Belief(self.env.scenario)
-        self._belief_tick = self.env.world.tick
-        self._next_replan = self.env.world.tick
+        self.mission = mission
+        self.belief = mission.track_belief()
+        mission.set_replan_rule(self.replan_period, event_replans=False)
+        mission.graph_params = self.graph_params
         n = len(self._ids)
         self._routes: list[list[tuple[float, float, bool]]] = [[] for _ in range(n)]
         self._alt: list[float | None] = [None] * n
@@ -123,19 +130,16 @@ class PlanFollower:
         self.plan = None
         self.replans = 0
 
-    def actions(self, observations: dict) -> dict[str, int]:
+    def actions(self, observations: dict[str, Any]) -> dict[str, int]:
         """One legal action per live agent for the current tick."""
-        if self.belief is None:
+        if self.mission is None:
             self.reset()
-        env, world = self.env, self.env.world
-        info = env.last_info
-        if info is not None and info.tick > self._belief_tick:
-            self.belief.update(info)
-            self._belief_tick = info.tick
-        if world.tick >= self._next_replan:
-            self._replan()
-            self._next_replan = world.tick + self._period
-        team = world.team
+        mission = self.mission
+        assert mission is not None
+        if mission.replan_due():
+            graph, plan = mission.replan(self.scheduler, time_limit=self.time_limit)
+            self._follow(plan, graph)
+        team = mission.world.team
         pos, z_target = team.pos.tolist(), team.z_target.tolist()
         mode, speed = team.mode.tolist(), team.speed.tolist()
         climb = 5.0 * team.tick_scale
@@ -146,7 +150,7 @@ class PlanFollower:
             mask = observations[a]["action_mask"].tolist()
             act = self._act[i]
 
-            def legal(name: str, act=act, mask=mask) -> bool:
+            def legal(name: str, act: dict[str, int] = act, mask: list[int] = mask) -> bool:
                 k = act.get(name)
                 return k is not None and bool(mask[k])
 
@@ -163,10 +167,11 @@ class PlanFollower:
                     done = route.pop(0)
                     if self._patrol[i]:  # a patrol loop goes round again
                         route.append(done)
-                if choice == "stay" and self._alt[i] is not None:  # altitude first
-                    if z_target[i] < self._alt[i] - 0.5 * climb and legal("climb"):
+                alt = self._alt[i]
+                if choice == "stay" and alt is not None:  # altitude first
+                    if z_target[i] < alt - 0.5 * climb and legal("climb"):
                         choice = "climb"
-                    elif z_target[i] > self._alt[i] + 0.5 * climb and legal("descend"):
+                    elif z_target[i] > alt + 0.5 * climb and legal("descend"):
                         choice = "descend"
                 if choice == "stay" and route:
                     dx, dy = route[0][0] - x, route[0][1] - y
@@ -182,14 +187,13 @@ class PlanFollower:
             out[a] = act[choice]
         return out
 
-    def _replan(self) -> None:
-        world = self.env.world
-        graph = build_task_graph(self.env.scenario, world.team, self.belief, self.graph_params)
-        plan = solve(self.scheduler, graph, time_limit=self.time_limit, rng=world.controller_rng)
+    def _follow(self, plan: Plan, graph: TaskGraph) -> None:
+        """Take the routes (goal positions, dump on fire tasks) and altitudes of a new plan."""
         self.plan = plan
         self.replans += 1
         tidx, pos, kind = graph.task_index, graph.task_pos, graph.task_kind
-        can_act = world.team.can_act.tolist()
+        assert self.mission is not None
+        can_act = self.mission.world.team.can_act.tolist()
         for agent, z in plan.altitudes.items():
             self._alt[self._row[agent]] = float(z)
         for agent in plan.home:

@@ -52,10 +52,16 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
+
+if TYPE_CHECKING:
+    from fcplan.scenario import Scenario
+    from fcplan.world import StepInfo, World
 
 __all__ = [
     "CoarseMaps",
@@ -112,7 +118,9 @@ class CoarseMaps:
         Staleness per tick (``1 / ticks to become fully stale``).
     """
 
-    def __init__(self, scenario, cell_px: int, view: int, seen_scale: float = 1.0) -> None:
+    def __init__(
+        self, scenario: Scenario, cell_px: int, view: int, seen_scale: float = 1.0
+    ) -> None:
         w = scenario.world_size
         c = int(cell_px)
         self.world_size, self.cell_px, self.view = w, c, int(view)
@@ -144,7 +152,7 @@ class CoarseMaps:
         self._sensing_rows = [j for j, f in enumerate(self._sensing) if f]
         self.reset()
 
-    def _static_layers(self, scenario) -> np.ndarray:
+    def _static_layers(self, scenario: Scenario) -> np.ndarray:
         w, c, nc = self.world_size, self.cell_px, self.nc
         static = np.zeros((3, nc, nc), dtype=np.float32)
         inside = np.ones((w, w), dtype=bool)
@@ -211,7 +219,7 @@ class CoarseMaps:
             if scaled is not None:
                 scaled[j] = min(grid[j] * self._inv_c, 1.0)
 
-    def update(self, info, world) -> None:
+    def update(self, info: StepInfo, world: World) -> None:
         """Fold one tick (:class:`fcplan.world.StepInfo`) of ``world`` into the maps."""
         if info.ignited.size:  # the burning layer is folded in on demand (burning_layer)
             self._pending.append(info.ignited)
@@ -245,7 +253,7 @@ class CoarseMaps:
         rows = range(len(rects)) if which is None else [j for j, f in enumerate(which) if f]
         self._cover(rects, rows, -float(np.float32(tick * self.seen_scale)))
 
-    def _cover(self, rects: list, rows, value: float) -> None:
+    def _cover(self, rects: list[list[float]], rows: Iterable[int], value: float) -> None:
         """:meth:`cover` of the rectangles ``rects[j]`` for ``j`` in ``rows`` with ``value``."""
         c = self.cell_px
         seen = self._seen  # slicing stops at the map's far edges by itself

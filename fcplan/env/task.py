@@ -2,8 +2,9 @@
 
 The team's scheduler, made learnable: every replan period each UAV picks one task of the current
 task graph (:mod:`fcplan.taskgraph`) or no-op; the simulator (:class:`fcplan.world.World`, the
-team's :class:`fcplan.belief.Belief`) runs the resulting :class:`fcplan.plan.Plan` until the next
-period. It mirrors the replan loop of :func:`fcplan.run_episode` with periodic replans only.
+team's :class:`fcplan.belief.Belief`, together a :class:`fcplan.mission.Mission`) runs the resulting
+:class:`fcplan.plan.Plan` until the next period. It is the replan loop of :func:`fcplan.run_episode`
+(the same mission) with periodic replans only and the learner in place of the scheduler.
 
 ==================  ==================================================================
 Import              ``from fcplan.env import parallel_env``
@@ -41,6 +42,9 @@ Arguments
     :class:`fcplan.errors.PlanError` naming it. ``False`` skips the check.
 ``graph_params``
     :class:`fcplan.taskgraph.TaskGraphParams` for the task graph.
+``reward_fn``
+    The step's reward before shaping, a :class:`fcplan.env.reward.RewardFn` (default
+    :class:`~fcplan.env.reward.PenaltyReward`: minus the manual's negative reward).
 ``render_mode``
     ``None`` or ``"rgb_array"`` (:func:`fcplan.render.render_frame` of the live world).
 
@@ -62,9 +66,9 @@ Actions, no-op and conflicts
 
 Reward
     ``r = -sum_ticks rate(t) / tps + prune_bonus * pruned``, with ``rate`` the manual's penalty rate
-    (:func:`fcplan.metrics.negative_reward_rate`: ``0.1 |active| + sum_f PC_f n_f``), the same for
-    every agent. Over an unshaped episode the rewards sum to minus the manual total negative
-    reward (up to float rounding).
+    (``0.1 |active| + sum_f PC_f n_f``, :mod:`fcplan.env.reward`), the same for every agent. Over
+    an unshaped episode the rewards sum to minus the manual total negative reward (up to float
+    rounding).
 
 Termination and truncation
     No terminal state: every agent is truncated at the step that reaches the scenario's duration
@@ -106,9 +110,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pettingzoo import ParallelEnv
 
 from fcplan.belief import Belief
-from fcplan.env import EnvError
+from fcplan.env.reward import PenaltyReward, RewardFn
 from fcplan.env.task_actions import actions_plan, decode_actions, rows_commands
 from fcplan.env.task_candidates import (
     AGENT_FEATURES,
@@ -119,26 +124,17 @@ from fcplan.env.task_candidates import (
     rank_candidates,
     task_features,
 )
+from fcplan.errors import EnvError
 from fcplan.metrics import compute_all
+from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario
 from fcplan.plan import validate_plan
-from fcplan.taskgraph import TaskGraph, TaskGraphParams, build_task_graph
+from fcplan.taskgraph import TaskGraph, TaskGraphParams
 from fcplan.world import World
 
 __all__ = ["TaskEnv"]
 
-try:  # PettingZoo is a dependency of fcplan.env; keep the module importable without it
-    from pettingzoo import ParallelEnv as _Base
-except ImportError:  # pragma: no cover
-    _Base = object
 
-
-def _load(scenario):
-    from fcplan.scenario import Scenario, load_scenario
-
-    return scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
-
-
-class TaskEnv(_Base):
+class TaskEnv(ParallelEnv):
     """Task-level parallel environment (the module docstring is its documentation page)."""
 
     metadata = {
@@ -150,7 +146,7 @@ class TaskEnv(_Base):
 
     def __init__(
         self,
-        scenario,
+        scenario: ScenarioLike,
         *,
         k: int = 8,
         replan_period: float = 1.0,
@@ -162,10 +158,11 @@ class TaskEnv(_Base):
         validate: bool = True,
         graph_params: TaskGraphParams | None = None,
         render_mode: str | None = None,
+        reward_fn: RewardFn | None = None,
     ) -> None:
         from gymnasium import spaces
 
-        self.scenario = _load(scenario)
+        self.scenario = as_scenario(scenario)
         if not (isinstance(k, (int, np.integer)) and 1 <= k <= 1024):
             raise EnvError(f"k: must be an integer in 1..1024 (got {k!r})")
         if not (np.isfinite(replan_period) and replan_period > 0):
@@ -208,22 +205,44 @@ class TaskEnv(_Base):
         self.action_spaces = {a: spaces.Discrete(self.k + 1) for a in self.possible_agents}
         n_state = self.n_agents * s + 2 * self._nb * self._nb + 4
         self.state_space = spaces.Box(-b, b, (n_state,), np.float32)
-        self.world = World()
+        #: the episode: world, belief and the periodic replan rule (no event replans)
+        self.mission = Mission(
+            self.scenario,
+            0,
+            replan_period=replan_period,
+            event_replans=False,
+            graph_params=graph_params,
+        )
+        self.reward_fn: RewardFn = reward_fn or PenaltyReward()
         self._seed_seq: np.random.SeedSequence | None = None
         self.graph: TaskGraph | None = None
         self.candidates: Candidates | None = None
 
+    @property
+    def world(self) -> World:
+        """The live :class:`fcplan.world.World` (the mission's)."""
+        return self.mission.world
+
+    @property
+    def belief(self) -> Belief:
+        """The team's :class:`fcplan.belief.Belief` (the mission's)."""
+        belief = self.mission.belief
+        assert belief is not None  # (the mission keeps one)
+        return belief
+
     # ------------------------------------------------------------------ spaces
-    def observation_space(self, agent: str):
+    def observation_space(self, agent: str) -> Any:
         """The agent's observation space (the same object every call)."""
         return self.observation_spaces[agent]
 
-    def action_space(self, agent: str):
+    def action_space(self, agent: str) -> Any:
         """``Discrete(k + 1)`` (the same object every call)."""
         return self.action_spaces[agent]
 
     # ------------------------------------------------------------------ episode
-    def reset(self, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, Any]]:
         """Start an episode; return ``(observations, infos)``.
 
         ``seed`` seeds the world exactly as ``World.reset(scenario, seed)``; without a seed the
@@ -237,8 +256,8 @@ class TaskEnv(_Base):
             if self._seed_seq is None:
                 self._seed_seq = np.random.SeedSequence()
             world_seed = self._seed_seq.spawn(1)[0]
-        self.world.reset(self.scenario, world_seed)
-        self.belief = Belief(self.scenario)
+        self.mission.reset(world_seed)
+        self.reward_fn.reset(self.world)
         self.agents = list(self.possible_agents)
         self.steps = 0
         self.return_ = 0.0
@@ -248,7 +267,7 @@ class TaskEnv(_Base):
         infos = {a: {"tick": 0} for a in self.agents}
         return self._obs, infos
 
-    def step(self, actions: dict[str, int]):
+    def step(self, actions: dict[str, int]) -> tuple[dict[str, Any], ...]:
         """Apply one action per live agent (missing agents: no-op) and run one replan period.
 
         Returns ``(observations, rewards, terminations, truncations, infos)``.
@@ -256,8 +275,10 @@ class TaskEnv(_Base):
         if not self.agents:
             raise EnvError("step: the episode is over; call reset() first")
         graph, cand = self.graph, self.candidates
+        assert graph is not None and cand is not None  # (built by reset)
         noop = self.k
-        act = [noop if (x := actions.get(a)) is None else int(x) for a in self.possible_agents]
+        # (a list of Python ints: decode_actions' fast path, though its annotation says ndarray)
+        act: Any = [noop if (x := actions.get(a)) is None else int(x) for a in self.possible_agents]
         rows, illegal, conflict = decode_actions(graph, cand, act, illegal=self.illegal_action)
         # a handful of agents: plain Python lists from here
         rows_l = rows.tolist()
@@ -304,34 +325,18 @@ class TaskEnv(_Base):
             self.agents = []
         return self._obs, rewards, terms, truncs, infos
 
-    def _advance(self, commands) -> float:
-        """Run one period of ticks; return the step's reward."""
-        world, belief = self.world, self.belief
-        fire = world.fire
-        start = world.tick
-        pruned = fire.n_pruned
-        active = 0  # sum over the ticks of the burning cells
-        step, update = world.step, belief.update
-        # (the period, cut at the scenario's end: world.done once tick >= n_ticks)
-        for _ in range(min(self.period, self.scenario.n_ticks - start)):
-            update(step(commands))
-            commands = None
-            active += fire.n_burning
-        # burning cells per facility summed over the ticks, from the trace rows the ticks wrote
-        # (the same integers as adding world.facility_burning after every tick); cells put out
-        # during the step: the change of the fire's count (the sum of every tick's info.pruned)
-        in_fac = world.trace_sum("facility_burning", start, world.tick)
-        pruned = fire.n_pruned - pruned
-        rate = self.scenario.scoring.propagation_weight * active + float(
-            in_fac @ world.facility_penalties
-        )
-        return -rate / self.tps + self.prune_bonus * pruned
+    def _advance(self, commands: Commands) -> float:
+        """Run one period of ticks (cut at the scenario's end); return the step's reward."""
+        world = self.world
+        start, pruned = world.tick, world.fire.n_pruned
+        self.mission.advance(self.period, commands)
+        # cells put out during the step: the change of the fire's count (the sum of every tick's
+        # info.pruned)
+        return self.reward_fn(world, start) + self.prune_bonus * (world.fire.n_pruned - pruned)
 
     def _observe(self) -> None:
         """Build the graph, candidates and observations of the current tick."""
-        self.graph = build_task_graph(
-            self.scenario, self.world.team, self.belief, self.graph_params
-        )
+        self.graph = self.mission.task_graph()
         self.candidates = rank_candidates(self.graph, self.k)
         frac = self.world.tick / max(self.scenario.n_ticks, 1)
         self._agent_obs = agent_features(self.graph, self.candidates, frac)
@@ -379,7 +384,7 @@ class TaskEnv(_Base):
         ).astype(np.float32)
         return np.clip(out, -FEATURE_BOUND, FEATURE_BOUND)
 
-    def render(self):
+    def render(self) -> np.ndarray | None:
         """An ``(H, W, 3)`` uint8 image of the map, known fire, agents, their fields of view and
         the goals still ahead, with the information panel (``render_mode="rgb_array"``; drawn
         by :func:`fcplan.render.render_frame`), else None."""

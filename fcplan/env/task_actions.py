@@ -100,7 +100,7 @@ def decode_actions(
         bad_l.append(r < 0 and x != k)
     bad = np.array(bad_l, dtype=bool)
     if illegal == "raise" and True in bad_l:
-        from fcplan.env import EnvError
+        from fcplan.errors import EnvError
 
         i = bad_l.index(True)
         legal = np.flatnonzero(np.r_[cand.valid[i], True]).tolist()

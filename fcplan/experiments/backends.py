@@ -8,8 +8,9 @@ died, the cluster lost it). Lost episodes are not stored, so a re-run plays them
 
 * :func:`iter_serial`: one after another in this process (``jobs=1``).
 * :func:`iter_pool`: a :class:`concurrent.futures.ProcessPoolExecutor` with one worker per core by
-  default. Workers ignore Ctrl-C; the parent terminates them on Ctrl-C (episodes in flight are
-  lost). A worker that dies (killed, crashed) breaks the pool: the pool is restarted and the
+  default. Workers ignore Ctrl-C; the parent terminates them on Ctrl-C or SIGTERM (episodes in
+  flight are lost), and they die with the parent if it is killed
+  (:func:`~fcplan.experiments.workers.init_worker`). A worker that dies (killed, crashed) breaks the pool: the pool is restarted and the
   unfinished episodes resubmitted, up to ``max_restarts`` times; after that the rest are lost.
 * :func:`iter_dask`: ``address="local"`` starts a :class:`distributed.LocalCluster` (``jobs``
   single-threaded worker processes); any other address connects to an existing scheduler
@@ -35,6 +36,7 @@ Examples
 from __future__ import annotations
 
 import logging
+import os
 from collections.abc import Callable, Generator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -79,7 +81,7 @@ def iter_pool(
         executor = ProcessPoolExecutor(
             max_workers=max(1, min(jobs, len(pending))),
             initializer=init_worker,
-            initargs=(runtime or {},),
+            initargs=(runtime or {}, os.getpid()),
         )
         futures: dict[Future, Any] = {}
         finished_keys: set[str] = set()

@@ -1,106 +1,26 @@
-"""The ``fcplan sweep`` and ``fcplan report`` sub-commands (listed in ``fcplan.cli``).
+"""The ``fcplan sweep`` and ``fcplan report`` commands under their first import path.
 
-::
-
-    fcplan sweep CONFIG.toml [--results DIR] [--jobs N] [--dask ADDRESS|local] [--retry-failed]
-                             [--quiet]
-    fcplan report RESULTS [--out DIR] [--html] [--metric NAME]
-
-``fcplan sweep`` runs :func:`fcplan.experiments.sweep` (default results folder:
-``results/<CONFIG stem>``, so re-running the same command resumes); it prints a summary, one
-warning line per failed episode, and exits 0 when every episode is stored (completed or failed)
-and 1 when some were lost (a worker died): re-run to play them. ``fcplan report`` runs
-:func:`fcplan.experiments.report.report` and prints the Markdown report.
+They live in :mod:`fcplan.cli.sweep` and :mod:`fcplan.cli.report`; :func:`add_parser` adds both.
 
 Examples
 --------
->>> import argparse
->>> from fcplan.cliutil import Parser
+>>> from fcplan.cli.util import Parser
 >>> p = Parser(prog="fcplan")
 >>> add_parser(p.add_subparsers(dest="command", parser_class=Parser))
->>> p.parse_args(["sweep", "study.toml", "--jobs", "2"]).jobs
-2
+>>> [p.parse_args([c, "x"]).run.__module__ for c in ("sweep", "report")]
+['fcplan.cli.sweep', 'fcplan.cli.report']
 """
 
 from __future__ import annotations
 
-import argparse
-import sys
-from pathlib import Path
-
-from fcplan.cliutil import positive_int
+import fcplan.cli.report as report
+import fcplan.cli.sweep as sweep
+from fcplan.cli.util import SubParsers
 
 __all__ = ["add_parser"]
 
 
-def add_parser(sub) -> None:
-    """Add ``sweep`` and ``report`` to the ``fcplan`` sub-parsers ``sub``."""
-    s = sub.add_parser(
-        "sweep",
-        help="run a TOML grid of scenarios x schedulers x seeds x overrides; results to Parquet",
-    )
-    s.add_argument("config", help="sweep file (TOML): scenarios, schedulers, seeds, overrides")
-    s.add_argument(
-        "--results",
-        metavar="DIR",
-        default=None,
-        help="results folder (default results/<config name>); re-running resumes",
-    )
-    s.add_argument(
-        "--jobs", "-j", type=positive_int, default=None, help="worker processes (default: CPUs)"
-    )
-    s.add_argument(
-        "--dask",
-        metavar="ADDRESS",
-        default=None,
-        help="run on a Dask cluster: a scheduler address (tcp://host:8786) or 'local'",
-    )
-    s.add_argument(
-        "--retry-failed", action="store_true", help="also re-run episodes stored as failed"
-    )
-    s.add_argument("--quiet", "-q", action="store_true", help="no progress on stderr")
-    s.set_defaults(run=_run_sweep)
-
-    r = sub.add_parser(
-        "report", help="tables, paired Wilcoxon comparisons and plots from a sweep's results"
-    )
-    r.add_argument("results", help="results folder written by fcplan sweep")
-    r.add_argument(
-        "--out", metavar="DIR", default=None, help="output folder (default RESULTS/report)"
-    )
-    r.add_argument("--html", action="store_true", help="also write report.html")
-    r.add_argument(
-        "--metric",
-        default="manual.final_score",
-        help="metric for the paired comparisons and plots (default manual.final_score)",
-    )
-    r.set_defaults(run=_run_report)
-
-
-def _run_sweep(args: argparse.Namespace) -> int:
-    from fcplan.experiments.sweep import sweep
-
-    results = args.results or str(Path("results") / Path(args.config).stem)
-    summary = sweep(
-        args.config,
-        results,
-        jobs=args.jobs,
-        dask=args.dask,
-        retry_failed=args.retry_failed,
-        progress=not args.quiet,
-    )
-    print(summary.format())
-    for e in summary.errors:
-        print(f"fcplan: warning: episode failed: {e}", file=sys.stderr)
-    if summary.ran or summary.skipped:
-        print(f"report: fcplan report {results}")
-    return 1 if summary.lost else 0
-
-
-def _run_report(args: argparse.Namespace) -> int:
-    from fcplan.experiments.report import report
-
-    rep = report(args.results, out=args.out, html=args.html, metric=args.metric)
-    print(rep.markdown, end="")
-    print(f"written: {', '.join(str(p) for p in rep.files)}", file=sys.stderr)
-    return 0
+def add_parser(sub: SubParsers) -> None:
+    """Add ``fcplan sweep`` and ``fcplan report`` to the ``fcplan`` sub-parsers ``sub``."""
+    sweep.add_parser(sub)
+    report.add_parser(sub)

@@ -8,18 +8,26 @@ process pool that is restarted if a worker dies), and returns a
 per-scheduler table with confidence intervals, text, CSV and JSON output). Workers send back each
 episode's summary numbers and per-replan solve times, never the trace.
 
-Reproducibility. Every episode is seeded by its seed alone, so the scores do not depend on
-``jobs``, on the worker an episode ran in, or on the order episodes finished: a serial and a
-parallel comparison give identical score columns. The timing columns (solve times, wall time) are
-measurements and vary from run to run.
+Reproducibility. Every episode is seeded by its seed alone, and by default every scheduler that
+has a deterministic mode runs in it (:func:`fcplan.scheduling.supports_deterministic`: the
+``deterministic=True`` setting is added to its spec unless the spec sets ``deterministic``
+itself), so the scores do not depend on ``jobs``, on machine load, on the worker an episode ran
+in, or on the order episodes finished: a serial and a parallel comparison give identical score
+columns. The wall-time mode (time limits that bind on the wall clock) is an explicit choice:
+``deterministic=False`` (``fcplan compare --wall-time``) or ``deterministic=false`` in one
+scheduler's spec; every episode row records it in its ``deterministic`` column (the scheduler's
+own ``deterministic`` attribute: True for greedy, idle and random, which never read the clock).
+The timing columns (solve times, wall time) are measurements and vary from run to run.
 
 Failures. A scheduler that raises or returns an invalid plan does not fail its episode (the
 episode loop falls back to greedy for that replan and counts a fallback). An episode that fails
 anyway (an exception escaping :func:`fcplan.run_episode`) is recorded with its error message and
 counted in the ``errors`` column, and so is an episode lost because its worker process kept dying;
-the other episodes run on. Scheduler names are checked, and every scheduler is constructed once
-with its default settings, before any episode runs, so a typo or a scheduler that cannot be built
-fails at once with a one-line :class:`fcplan.FcplanError`. Ctrl-C (:class:`KeyboardInterrupt`)
+the other episodes run on. An episode whose scheduler fell back on more than half of its replans
+is flagged (``fallback_majority``): its score is mostly greedy's. Scheduler specs are checked, and
+every scheduler is constructed once with its settings, before any episode runs (through
+:func:`fcplan.make_scheduler`, the one validation path), so a typo or a bad setting fails at once
+with a one-line :class:`fcplan.FcplanError`. Ctrl-C (:class:`KeyboardInterrupt`)
 cancels the pending episodes, stops the workers and re-raises.
 
 Examples
@@ -44,16 +52,18 @@ from typing import Any
 
 import numpy as np
 
-from fcplan.errors import FcplanError, UnknownNameError
+from fcplan.errors import FcplanError
 from fcplan.experiments.backends import select_backend
 from fcplan.experiments.comparison import ComparisonResult
 from fcplan.experiments.progress import ProgressPrinter
 from fcplan.experiments.ranges import RangeError, parse_range
-from fcplan.experiments.tables import SCORE_COLUMNS
+from fcplan.experiments.tables import SCORE_COLUMNS, fallback_majority
 from fcplan.experiments.workers import default_jobs, runtime_factories
 
 __all__ = [
     "compare",
+    "fallback_majority",
+    "scheduler_variant",
     "ComparisonResult",
     "parse_range",
     "RangeError",
@@ -70,32 +80,57 @@ from :data:`fcplan.experiments.tables.SCORE_COLUMNS`."""
 # validation
 
 
-def _check_schedulers(names: Sequence[str]) -> list[str]:
-    """Validate scheduler names and build each once; a clear one-line error otherwise."""
-    from fcplan.scheduling import available_schedulers, make_scheduler
+@dataclass(frozen=True, slots=True)
+class _Variant:
+    """A scheduler as given (``label``, the spec) and as built (registered name and settings)."""
 
+    label: str
+    name: str
+    settings: dict[str, Any]
+
+
+def scheduler_variant(spec: str, *, deterministic: bool = True) -> tuple[str, dict[str, Any]]:
+    """The registered name and settings of ``spec``, checked by building the scheduler once.
+
+    ``deterministic=True`` adds ``deterministic=True`` to the settings of a scheduler that
+    supports it (:func:`fcplan.scheduling.supports_deterministic`) unless the spec sets it.
+
+    Raises
+    ------
+    fcplan.FcplanError
+        The one-line error of :func:`fcplan.make_scheduler` (unknown name or setting, a value
+        the scheduler refuses, a malformed spec).
+
+    Examples
+    --------
+    >>> scheduler_variant("routing:time_limit=0.05")
+    ('routing', {'time_limit': 0.05, 'deterministic': True})
+    >>> scheduler_variant("greedy:route_length=2", deterministic=False)
+    ('greedy', {'route_length': 2})
+    """
+    from fcplan.scheduling import make_scheduler, parse_scheduler_spec, supports_deterministic
+
+    if not isinstance(spec, str):
+        raise FcplanError(f"schedulers are given by registered name, got {spec!r}")
+    name, settings = parse_scheduler_spec(spec)
+    if deterministic and "deterministic" not in settings and supports_deterministic(name):
+        settings["deterministic"] = True
+    make_scheduler(name, **settings)
+    return name, settings
+
+
+def _check_schedulers(names: Sequence[str], deterministic: bool) -> list[_Variant]:
+    """Check every spec and build each scheduler once (a one-line error otherwise)."""
     if isinstance(names, str):
         names = [names]
     names = list(dict.fromkeys(names))
     if not names:
         raise FcplanError("no schedulers to compare")
-    known = available_schedulers()
-    for name in names:
-        if not isinstance(name, str):
-            raise FcplanError(f"schedulers are given by registered name, got {name!r}")
-        if name.split(":")[0].strip() not in known:
-            raise UnknownNameError(
-                f"unknown scheduler {name!r}; known schedulers: {', '.join(known)}"
-            )
-        try:
-            make_scheduler(name)
-        except FcplanError:
-            raise
-        except Exception as exc:  # noqa: BLE001 - report any construction failure in one line
-            raise FcplanError(
-                f"scheduler {name!r} cannot be created: {type(exc).__name__}: {exc}"
-            ) from exc
-    return names
+    out = []
+    for spec in names:
+        name, settings = scheduler_variant(spec, deterministic=deterministic)
+        out.append(_Variant(spec, name, settings))
+    return out
 
 
 def _load_scenarios(scenarios: Any) -> list[Any]:
@@ -141,7 +176,7 @@ def _positive(name: str, value: Any) -> float:
 class _Task:
     index: int
     scenario: Any  # Scenario
-    scheduler: str
+    variant: _Variant
     seed: int
     time_limit: float | None
     replan_period: float
@@ -157,7 +192,7 @@ def _identity(task: _Task) -> dict[str, Any]:
     return {
         "scenario": task.scenario.name,
         "difficulty": task.scenario.difficulty,
-        "scheduler": task.scheduler,
+        "scheduler": task.variant.label,
         "seed": task.seed,
     }
 
@@ -169,10 +204,13 @@ def _failed_row(task: _Task, error: str) -> dict[str, Any]:
 
 def _run_task(task: _Task) -> tuple[int, dict[str, Any], list[float]]:
     """Play one episode; return its summary row and per-replan solve times (ms)."""
+    from fcplan.scheduling import make_scheduler
+
     try:
+        scheduler = make_scheduler(task.variant.name, **task.variant.settings)
         res = run_episode(
             task.scenario,
-            task.scheduler,
+            scheduler,
             seed=task.seed,
             replan_period=task.replan_period,
             time_limit=task.time_limit,
@@ -181,9 +219,13 @@ def _run_task(task: _Task) -> tuple[int, dict[str, Any], list[float]]:
         times = (res.solve_times_s * 1e3).tolist()
     except Exception as exc:  # noqa: BLE001 - one failed episode must not stop the comparison
         return task.index, _failed_row(task, f"{type(exc).__name__}: {exc}"), []
-    for k in ("scenario", "seed", "scheduler"):  # the registered name is the row's label
+    for k in ("scenario", "seed", "scheduler"):  # the spec as given is the row's label
         summary.pop(k, None)
-    return task.index, {**_identity(task), **summary, "error": ""}, times
+    mode = {
+        "deterministic": bool(getattr(scheduler, "deterministic", False)),
+        "fallback_majority": fallback_majority(summary),
+    }
+    return task.index, {**_identity(task), **summary, **mode, "error": ""}, times
 
 
 def run_episode(*args: Any, **kwargs: Any) -> Any:
@@ -206,6 +248,7 @@ def compare(
     time_limit: float | None = None,
     replan_period: float = 1.0,
     progress: Callable[[int, int, dict[str, Any]], None] | None = None,
+    deterministic: bool = True,
 ) -> ComparisonResult:
     """Run every (scenario, scheduler, seed) episode and collect the scores.
 
@@ -215,8 +258,8 @@ def compare(
         Scenario objects (e.g. ``load_scenario(3).replace(duration_s=20)``) or names/paths for
         :func:`fcplan.load_scenario`; all are loaded (and so validated) before anything runs.
     schedulers : sequence of str
-        Registered scheduler names (:func:`fcplan.available_schedulers`). Each is built once up
-        front with its default settings; every episode builds its own instance.
+        Scheduler specs: registered names (:func:`fcplan.available_schedulers`), with settings as
+        ``name:key=value``. Each is built once up front; every episode builds its own instance.
     seeds : sequence of int
         Seeds >= 0; each (scenario, scheduler) pair is played once per seed.
     jobs : int, optional
@@ -229,6 +272,9 @@ def compare(
     progress : callable, optional
         Called as ``progress(done, total, row)`` after each episode (``row`` is its episode
         dict), in completion order. :class:`ProgressPrinter` prints throttled progress lines.
+    deterministic : bool
+        Run every scheduler that has a deterministic mode in it (the default, see the module
+        docstring); False is the wall-time mode.
 
     Returns
     -------
@@ -245,7 +291,9 @@ def compare(
         After cancelling the pending episodes and stopping the workers.
     """
     scen = _load_scenarios(scenarios)
-    names = _check_schedulers(schedulers)
+    if not isinstance(deterministic, bool):
+        raise FcplanError(f"deterministic must be True or False, got {deterministic!r}")
+    variants = _check_schedulers(schedulers, deterministic)
     seed_list = _check_seeds(seeds)
     tl = None if time_limit is None else _positive("time_limit", time_limit)
     rp = _positive("replan_period", replan_period)
@@ -254,21 +302,22 @@ def compare(
     if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
         raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
     tasks = [
-        _Task(len(seed_list) * (i * len(names) + j) + k, s, name, seed, tl, rp)
+        _Task(len(seed_list) * (i * len(variants) + j) + k, s, v, seed, tl, rp)
         for i, s in enumerate(scen)
-        for j, name in enumerate(names)
+        for j, v in enumerate(variants)
         for k, seed in enumerate(seed_list)
     ]
     jobs = int(min(jobs, len(tasks)))
     t0 = time.perf_counter()
-    rows, times = _play(tasks, jobs, runtime_factories(names), progress)
+    rows, times = _play(tasks, jobs, runtime_factories([v.name for v in variants]), progress)
+    settings = {"time_limit": tl, "replan_period": rp, "jobs": jobs, "deterministic": deterministic}
     return ComparisonResult(
         episodes=rows,
         solve_times_ms=times,
         scenarios=[s.name for s in scen],
-        schedulers=names,
+        schedulers=[v.label for v in variants],
         seeds=seed_list,
-        settings={"time_limit": tl, "replan_period": rp, "jobs": jobs},
+        settings=settings,
         wall_time_s=time.perf_counter() - t0,
     )
 

@@ -12,8 +12,10 @@
   :data:`~fcplan.experiments.tables.SCORE_COLUMNS` (the manual's final score, OFS, PS, AS, FPS,
   NRR and total negative reward, and the reference2020 final score); the median and 95th
   percentile of the solve time per replan in ms, pooled over all the scheduler's replans;
-  fallbacks (replans where the scheduler failed and greedy stood in) and replans; the mean wall
-  time per episode.
+  fallbacks (replans where the scheduler failed and greedy stood in) and replans; the episodes
+  that fell back on more than half of their replans (``fallback_majority``: their scores are
+  mostly greedy's, and :meth:`~ComparisonResult.format` says so under the table); whether the
+  scheduler ran in its deterministic mode (``deterministic``); the mean wall time per episode.
 * :meth:`~ComparisonResult.format` (text table, ``mean ± ci`` cells),
   :meth:`~ComparisonResult.to_csv` (the table), :meth:`~ComparisonResult.to_json` (the table, the
   episodes and the solve times; :meth:`~ComparisonResult.from_json` reads it back).
@@ -45,7 +47,7 @@ import numpy as np
 
 from fcplan.errors import UnknownNameError
 from fcplan.experiments.stats import MeanCI, mean_ci, paired_mean_ci
-from fcplan.experiments.tables import SCORE_COLUMNS, Column, difficulty_key
+from fcplan.experiments.tables import SCORE_COLUMNS, Column, difficulty_key, fallback_majority
 
 __all__ = ["ComparisonResult"]
 
@@ -125,6 +127,9 @@ class ComparisonResult:
         row["solve_p95_ms"] = _pct(st, 95)
         row["fallbacks"] = fallbacks
         row["fallback_rate"] = fallbacks / replans if replans else math.nan
+        row["fallback_majority"] = sum(fallback_majority(e) for e in good)
+        modes = {e.get("deterministic") for e in good}
+        row["deterministic"] = None if not modes or None in modes else bool(modes == {True})
         row["optimal_rate"] = (
             sum(e.get("optimal_replans", 0) for e in good) / replans if replans else math.nan
         )
@@ -157,7 +162,9 @@ class ComparisonResult:
             ``<key>_ci`` (95 % half-width; NaN with
             fewer than 2 episodes), ``replans``, ``solve_p50_ms``, ``solve_p95_ms`` (pooled over
             all replans), ``fallbacks``, ``fallback_rate`` (fallbacks / replans),
-            ``wall_time_s_mean`` (per episode).
+            ``fallback_majority`` (episodes that fell back on more than half of their replans),
+            ``deterministic`` (every episode in the scheduler's deterministic mode; None when
+            not recorded), ``wall_time_s_mean`` (per episode).
         """
         groups: dict[tuple[Any, ...], list[int]] = {}
         for name in self._schedulers():
@@ -246,6 +253,14 @@ class ComparisonResult:
                 f"{len(self.errors)} episode(s) failed; first: {e['scenario']} {e['scheduler']} "
                 f"seed {e['seed']}: {e['error']}"
             )
+        for r in rows:
+            if r["fallback_majority"]:
+                where = f" ({r['difficulty']})" if by_difficulty else ""
+                out.append(
+                    f"warning: {r['scheduler']}{where}: {r['fallback_majority']} of "
+                    f"{r['episodes']} episode(s) fell back to greedy on more than half of their "
+                    "replans; their scores are mostly greedy's"
+                )
         return "\n".join(out)
 
     def __str__(self) -> str:
@@ -329,12 +344,19 @@ def _text_columns(by_difficulty: bool) -> list[tuple[str, _Cell, str]]:
     cols += [
         ("solve ms p50/p95", lambda r: f"{_ms(r['solve_p50_ms'])}/{_ms(r['solve_p95_ms'])}", ">"),
         ("fallbacks", lambda r: f"{r['fallbacks']}/{r['replans']}", ">"),
+        ("fb>50%", lambda r: str(r["fallback_majority"]), ">"),
         ("optimal", lambda r: _share(r["optimal_rate"]), ">"),
         ("t-limit", lambda r: _share(r["time_limit_rate"]), ">"),
         ("rounds/msgs", _rounds, ">"),
+        ("mode", _mode, ">"),
         ("wall s", lambda r: f"{r['wall_time_s_mean']:.2f}", ">"),
     ]
     return cols
+
+
+def _mode(r: dict[str, Any]) -> str:
+    """``det`` (deterministic mode), ``wall`` (plans may depend on the wall clock) or ``-``."""
+    return {True: "det", False: "wall"}.get(r["deterministic"], "-")
 
 
 def _ms(v: float) -> str:

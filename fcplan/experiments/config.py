@@ -9,6 +9,8 @@ A sweep file (``fcplan sweep study.toml``) describes a grid; every combination i
     replan_period = 1.0               # simulated s between replans; a list makes it a grid axis
     time_limit = 0.1                  # s per scheduler call; omit for each scheduler's own;
                                       #   a list makes it an axis
+    deterministic = true              # default: schedulers with a deterministic mode run in it;
+                                      #   false is the wall-time mode (fcplan sweep --wall-time)
 
     schedulers = ["greedy", "routing:time_limit=0.05"]   # names or name:key=value specs
     # or, with labels, fixed settings and setting grids:
@@ -30,6 +32,12 @@ limit, scheduler variant, seed. Every override combination is applied to every s
 validated *before* anything runs; errors (:class:`SweepConfigError`) name the sweep file, the field
 and what is allowed.
 
+Deterministic mode. By default every scheduler variant whose factory takes a ``deterministic``
+setting (:func:`fcplan.scheduling.supports_deterministic`) gets ``deterministic = true`` unless it
+sets the setting itself, so an episode's metrics do not depend on machine load or the number of
+workers. ``deterministic = false`` (or ``sweep(..., deterministic=False)``, ``fcplan sweep
+--wall-time``) is the wall-time mode; the settings column of every result row records which.
+
 Each :class:`EpisodeSpec` has a ``key``: a hash of everything that determines the episode (the
 scenario document after overrides, the scheduler name, label and settings, the seed, the replan
 period and the time limit). Results are stored by key, so a re-run skips what is done even if the
@@ -49,20 +57,18 @@ Examples
 
 from __future__ import annotations
 
-import copy
 import hashlib
 import itertools
 import json
 import math
 import os
-import re
-import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fcplan.errors import FcplanError
+from fcplan.errors import FcplanError, ScenarioError
+from fcplan.experiments.overrides import SweepConfigError, apply_overrides
 
 __all__ = [
     "EpisodeSpec",
@@ -73,13 +79,17 @@ __all__ = [
     "load_sweep_config",
 ]
 
-_TOP_KEYS = ("name", "scenarios", "schedulers", "seeds", "replan_period", "time_limit", "overrides")
+_TOP_KEYS = (
+    "name",
+    "scenarios",
+    "schedulers",
+    "seeds",
+    "replan_period",
+    "time_limit",
+    "overrides",
+    "deterministic",
+)
 _SCHEDULER_KEYS = ("name", "label", "settings", "grid")
-
-
-class SweepConfigError(FcplanError, ValueError):
-    """A sweep file (or dict) is malformed: the message names the file, the field and what is
-    allowed."""
 
 
 def _canon(obj: Any) -> str:
@@ -145,6 +155,7 @@ class SweepConfig:
     time_limits: tuple[float | None, ...] = (None,)
     name: str = ""
     source: str = "<sweep>"
+    deterministic: bool = True
 
     def to_dict(self) -> dict[str, Any]:
         """The normalised grid as JSON-ready data (scenarios by name)."""
@@ -158,6 +169,7 @@ class SweepConfig:
             "overrides": {k: list(v) for k, v in self.overrides.items()},
             "replan_period": list(self.replan_periods),
             "time_limit": list(self.time_limits),
+            "deterministic": self.deterministic,
         }
 
     @property
@@ -218,92 +230,6 @@ class SweepConfig:
                         )
                     )
         return out
-
-
-# --------------------------------------------------------------------------------------------
-# overrides
-
-_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[(?:\*|\d+)\])*)$")
-
-
-def _set_path(node: Any, parts: list[str], value: Any, path: str) -> None:
-    """Set ``value`` at the dotted ``parts`` inside ``node`` (dicts and lists)."""
-    head, rest = parts[0], parts[1:]
-    m = _PART.match(head)
-    if m is None:
-        raise FcplanError(f"malformed path element {head!r} (use key, key[0] or key[*])")
-    key, idx_text = m.group(1), m.group(2)
-    indices = re.findall(r"\[(\*|\d+)\]", idx_text)
-    if not isinstance(node, dict):
-        raise FcplanError(f"{path}: {key!r} is not inside a table")
-    if not indices and not rest:
-        node[key] = copy.deepcopy(value)
-        return
-    if key not in node:
-        raise FcplanError(
-            f"{path}: no field {key!r} here; fields: {', '.join(sorted(node)) or '(none)'}"
-        )
-    slots: list[tuple[Any, Any]] = [(node, key)]  # (container, index) pairs to descend into
-    for ix in indices:
-        nxt: list[tuple[Any, Any]] = []
-        for parent, k in slots:
-            t = parent[k]
-            if not isinstance(t, list):
-                raise FcplanError(f"{path}: {key!r} is not a list, so [{ix}] does not apply")
-            if ix == "*":
-                nxt.extend((t, i) for i in range(len(t)))
-            elif int(ix) < len(t):
-                nxt.append((t, int(ix)))
-            else:
-                raise FcplanError(f"{path}: index {ix} out of range 0..{len(t) - 1}")
-        slots = nxt
-    for parent, k in slots:
-        if rest:
-            _set_path(parent[k], rest, value, path)
-        else:
-            parent[k] = copy.deepcopy(value)
-
-
-def apply_overrides(scenario: Any, overrides: Mapping[str, Any], *, source: str = "") -> Any:
-    """A copy of ``scenario`` with dotted-path ``overrides`` applied to its TOML document.
-
-    Paths are keys separated by dots; ``key[i]`` indexes a list and ``key[*]`` means every item,
-    e.g. ``"team.perception.count"``, ``"fire.regions[*].wind_speed"``, ``"duration_s"``. In
-    ``uniform`` fire mode the region parameters live in ``fire`` itself (``"fire.wind_speed"``).
-    Several paths joined by ``+`` all receive the value (``"team.perception.count+team.action.count"``).
-
-    Raises
-    ------
-    SweepConfigError
-        A path that does not exist in the document, or a value the scenario rejects (the
-        scenario's validation message is included).
-
-    Examples
-    --------
-    >>> from fcplan.scenario import load_scenario
-    >>> s = apply_overrides(load_scenario(12), {"fire.regions[*].wind_speed": 15})
-    >>> [r.wind_speed for r in s.regions]
-    [15.0, 15.0]
-    """
-    from fcplan.scenario import Scenario
-
-    if not overrides:
-        return scenario
-    doc = copy.deepcopy(scenario.to_dict())
-    where = f"{source}: " if source else ""
-    for path, value in overrides.items():
-        try:
-            for one in path.split("+"):
-                _set_path(doc, one.strip().split("."), value, path)
-        except FcplanError as exc:
-            raise SweepConfigError(f"{where}overrides: scenario {scenario.name}: {exc}") from None
-    try:
-        return Scenario.from_dict(doc, source=scenario.source)
-    except FcplanError as exc:
-        shown = ", ".join(f"{k}={v!r}" for k, v in overrides.items())
-        raise SweepConfigError(
-            f"{where}overrides {shown} make scenario {scenario.name} invalid: {exc}"
-        ) from None
 
 
 # --------------------------------------------------------------------------------------------
@@ -402,15 +328,14 @@ def _scenarios(source: str, value: Any, base_dir: Path | None) -> tuple[Any, ...
     return tuple(seen.values())
 
 
-def _schedulers(source: str, value: Any) -> tuple[SchedulerVariant, ...]:
-    from fcplan.scheduling import available_schedulers, make_scheduler, parse_scheduler_spec
+def _schedulers(source: str, value: Any, deterministic: bool) -> tuple[SchedulerVariant, ...]:
+    from fcplan.scheduling import make_scheduler, parse_scheduler_spec, supports_deterministic
 
     if value is None:
         raise _err(source, "schedulers", 'is required, e.g. schedulers = ["greedy", "random"]')
     items = value if isinstance(value, list) else [value]
     if not items:
         raise _err(source, "schedulers", "must not be empty")
-    known = available_schedulers()
     variants: list[SchedulerVariant] = []
     for i, item in enumerate(items):
         where = f"schedulers[{i}]"
@@ -457,20 +382,13 @@ def _schedulers(source: str, value: Any) -> tuple[SchedulerVariant, ...]:
         else:
             raise _err(source, where, "must be a name, a name:key=value spec or a table", item)
         for label, name, settings in entries:
-            if name not in known:
-                raise _err(
-                    source, f"{where}", f"unknown scheduler {name!r}; known: {', '.join(known)}"
-                )
-            try:
+            try:  # the one validation path of scheduler specs (unknown names included)
+                add = deterministic and "deterministic" not in settings
+                if add and supports_deterministic(name):
+                    settings = {**settings, "deterministic": True}
                 make_scheduler(name, **settings)
             except FcplanError as exc:
                 raise _err(source, where, str(exc)) from None
-            except Exception as exc:  # noqa: BLE001 - any construction failure, one line
-                raise _err(
-                    source,
-                    where,
-                    f"scheduler {name!r} cannot be created: {type(exc).__name__}: {exc}",
-                ) from None
             if any(v.label == label for v in variants):
                 raise _err(source, where, "duplicate scheduler label", label)
             variants.append(SchedulerVariant(label, name, dict(settings)))
@@ -510,19 +428,31 @@ def _flatten(d: Mapping[str, Any], prefix: str = "") -> list[tuple[str, Any]]:
 
 def load_sweep_config(
     config: str | os.PathLike[str] | Mapping[str, Any] | SweepConfig,
+    *,
+    deterministic: bool = True,
 ) -> SweepConfig:
     """Read and validate a sweep file (TOML path) or the same document as a dict.
 
     Scenario names, scheduler names and settings, seeds and numbers are all checked here, and
     every override combination is applied to every scenario (so an invalid one fails now, not
-    mid-sweep).
+    mid-sweep). The file is read as scenario files are (:func:`fcplan.scenario.read.read_text`:
+    a regular file of at most 2 MiB, nesting bounded). ``deterministic=False`` chooses the
+    wall-time mode whatever the file says (see the module docstring).
 
     Raises
     ------
     SweepConfigError
         With the file, the field and what is allowed.
     """
+    from fcplan.scenario.bounds import check_document
+    from fcplan.scenario.read import parse_toml, read_text
+
     if isinstance(config, SweepConfig):
+        if config.deterministic and not deterministic:
+            raise SweepConfigError(
+                f"{config.source}: this config was loaded in the deterministic mode; load it "
+                "with load_sweep_config(..., deterministic=False) for the wall-time mode"
+            )
         return config
     base_dir = None
     if isinstance(config, Mapping):
@@ -531,14 +461,16 @@ def load_sweep_config(
         path = Path(config)
         source = str(path)
         try:
-            doc = tomllib.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise SweepConfigError(f"{source}: no such sweep file") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise SweepConfigError(f"{source}: cannot read: {exc}") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise SweepConfigError(f"{source}: not valid TOML: {exc}") from None
+            doc = parse_toml(read_text(path), source)
+        except ScenarioError as exc:
+            if exc.problem == "no such file":
+                raise SweepConfigError(f"{source}: no such sweep file") from None
+            raise SweepConfigError(f"{source}: {exc.problem}") from None
         base_dir = path.resolve().parent
+    try:
+        check_document(doc)
+    except ScenarioError as exc:
+        raise SweepConfigError(f"{source}: {exc.field}: {exc.problem}") from None
     unknown = set(doc) - set(_TOP_KEYS)
     if unknown:
         raise _err(
@@ -549,9 +481,13 @@ def load_sweep_config(
         raise _err(source, "name", "must be a string", name)
     if "time_limit" in doc and doc["time_limit"] is None:
         doc.pop("time_limit")
+    mode = doc.get("deterministic", True)
+    if not isinstance(mode, bool):
+        raise _err(source, "deterministic", "must be true or false", mode)
+    mode = mode and deterministic
     cfg = SweepConfig(
         scenarios=_scenarios(source, doc.get("scenarios"), base_dir),
-        schedulers=_schedulers(source, doc.get("schedulers")),
+        schedulers=_schedulers(source, doc.get("schedulers"), mode),
         seeds=_seeds(source, doc.get("seeds")),
         overrides=_overrides(source, doc.get("overrides")),
         replan_periods=_number_axis(
@@ -562,6 +498,7 @@ def load_sweep_config(
         ),
         name=name,
         source=source,
+        deterministic=mode,
     )
     for scen in cfg.scenarios:  # validate every override combination up front
         for combo in cfg.override_combinations():

@@ -17,6 +17,9 @@ Row columns (one per episode; :func:`fcplan.experiments.load_results` reads them
   metrics, ``ticks``, ``wall_time_s``, ``replans``, ``fallbacks``, ``optimal_replans``,
   ``time_limit_replans``, ``solve_p50_ms``, ``solve_p95_ms``, ``rounds_per_replan``,
   ``messages_per_replan``) plus ``solve_mean_ms``, ``solve_max_ms``;
+* ``deterministic`` (the scheduler ran in a mode whose plans do not depend on the wall clock:
+  its ``deterministic`` attribute) and ``fallback_majority`` (it fell back to greedy on more than
+  half of its replans, so the scores are mostly greedy's);
 * per replan (lists): ``replan_solve_ms``, ``replan_tasks``, ``replan_agents``;
 * ``status`` (``ok`` | ``failed``), ``error`` (``""`` or ``"ExcType: message"``),
   ``episode_wall_s`` (including scheduler construction), ``host``, ``finished_at`` (UTC ISO
@@ -110,6 +113,7 @@ def play_episode(spec: Any, runtime: dict[str, Callable[..., Any]] | None = None
     dict
         The result row (see the module docstring); never raises for a failing episode.
     """
+    from fcplan.experiments.tables import fallback_majority
     from fcplan.experiments.workers import register_runtime
 
     t0 = time.perf_counter()
@@ -131,6 +135,10 @@ def play_episode(spec: Any, runtime: dict[str, Callable[..., Any]] | None = None
         for k in ("scenario", "scheduler", "seed"):
             summary.pop(k, None)
         row.update(summary)
+        row.update(
+            deterministic=bool(getattr(scheduler, "deterministic", False)),
+            fallback_majority=fallback_majority(summary),
+        )
         ms = res.solve_times_s * 1e3
         tasks = [int(st.size.get("tasks", -1)) for st in res.solves]
         agents = [int(st.size.get("agents", -1)) for st in res.solves]

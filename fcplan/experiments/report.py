@@ -17,10 +17,15 @@
     of pairs, the mean difference of the metric ± its 95 % CI, wins/ties/losses, and the p-value
     of the two-sided Wilcoxon signed-rank test (:func:`scipy.stats.wilcoxon`, zero differences
     dropped; ``p = 1`` when every pair ties, NaN without pairs);
+  - the schedulers with episodes that fell back to greedy on more than half of their replans
+    (:func:`~fcplan.experiments.tables.fallback_majority`, from the ``fallbacks`` and ``replans``
+    columns): those episodes' scores are mostly greedy's;
   - the failed episodes with their errors.
-* PNG plots (matplotlib, Agg backend): ``score_distribution.png`` (box plot and every episode per
-  scheduler), ``score_by_difficulty.png`` (means with CI bars per difficulty group),
-  ``score_per_scenario.png`` (mean and CI per scenario and scheduler), ``solve_time_vs_size.png``
+* plots (matplotlib, Agg backend), each as PNG and as PDF beside it
+  (:mod:`fcplan.experiments.plots`): ``score_distribution`` (box plot and every episode per
+  scheduler), ``score_by_difficulty`` (every episode, and the mean with its CI per difficulty
+  group), ``score_per_scenario`` (the same per scenario and scheduler; intervals far beyond the
+  episodes' range are cut at the axis and their half-width written), ``solve_time_vs_size``
   (time per scheduler call against the task graph's size, every replan, and the median against
   team size per episode).
 * ``report.html`` with ``html=True``: the same tables and the plots embedded.
@@ -66,7 +71,12 @@ from fcplan.experiments.plots import (
 )
 from fcplan.experiments.results import load_results
 from fcplan.experiments.stats import mean_ci
-from fcplan.experiments.tables import REPORT_COLUMNS, difficulty_key, higher_is_better
+from fcplan.experiments.tables import (
+    REPORT_COLUMNS,
+    difficulty_key,
+    fallback_majority,
+    higher_is_better,
+)
 
 __all__ = ["METRICS", "Report", "report"]
 
@@ -295,6 +305,7 @@ def report(
     sections += [("img", image) for image in images]
     markdown = "\n\n".join(_markdown(kind, content) for kind, content in sections) + "\n"
     files = [out_dir / "report.md", *(p for _, p in images)]
+    files += [p.with_suffix(".pdf") for _, p in images]
     (out_dir / "report.md").write_text(markdown, encoding="utf-8")
     csvs = (
         ("per_scheduler", tables["per_scheduler"]),
@@ -350,7 +361,7 @@ def _tables(df: Any, diffs: list[str], metrics: list[str]) -> tuple[dict[str, An
 def _draw_plots(
     out_dir: Path, df: Any, names: list[str], diffs: list[str], scenarios: list[str], metric: str
 ) -> list[tuple[str, Path]]:
-    """Write the PNG plots; return (title, file) of each."""
+    """Write the plots (PNG, and PDF beside each); return (title, PNG file) of each."""
     mpl = require("matplotlib", "plot")
     if "matplotlib.pyplot" not in sys.modules:
         mpl.use("Agg")  # files only; a notebook keeps its own backend
@@ -366,7 +377,7 @@ def _draw_plots(
     ):
         p = out_dir / f"{name}.png"
         table = _group_table(df, [col, "scheduler"], [metric])
-        plot_grouped(table, col, groups, names, metric, label, p, colors, f"{label} {title}")
+        plot_grouped(ok, table, col, groups, names, metric, label, p, colors, f"{label} {title}")
         images.append((f"{label} {caption}", p))
     p = out_dir / "solve_time_vs_size.png"
     plot_solve_time(df, names, p, colors)
@@ -407,6 +418,7 @@ def _sections(
             ("table", _ci_cells(tables["per_setting"], ["scheduler", *setting_cols], metrics)),
         ]
     sections += _paired_sections(paired, metric)
+    sections += _fallback_sections(df[df["status"] == "ok"])
     failed = df[df["status"] != "ok"]
     if len(failed):
         rows = [
@@ -418,6 +430,24 @@ def _sections(
             ("table", (["scheduler", "scenario", "seed", "error"], rows)),
         ]
     return sections
+
+
+def _fallback_sections(ok: Any) -> list[Section]:
+    """A warning table of the schedulers whose episodes mostly fell back (none: nothing)."""
+    if not {"fallbacks", "replans"} <= set(ok.columns) or ok.empty:
+        return []
+    flags = ok.apply(lambda r: fallback_majority(r.to_dict()), axis=1).astype(bool)
+    counts = ok.assign(_f=flags).groupby("scheduler", sort=False)["_f"].agg(["sum", "size"])
+    rows = [[str(k), str(int(r["sum"])), str(int(r["size"]))] for k, r in counts.iterrows()]
+    rows = [r for r in rows if r[1] != "0"]
+    if not rows:
+        return []
+    note = (
+        "These episodes fell back to greedy on more than half of their replans: their scores "
+        "are mostly greedy's, not the scheduler's."
+    )
+    head = ["scheduler", "episodes mostly fallen back", "completed episodes"]
+    return [("h2", "Fallback warning"), ("p", note), ("table", (head, rows))]
 
 
 def _paired_sections(paired: Any, metric: str) -> list[Section]:

@@ -4,13 +4,20 @@ Layout of a results folder (``fcplan sweep ... --results DIR``)::
 
     DIR/<key>.parquet          one row: a finished episode (completed or failed), named by its key
     DIR/manifest-<hash>.json   the normalised grid of each sweep run into this folder
-    DIR/.<key>.<pid>.tmp       a write in progress (ignored; removed by the next sweep)
+    DIR/.<key>.<owner>.tmp     a write in progress (ignored; removed once its writer is dead)
     DIR/<subfolder>/           ignored (e.g. the report's default output, DIR/report/)
 
 Crash safety. A row is written to a hidden temporary file, flushed to disk, then renamed over
 ``<key>.parquet`` (:func:`os.replace`, atomic on POSIX and Windows), so a reader sees either the
 whole row or nothing: a killed sweep leaves no partial rows, at most a stray ``.tmp`` file. Because
 the file name is the episode key, an episode is stored at most once, whatever retries happen.
+A write that fails (a full disk: ``ENOSPC``) removes its temporary file and raises
+:class:`ResultsError` (one line; the rows already stored are untouched).
+
+Temporary files carry their writer (``<host>~<pid>~<random>``): :func:`remove_stale_temporaries`
+deletes only those whose writer is dead (same host, no such process), never a live sweep's.
+:func:`lock_results` lets one sweep at a time write into a folder (``fcntl.flock`` on the folder
+itself, so nothing is left behind; on systems without ``fcntl`` the folder is not locked).
 
 Each file carries the schema metadata key ``fcplan`` = ``{"format": "fcplan-sweep-episode",
 "version": 1}``. :func:`load_results` refuses (with :class:`ResultsError` naming the file) a
@@ -29,9 +36,11 @@ PosixPath('.../abc123.parquet')
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
 import re
+import socket
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
@@ -40,13 +49,52 @@ from typing import Any
 from fcplan.errors import FcplanError
 from fcplan.experiments.optional import require
 
-__all__ = ["ResultsError", "load_results", "stored_status", "write_row", "write_manifest"]
+__all__ = [
+    "ResultsError",
+    "load_results",
+    "lock_results",
+    "remove_stale_temporaries",
+    "stored_status",
+    "write_row",
+    "write_manifest",
+]
 
 FORMAT = {"format": "fcplan-sweep-episode", "version": 1}
 _META_KEY = b"fcplan"
 _ROW_FILE = re.compile(r"^[0-9A-Za-z_-]+\.parquet$")
 _MANIFEST = re.compile(r"^manifest-[0-9a-f]+\.json$")
 _TMP = re.compile(r"^\..+\.tmp$")
+# the writer of a temporary file: ``.<stem>.<host>~<pid>~<random>.tmp`` (host: [A-Za-z0-9_-]);
+# files of earlier versions, ``.<stem>.<pid>.<random>.tmp``, were written on this host
+_OWNER = re.compile(r"^\..+\.(?P<host>[A-Za-z0-9_-]+)~(?P<pid>\d+)~[0-9a-f]+\.tmp$")
+_OLD_OWNER = re.compile(r"^\..+?\.(?P<pid>\d+)(?:\.[0-9a-f]+)?\.tmp$")
+
+
+def _host() -> str:
+    return re.sub(r"[^A-Za-z0-9_-]", "_", socket.gethostname()) or "host"
+
+
+def _temporary(directory: Path, stem: str) -> Path:
+    """A fresh hidden temporary file name in ``directory`` naming its writer (this process)."""
+    return directory / f".{stem}.{_host()}~{os.getpid()}~{uuid.uuid4().hex[:8]}.tmp"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return True  # someone else's process (or a pid we cannot ask about): leave it
+    return True
+
+
+def _write_failed(path: Path, exc: OSError) -> ResultsError:
+    """A one-line error for a failed write (a full disk named as such)."""
+    why = exc.strerror or str(exc)
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        why = f"{why}: the disk is full; free some space and re-run the same command to resume"
+    return ResultsError(f"cannot write {path}: {why} (rows already stored are intact)")
 
 
 class ResultsError(FcplanError):
@@ -60,6 +108,11 @@ def write_row(directory: str | os.PathLike[str], row: dict[str, Any]) -> Path:
     -------
     pathlib.Path
         The file written.
+
+    Raises
+    ------
+    ResultsError
+        The write failed (e.g. a full disk); nothing is left behind.
     """
     pa = require("pyarrow", "parquet")
     pq = require("pyarrow.parquet", "parquet")
@@ -70,15 +123,17 @@ def write_row(directory: str | os.PathLike[str], row: dict[str, Any]) -> Path:
     table = pa.Table.from_pylist([row])
     table = table.replace_schema_metadata({_META_KEY: json.dumps(FORMAT).encode()})
     final = d / f"{key}.parquet"
-    tmp = d / f".{key}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp"
+    tmp = _temporary(d, key)
     try:
         with open(tmp, "wb") as fh:
             pq.write_table(table, fh)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, final)
+    except OSError as exc:
+        raise _write_failed(final, exc) from None
     finally:
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(OSError):
             tmp.unlink()
     return final
 
@@ -86,21 +141,77 @@ def write_row(directory: str | os.PathLike[str], row: dict[str, Any]) -> Path:
 def write_manifest(directory: str | os.PathLike[str], config_hash: str, doc: dict) -> Path:
     """Write the sweep's normalised grid as ``manifest-<config_hash>.json`` (atomically)."""
     path = Path(directory) / f"manifest-{config_hash}.json"
-    tmp = Path(directory) / f".manifest-{config_hash}.{os.getpid()}.tmp"
-    tmp.write_text(json.dumps(doc, indent=1, sort_keys=True, default=str) + "\n", "utf-8")
-    os.replace(tmp, path)
+    tmp = _temporary(Path(directory), f"manifest-{config_hash}")
+    try:
+        tmp.write_text(json.dumps(doc, indent=1, sort_keys=True, default=str) + "\n", "utf-8")
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise _write_failed(path, exc) from None
+    finally:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
     return path
 
 
 def remove_stale_temporaries(directory: str | os.PathLike[str]) -> int:
-    """Delete ``.tmp`` files left by a killed writer; returns how many."""
-    n = 0
+    """Delete the ``.tmp`` files of dead writers (killed sweeps); returns how many.
+
+    A temporary file names its writer (host and pid). It is stale when the writer ran on this
+    host and no process has its pid any more; a live writer's file (another sweep writing now)
+    and another host's are left alone.
+    """
+    here, n = _host(), 0
     for p in Path(directory).iterdir():
-        if p.is_file() and _TMP.match(p.name):
-            with contextlib.suppress(FileNotFoundError):
-                p.unlink()
-                n += 1
+        m = _OWNER.match(p.name) or _OLD_OWNER.match(p.name)
+        if m is None or not p.is_file():
+            continue
+        if m.groupdict().get("host", here) != here or _alive(int(m.group("pid"))):
+            continue
+        with contextlib.suppress(FileNotFoundError):
+            p.unlink()
+            n += 1
     return n
+
+
+@contextlib.contextmanager
+def lock_results(directory: str | os.PathLike[str]) -> Iterator[None]:
+    """Hold the results folder ``directory`` for one sweep (an exclusive ``flock`` on it).
+
+    Raises
+    ------
+    ResultsError
+        Another process holds it (another sweep is writing into the folder).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> d = tempfile.mkdtemp()
+    >>> with lock_results(d):
+    ...     with lock_results(d):
+    ...         pass  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fcplan.experiments.results.ResultsError: ...: another sweep is writing into this results folder...
+    """
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX: no locking
+        yield
+        return
+    fd = os.open(directory, os.O_RDONLY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ResultsError(
+                f"{directory}: another sweep is writing into this results folder; wait for it "
+                "to finish (then re-run to resume) or choose another --results folder"
+            ) from None
+        except OSError:  # a file system without flock (some network mounts): no locking
+            pass
+        yield
+    finally:
+        os.close(fd)  # releases the lock
 
 
 def _row_files(directory: str | os.PathLike[str]) -> Iterator[Path]:
@@ -117,6 +228,8 @@ def _row_files(directory: str | os.PathLike[str]) -> Iterator[Path]:
                 f"{p}: foreign file in a results folder (expected <key>.parquet episode files "
                 "and manifest-*.json); move it elsewhere"
             )
+        if not p.is_file():  # a FIFO, socket or device would block or never end: never opened
+            raise ResultsError(f"{p}: not a regular file (a FIFO, socket or device?); remove it")
         yield p
 
 

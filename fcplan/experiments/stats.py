@@ -41,7 +41,16 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats as _st
 
-__all__ = ["MeanCI", "mean_ci", "paired_mean_ci", "t_quantile"]
+__all__ = [
+    "MeanCI",
+    "PairedComparison",
+    "holm",
+    "mean_ci",
+    "paired_comparisons",
+    "paired_mean_ci",
+    "t_quantile",
+    "wilcoxon_p",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -162,3 +171,108 @@ def paired_mean_ci(a: Iterable[float], b: Iterable[float], confidence: float = 0
     if xa.shape != xb.shape:
         raise ValueError(f"paired samples differ in length: {xa.size} and {xb.size}")
     return mean_ci(xa - xb, confidence)
+
+
+def holm(pvalues: Iterable[float]) -> np.ndarray:
+    """Holm's step-down adjustment of ``m`` p-values (family-wise error control).
+
+    Sort ascending, multiply the ``i``-th smallest (0-based) by ``m - i``, make the sequence
+    non-decreasing and cap it at 1; NaN p-values stay NaN and do not count in ``m``.
+
+    Examples
+    --------
+    >>> holm([0.01, 0.04, 0.03]).round(3).tolist()
+    [0.03, 0.06, 0.06]
+    """
+    p = np.asarray(list(pvalues), np.float64)
+    out = np.full(p.shape, np.nan)
+    ok = np.flatnonzero(~np.isnan(p))
+    m = ok.size
+    if m == 0:
+        return out
+    order = ok[np.argsort(p[ok], kind="stable")]
+    adjusted = np.maximum.accumulate(p[order] * (m - np.arange(m)))
+    out[order] = np.minimum(adjusted, 1.0)
+    return out
+
+
+def wilcoxon_p(differences: Iterable[float]) -> float:
+    """Two-sided Wilcoxon signed-rank p-value of paired differences (zeros dropped; NaN when
+    fewer than one non-zero difference, or with NaN differences).
+
+    Examples
+    --------
+    >>> round(wilcoxon_p([1.0, 2.0, 3.0, 4.0, 5.0, 6.0]), 4)
+    0.0312
+    """
+    d = np.asarray(list(differences), np.float64)
+    if np.isnan(d).any() or not np.any(d != 0):
+        return math.nan
+    return float(_st.wilcoxon(d[d != 0]).pvalue)
+
+
+@dataclass(frozen=True, slots=True)
+class PairedComparison:
+    """Scheduler ``a`` against ``b`` on the same (scenario, seed) pairs.
+
+    Attributes
+    ----------
+    a, b : str
+    diff : MeanCI
+        Mean and confidence interval of ``a_i - b_i``.
+    p : float
+        Two-sided Wilcoxon signed-rank p-value.
+    p_holm : float
+        ``p`` after Holm's adjustment over every pair of the comparison.
+    effect : float
+        Cohen's ``d_z``: mean difference over the standard deviation of the differences.
+    """
+
+    a: str
+    b: str
+    diff: MeanCI
+    p: float
+    p_holm: float
+    effect: float
+
+    @property
+    def resolved(self) -> bool:
+        """Whether the interval excludes 0 (the sign of the difference is known)."""
+        return bool(self.diff.low > 0 or self.diff.high < 0)
+
+
+def paired_comparisons(
+    scores: dict[str, Iterable[float]], confidence: float = 0.95
+) -> list[PairedComparison]:
+    """Every pair of schedulers, with paired intervals, Wilcoxon and Holm-adjusted p-values.
+
+    Parameters
+    ----------
+    scores : dict of name -> sequence of float
+        One score per (scenario, seed) pair, the pairs in the same order for every scheduler.
+    confidence : float
+        Level of the paired intervals.
+
+    Examples
+    --------
+    >>> cmp = paired_comparisons({"x": [5, 6, 7, 8, 9, 10], "y": [1, 2, 3, 4, 5, 6]})
+    >>> c = cmp[0]
+    >>> (c.a, c.b, c.diff.mean, c.resolved, round(c.p_holm, 4))
+    ('x', 'y', 4.0, True, 0.0312)
+    """
+    names = list(scores)
+    arrays = {k: np.asarray(list(v), np.float64) for k, v in scores.items()}
+    pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
+    rows = []
+    for a, b in pairs:
+        if arrays[a].shape != arrays[b].shape:
+            raise ValueError(f"{a} and {b} have different numbers of paired scores")
+        d = arrays[a] - arrays[b]
+        ci = mean_ci(d, confidence)
+        effect = ci.mean / ci.std if ci.std and ci.std > 0 else math.nan
+        rows.append((a, b, ci, wilcoxon_p(d), effect))
+    adjusted = holm([r[3] for r in rows])
+    return [
+        PairedComparison(a, b, ci, p, float(ph), eff)
+        for (a, b, ci, p, eff), ph in zip(rows, adjusted, strict=True)
+    ]

@@ -18,6 +18,23 @@ Resume and failures.
 * An episode whose worker process died (killed, out of memory) is *lost*: nothing is stored and
   a re-run plays it. :attr:`SweepSummary.lost` counts them.
 
+Processes and files.
+
+* One sweep at a time writes into a results folder (:func:`~fcplan.experiments.results.lock_results`);
+  a second one into the same folder stops at once with a one-line
+  :class:`~fcplan.experiments.results.ResultsError`. Temporary files of dead sweeps are removed at
+  the start; a live sweep's never are.
+* Pool workers die with the sweep: they ask the kernel for SIGKILL when their parent dies
+  (Linux ``PR_SET_PDEATHSIG``) and a watchdog thread checks the parent every second elsewhere
+  (:func:`~fcplan.experiments.workers.init_worker`), so ``kill -9`` of the sweep leaves no worker
+  behind. SIGTERM is handled like Ctrl-C by ``fcplan`` (the workers are stopped, every row
+  stored so far is kept).
+* A write that fails (a full disk) stops the sweep with a one-line
+  :class:`~fcplan.experiments.results.ResultsError`; the rows stored so far are intact and a
+  re-run resumes.
+* Schedulers with a deterministic mode run in it unless ``deterministic=False`` (``fcplan sweep
+  --wall-time``), see :mod:`fcplan.experiments.config`.
+
 Examples
 --------
 >>> import tempfile
@@ -50,6 +67,7 @@ from fcplan.experiments.progress import make_progress
 from fcplan.experiments.results import (
     ResultsError,
     load_results,
+    lock_results,
     remove_stale_temporaries,
     stored_status,
     write_manifest,
@@ -129,6 +147,7 @@ def sweep(
     dask: str | None = None,
     retry_failed: bool = False,
     progress: bool | Callable[[int, int, dict[str, Any]], None] = True,
+    deterministic: bool = True,
 ) -> SweepSummary:
     """Run a sweep, storing each finished episode in ``results`` at once.
 
@@ -150,6 +169,9 @@ def sweep(
     progress : bool or callable
         ``True``: a progress bar on stderr (plain lines when stderr is not a terminal);
         ``False``: silent; or a ``progress(done, total, row)`` callback.
+    deterministic : bool
+        Run schedulers that have a deterministic mode in it (default); False is the wall-time
+        mode (:func:`~fcplan.experiments.config.load_sweep_config`).
 
     Returns
     -------
@@ -158,15 +180,31 @@ def sweep(
     Raises
     ------
     SweepConfigError, ResultsError
-        A bad config; a results folder holding damaged or foreign files.
+        A bad config; a results folder holding damaged or foreign files, in use by another
+        sweep, or a failed write (a full disk).
     KeyboardInterrupt
         On Ctrl-C, after stopping the workers; everything finished so far is stored.
     """
-    cfg = load_sweep_config(config)
+    cfg = load_sweep_config(config, deterministic=deterministic)
     _check_backend_args(jobs, dask)
     jobs = jobs or default_jobs()
     specs = list({s.key: s for s in cfg.episodes()}.values())
     out = _results_folder(results)
+    with lock_results(out):
+        remove_stale_temporaries(out)
+        return _run(cfg, specs, out, jobs, dask, retry_failed, progress)
+
+
+def _run(
+    cfg: SweepConfig,
+    specs: list[Any],
+    out: Path,
+    jobs: int,
+    dask: str | None,
+    retry_failed: bool,
+    progress: bool | Callable[[int, int, dict[str, Any]], None],
+) -> SweepSummary:
+    """Play the episodes of ``specs`` not stored in ``out`` (which this process has locked)."""
     status = stored_status(out)
     todo = [s for s in specs if s.key not in status or (retry_failed and status[s.key] != "ok")]
     h = cfg.config_hash
@@ -196,7 +234,7 @@ def _check_backend_args(jobs: Any, dask: Any) -> None:
 
 
 def _results_folder(results: str | os.PathLike[str]) -> Path:
-    """The results folder, created if needed, with stale temporary files removed."""
+    """The results folder, created if needed."""
     out = Path(results)
     if out.exists() and not out.is_dir():
         raise ResultsError(f"{out}: exists and is not a folder")
@@ -204,7 +242,6 @@ def _results_folder(results: str | os.PathLike[str]) -> Path:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise ResultsError(f"{out}: cannot create the results folder: {exc}") from None
-    remove_stale_temporaries(out)
     return out
 
 
@@ -222,7 +259,10 @@ def _store(
         return {"error": lost}
     row["config_hash"] = cfg.config_hash
     row["sweep"] = cfg.name
-    write_row(out, row)
+    try:
+        write_row(out, row)
+    except ResultsError as exc:
+        raise ResultsError(f"{exc}; {summary.ran} episode(s) stored by this run") from None
     summary.ran += 1
     if row.get("status") != "ok":
         summary.failed += 1

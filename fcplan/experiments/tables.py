@@ -14,6 +14,9 @@ time), which the sweep report tabulates as well.
 * :func:`higher_is_better`: the direction of any result column, for paired verdicts.
 * :func:`difficulty_key`: rows by difficulty group come in the order of
   :data:`fcplan.scenario.model.DIFFICULTIES` (practice, easy, moderate, hard, custom).
+* :func:`fallback_majority`: the flag of an episode whose scheduler fell back to greedy on more
+  than half of its replans (its scores are mostly greedy's), from its ``fallbacks`` and
+  ``replans`` columns.
 
 Examples
 --------
@@ -41,6 +44,7 @@ __all__ = [
     "RUN_COLUMNS",
     "SCORE_COLUMNS",
     "difficulty_key",
+    "fallback_majority",
     "higher_is_better",
 ]
 
@@ -134,3 +138,15 @@ def difficulty_key(difficulty: str) -> tuple[int, str]:
     """Sort key of a difficulty group: the known groups in order, then any other by name."""
     known = DIFFICULTIES.index(difficulty) if difficulty in DIFFICULTIES else len(DIFFICULTIES)
     return (known, difficulty)
+
+
+def fallback_majority(row: dict) -> bool:
+    """Whether an episode's scheduler fell back (to greedy) on more than half of its replans.
+
+    Examples
+    --------
+    >>> fallback_majority({"fallbacks": 11, "replans": 20}), fallback_majority({"replans": 0})
+    (True, False)
+    """
+    replans, fallbacks = row.get("replans") or 0, row.get("fallbacks") or 0
+    return bool(replans == replans and replans > 0 and fallbacks > replans / 2)

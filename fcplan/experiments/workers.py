@@ -1,9 +1,12 @@
 """Worker processes shared by :func:`~fcplan.experiments.compare` and
 :func:`~fcplan.experiments.sweep`.
 
-Episodes run in worker processes that ignore Ctrl-C (the parent handles it and stops them), and
-that know the schedulers registered at run time in the parent
-(:func:`fcplan.register_scheduler`), which a fresh process would not.
+Episodes run in worker processes that ignore Ctrl-C (the parent handles it and stops them), that
+know the schedulers registered at run time in the parent (:func:`fcplan.register_scheduler`),
+which a fresh process would not, and that die with their parent: on Linux the kernel sends them
+SIGKILL when it dies (``prctl(PR_SET_PDEATHSIG)``), and everywhere a watchdog thread ends the
+worker within :data:`WATCHDOG_PERIOD_S` of its parent's death (the parent pid stops existing or
+the worker is re-parented). So ``kill -9`` of a sweep or a comparison leaves no worker holding its pipes.
 
 Examples
 --------
@@ -15,13 +18,30 @@ True
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import os
 import signal
+import sys
+import threading
+import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
-__all__ = ["default_jobs", "init_worker", "register_runtime", "runtime_factories", "stop_workers"]
+__all__ = [
+    "WATCHDOG_PERIOD_S",
+    "default_jobs",
+    "die_with_parent",
+    "init_worker",
+    "register_runtime",
+    "runtime_factories",
+    "stop_workers",
+]
+
+#: Seconds between two looks of a worker's watchdog at its parent.
+WATCHDOG_PERIOD_S = 1.0
+_PR_SET_PDEATHSIG = 1
 
 
 def default_jobs() -> int:
@@ -55,10 +75,58 @@ def register_runtime(runtime: dict[str, Callable[..., Any]]) -> None:
             register_scheduler(name, factory)
 
 
-def init_worker(runtime: dict[str, Callable[..., Any]]) -> None:
-    """Process-pool initializer: leave Ctrl-C to the parent; re-register run-time schedulers."""
+def init_worker(runtime: dict[str, Callable[..., Any]], parent: int | None = None) -> None:
+    """Process-pool initializer: leave Ctrl-C to the parent, take SIGTERM's default action (the
+    parent's handler is inherited through fork), die with ``parent`` (:func:`die_with_parent`)
+    and re-register run-time schedulers."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if parent is not None:
+        die_with_parent(parent)
     register_runtime(runtime)
+
+
+def die_with_parent(parent: int) -> None:
+    """End this process when ``parent`` dies.
+
+    On Linux, ``prctl(PR_SET_PDEATHSIG, SIGKILL)`` asks the kernel to kill this process when the
+    thread that forked it exits; and a daemon thread checks every :data:`WATCHDOG_PERIOD_S` that
+    ``parent`` is alive and this process was not re-parented, and else ends it with
+    ``os._exit(1)`` (the portable fallback, which also covers a parent whose forking thread ended
+    early). The process that forked this one may be ``parent`` itself or a fork server it started
+    (the ``forkserver`` start method). If ``parent`` is already gone, this process ends at once.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - no usable libc: the thread acts
+            pass
+    ppid = os.getppid()  # ``parent`` itself, or a fork server it started
+    if not _parent_alive(parent, ppid):
+        os._exit(1)
+    threading.Thread(
+        target=_watch, args=(parent, ppid), name="fcplan-parent-watchdog", daemon=True
+    ).start()
+
+
+def _parent_alive(parent: int, ppid: int) -> bool:
+    """``parent`` exists and this process was not re-parented (``ppid``, its parent, lives)."""
+    if os.getppid() != ppid:
+        return False
+    try:
+        os.kill(parent, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # pragma: no cover - alive, another user's
+        return True
+    return True
+
+
+def _watch(parent: int, ppid: int) -> None:  # pragma: no cover - runs in pool workers
+    while _parent_alive(parent, ppid):
+        time.sleep(WATCHDOG_PERIOD_S)
+    os._exit(1)
 
 
 def stop_workers(executor: ProcessPoolExecutor, futures: Iterable[Future]) -> None:

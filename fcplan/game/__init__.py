@@ -21,7 +21,7 @@ Modules, from the bottom up (only the last two import pygame):
   buttons sit, the tutorial's text, where games are recorded;
 * :mod:`~fcplan.game.screens`: the screens as a state machine (:class:`~fcplan.game.screens.App`);
 * :mod:`~fcplan.game.view` and :mod:`~fcplan.game.app`: pygame drawing and the event loop;
-* :mod:`~fcplan.game.cli`: the ``fcplan play`` command.
+* :mod:`fcplan.cli.play`: the ``fcplan play`` command.
 
 Examples
 --------

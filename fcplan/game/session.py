@@ -2,14 +2,15 @@
 
 :class:`GameSession` is the part of ``fcplan play`` that decides what happens; the pygame front end
 (:mod:`fcplan.game.app`) only turns mouse and keyboard events into input dicts, calls :meth:`step`
-at the scenario's pace and draws. Each tick:
+at the scenario's pace and draws. The game is a :class:`fcplan.mission.Mission` whose commands
+come from a human instead of a scheduler; the recorder is one of its observers. Each tick:
 
 1. the inputs received since the last tick (stamped with the current tick) go to the
-   :class:`~fcplan.game.controls.Controller` and, as raw dicts, to the recorder's ``on_input``;
-2. the controller's commands go to ``World.step`` and to the recorder's ``on_commands`` (so a
-   recording re-simulates exactly);
-3. the team's belief and the recorder's ``on_step`` are updated (the online scores are
-   recomputed from the world's trace when the display asks for them).
+   :class:`~fcplan.game.controls.Controller` and, as raw dicts, to the observers' ``on_input``;
+2. the controller's commands go to :meth:`Mission.step <fcplan.mission.Mission.step>`, which
+   tells the observers (``on_commands``, so a recording re-simulates exactly), advances the world
+   and updates the team's belief (the fire the player can see) and tells them ``on_step`` (the
+   online scores are recomputed from the world's trace when the display asks for them).
 
 Because the controller is deterministic, :func:`replay_inputs` plays the same inputs at the same
 ticks and reaches the same outcome as the original game.
@@ -39,7 +40,10 @@ from fcplan.belief import Belief
 from fcplan.game.controls import Controller
 from fcplan.game.scores import OnlineScores
 from fcplan.metrics import Metrics, compute_all
-from fcplan.world import World
+from fcplan.mission import EpisodeObserver, Mission
+from fcplan.scenario import Scenario
+from fcplan.team import Command
+from fcplan.world import StepInfo, World
 
 __all__ = ["GameSession", "replay_inputs"]
 
@@ -52,12 +56,15 @@ class GameSession:
     scenario : fcplan.scenario.Scenario
     seed : int
         Seed of the world (fire, sensing and pruning draws).
-    recorder : object, optional
-        A :class:`fcplan.recording.Recorder` (or anything with its ``on_input``, ``on_commands``
-        and ``on_step`` methods).
+    recorder : EpisodeObserver, optional
+        A :class:`fcplan.recording.Recorder` (or any observer of the game's mission).
+    observers : iterable of EpisodeObserver
+        More observers of the game's mission.
 
     Attributes
     ----------
+    mission : fcplan.mission.Mission
+        The game's episode (world, belief, observers).
     world : fcplan.world.World
     controller : Controller
     scores : OnlineScores
@@ -66,20 +73,33 @@ class GameSession:
     inputs : list of dict
         Every input so far, each with its ``"tick"``.
     commands : list of (int, dict)
-        Every non-empty command dict passed to ``World.step``, with the tick it was applied at.
+        Every non-empty command dict given to the world, with the tick it was applied at.
+    last_info : fcplan.world.StepInfo or None
+        What the last tick did.
     """
 
-    def __init__(self, scenario, seed: int = 0, *, recorder=None) -> None:
+    def __init__(
+        self,
+        scenario: Scenario,
+        seed: int = 0,
+        *,
+        recorder: EpisodeObserver | None = None,
+        observers: Iterable[EpisodeObserver] = (),
+    ) -> None:
         self.scenario = scenario
         self.seed = seed
-        self.world = World().reset(scenario, seed)
+        self.recorder = recorder
+        watchers = [*([recorder] if recorder is not None else []), *observers]
+        self.mission = Mission(scenario, seed, observers=watchers)
+        self.world: World = self.mission.world
+        belief = self.mission.belief
+        assert belief is not None  # (a mission keeps a belief by default)
+        self.belief: Belief = belief
         self.controller = Controller(self.world)
         self.scores = OnlineScores(self.world)
-        self.belief = Belief(scenario)
-        self.recorder = recorder
         self.inputs: list[dict[str, Any]] = []
-        self.commands: list[tuple[int, dict]] = []
-        self.last_info = None
+        self.commands: list[tuple[int, dict[str, Command]]] = []
+        self.last_info: StepInfo | None = None
 
     @property
     def done(self) -> bool:
@@ -88,6 +108,7 @@ class GameSession:
 
     @property
     def tick(self) -> int:
+        """Ticks played."""
         return self.world.tick
 
     def input(self, event: Mapping[str, Any]) -> None:
@@ -98,24 +119,16 @@ class GameSession:
         ev["tick"] = self.world.tick
         self.controller.handle(ev)
         self.inputs.append(ev)
-        if self.recorder is not None:
-            self.recorder.on_input(self.world.tick, dict(ev))
+        self.mission.notify_input(dict(ev))
 
     def step(self) -> None:
         """Advance the world one tick with the commands collected since the last tick."""
         if self.done:
             return
         commands = self.controller.take_commands()
-        tick = self.world.tick
         if commands:
-            self.commands.append((tick, commands))
-            if self.recorder is not None:
-                self.recorder.on_commands(tick, commands)
-        info = self.world.step(commands or None)
-        self.belief.update(info)
-        self.last_info = info
-        if self.recorder is not None:
-            self.recorder.on_step(self.world, info)
+            self.commands.append((self.world.tick, commands))
+        self.last_info = self.mission.step(commands or None)
 
     def metrics(self) -> Metrics:
         """The manual metrics so far (online, cheap)."""
@@ -126,7 +139,9 @@ class GameSession:
         return compute_all(self.world.trace())
 
 
-def replay_inputs(scenario, seed: int, inputs: Iterable[Mapping[str, Any]]) -> GameSession:
+def replay_inputs(
+    scenario: Scenario, seed: int, inputs: Iterable[Mapping[str, Any]]
+) -> GameSession:
     """Play a whole game from recorded inputs (dicts with a ``"tick"``) and return it.
 
     Each input is applied when the world reaches its tick, before that tick's step, as in the

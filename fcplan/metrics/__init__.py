@@ -129,15 +129,19 @@ from fcplan.metrics.compute import (
     Metrics,
     compute_all,
     compute_metrics,
+    facility_penalty,
     grade,
     negative_reward_rate,
+    penalty_rate,
 )
-from fcplan.metrics.table import METRICS, MetricSpec, format_metrics, metric_spec
+from fcplan.metrics.outcomes import Outcomes, compute_outcomes
+from fcplan.metrics.table import METRICS, OUTCOMES, MetricSpec, format_metrics, metric_spec
 
 __all__ = [
     "DEFINITIONS",
     "GRADES",
     "METRICS",
+    "OUTCOMES",
     "MetricSpec",
     "Metrics",
     "compute_all",
@@ -145,5 +149,9 @@ __all__ = [
     "format_metrics",
     "grade",
     "metric_spec",
+    "facility_penalty",
     "negative_reward_rate",
+    "penalty_rate",
+    "Outcomes",
+    "compute_outcomes",
 ]

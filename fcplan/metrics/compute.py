@@ -129,6 +129,34 @@ def _penalty_rate(
     return w * active + (in_facility * penalties).sum(axis=1)
 
 
+def facility_penalty(in_facility: np.ndarray, penalties: np.ndarray) -> float:
+    """``Σ_f PC_f n_f``: the facilities' part of the penalty rate, for active cell counts
+    ``in_facility`` ((F,) ints, one tick's or summed over a window of ticks) and penalty
+    coefficients ``penalties`` ((F,) floats).
+
+    Examples
+    --------
+    >>> facility_penalty(np.array([0, 3]), np.array([5.0, 2.0]))
+    6.0
+    """
+    return float(in_facility @ penalties)
+
+
+def penalty_rate(active: float, facility_term: float, weight: float) -> float:
+    """The manual's penalty rate ``w |A| + Σ_f PC_f n_f`` (Eq. (1) integrand) from the active cell
+    count and the facility term (:func:`facility_penalty`). The rate is linear in the counts, so
+    counts summed over a window of ticks give the rate summed over the window; divided by the
+    ticks per second it is the negative reward the window accrues (what the environments'
+    reward functions pay, :mod:`fcplan.env.reward`).
+
+    Examples
+    --------
+    >>> penalty_rate(20, facility_penalty(np.array([3]), np.array([2.0])), 0.1)
+    8.0
+    """
+    return weight * active + facility_term
+
+
 def _facility_protection(burning: np.ndarray, pruned: np.ndarray) -> float:
     """FPS (unrounded): percent of facility columns with no burning or pruned cell in any row."""
     n_fac = burning.shape[1]

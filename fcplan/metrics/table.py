@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from fcplan.errors import UnknownNameError
 from fcplan.metrics.compute import Metrics
 
-__all__ = ["METRICS", "MetricSpec", "format_metrics", "metric_spec"]
+__all__ = ["METRICS", "OUTCOMES", "MetricSpec", "format_metrics", "metric_spec"]
 
 
 @dataclass(frozen=True)
@@ -36,7 +36,8 @@ class MetricSpec:
     label : str
         Row label of :func:`format_metrics` (``"overall firefighting (OFS)"``).
     unit : str
-        ``"%"``, ``"penalty"`` (a positive penalty magnitude), ``"points"`` or ``""``.
+        ``"%"``, ``"penalty"`` (a positive penalty magnitude), ``"points"``, ``"s"``, ``"cells"``,
+        ``"cell s"`` or ``""``.
     decimals : int
         Decimals of a ``mean ± ci`` cell in experiment tables.
     higher_is_better : bool
@@ -174,8 +175,55 @@ METRICS: tuple[MetricSpec, ...] = (
 """Every metric, in :class:`Metrics` field order: the one table of names, labels and units."""
 
 
+OUTCOMES: tuple[MetricSpec, ...] = (
+    MetricSpec(
+        name="time_to_containment_s",
+        label="time to containment",
+        unit="s",
+        decimals=1,
+        higher_is_better=False,
+        description="simulated seconds until no cell is active for the rest of the episode "
+        "(the duration when fire is still active at the end)",
+        column="contain s",
+        title="Time to containment",
+    ),
+    MetricSpec(
+        name="contained",
+        label="contained",
+        unit="",
+        decimals=2,
+        higher_is_better=True,
+        description="1 when the fire was out before the episode ended, else 0",
+        column="contained",
+        title="Contained",
+    ),
+    MetricSpec(
+        name="burned_area_cells",
+        label="burned area",
+        unit="cells",
+        decimals=0,
+        higher_is_better=False,
+        description="cells that ever burned (active plus pruned at the end)",
+        column="burned",
+        title="Burned area",
+    ),
+    MetricSpec(
+        name="facility_damage_cell_s",
+        label="facility damage",
+        unit="cell s",
+        decimals=1,
+        higher_is_better=False,
+        description="active cells inside facility footprints integrated over simulated seconds",
+        column="damage cell s",
+        title="Facility damage",
+    ),
+)
+"""The outcome metrics (:mod:`fcplan.metrics.outcomes`), in :class:`Outcomes` field order; their
+episode-summary columns are ``"outcome.<name>"``."""
+
+
 def metric_spec(name: str) -> MetricSpec:
-    """The :data:`METRICS` entry of a :class:`Metrics` field.
+    """The :data:`METRICS` (or :data:`OUTCOMES`) entry of a metric.
 
     Raises
     ------
@@ -188,10 +236,10 @@ def metric_spec(name: str) -> MetricSpec:
     >>> spec.column, spec.heading, spec.key("reference2020"), spec.higher_is_better
     ('OFS %', 'Overall firefighting', 'reference2020.overall_firefighting', True)
     """
-    for spec in METRICS:
+    for spec in METRICS + OUTCOMES:
         if spec.name == name:
             return spec
-    known = ", ".join(s.name for s in METRICS)
+    known = ", ".join(s.name for s in METRICS + OUTCOMES)
     raise UnknownNameError(f"unknown metric {name!r}; known metrics: {known}")
 
 

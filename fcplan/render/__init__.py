@@ -19,11 +19,13 @@ scenario's static map:
   agent its mode, battery now and at its next goal (bar and %), altitude and tank, and a legend.
 
 Modules: :mod:`~fcplan.render.frame` (:class:`FrameData`, :func:`snapshot`),
-:mod:`~fcplan.render.raster` (the palette :data:`COLORS`, the 5x7 bitmap font :func:`draw_text`,
-markers, lines and cell grids on numpy images), :mod:`~fcplan.render.scene` (static map, fire and
-agent layers), :mod:`~fcplan.render.panel` (the information panel) and
+:mod:`~fcplan.render.raster` (the palette :data:`COLORS`, markers, lines and cell grids on numpy
+images), :mod:`~fcplan.render.text` (anti-aliased DejaVu Sans text with Pillow, :func:`draw_text`,
+and the greedy label placement :func:`place_labels`), :mod:`~fcplan.render.scene` (static map, fire
+and agent layers), :mod:`~fcplan.render.panel` (the information panel) and
 :mod:`~fcplan.render.renderer` (:class:`Renderer`, :func:`render_frame`). Neither matplotlib nor
-pygame is needed. Everything is vectorised: fire layers are scattered (or gathered, when zooming in)
+pygame is needed; Pillow rasterises text with the bundled DejaVu Sans (``fcplan/render/fonts/``,
+Bitstream Vera licence), imported on the first frame, not by ``import fcplan``. Everything is vectorised: fire layers are scattered (or gathered, when zooming in)
 in one numpy operation each; only agents, routes and text lines are drawn one by one. A renderer
 draws the static map once. The output depends only on its inputs (no randomness, no clock).
 
@@ -39,8 +41,9 @@ Examples
 
 from fcplan.render.frame import FrameData, RenderError, snapshot
 from fcplan.render.panel import MODE_NAMES, panel_width
-from fcplan.render.raster import COLORS, GLYPH_H, GLYPH_W, draw_text, text_size
+from fcplan.render.raster import COLORS, font_px
 from fcplan.render.renderer import Renderer, render_frame
+from fcplan.render.text import draw_text, place_labels, text_size
 
 __all__ = [
     "FrameData",
@@ -51,8 +54,8 @@ __all__ = [
     "panel_width",
     "draw_text",
     "text_size",
+    "place_labels",
+    "font_px",
     "COLORS",
     "MODE_NAMES",
-    "GLYPH_H",
-    "GLYPH_W",
 ]

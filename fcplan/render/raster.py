@@ -1,12 +1,10 @@
-"""Pixel drawing on numpy RGB images: the palette, a 5x7 bitmap font, markers, lines, boxes and
-cell grids.
+"""Pixel drawing on numpy RGB images: the palette, markers, lines, boxes and cell grids.
 
 Every function paints into an ``(H, W, 3)`` uint8 image in place and clips at its edges;
 coordinates are image pixels (column ``x``, row ``y``). :data:`COLORS` names every colour a frame
-uses (change an entry to restyle every frame). Text uses a built-in 5x7 bitmap font
-(:func:`draw_text`, :func:`text_size`), so neither matplotlib nor pygame is needed. Masks of text
-lines and marker shapes are memoised by value (they are pure functions of their arguments), and
-cell grids are painted in one numpy operation per layer (:func:`cell_pixels`, :func:`paint_px`).
+uses (change an entry to restyle every frame); text is drawn by :mod:`fcplan.render.text`
+(anti-aliased DejaVu Sans, :func:`font_px` px per map size). Marker masks are memoised by value
+(they are pure functions of their arguments), and cell grids are painted in one numpy operation per layer (:func:`cell_pixels`, :func:`paint_px`).
 
 Examples
 --------
@@ -25,21 +23,18 @@ import numpy as np
 
 __all__ = [
     "COLORS",
-    "GLYPH_H",
-    "GLYPH_W",
     "ROLE_SHAPES",
     "blit_mask",
     "cell_pixels",
-    "draw_text",
+    "clip_box",
+    "font_px",
     "halo",
     "line",
     "paint_px",
     "rect",
     "shape_mask",
     "stamp",
-    "text_mask",
     "text_scale",
-    "text_size",
 ]
 
 Color = tuple[int, int, int]
@@ -83,145 +78,33 @@ COLORS: dict[str, tuple[int, int, int]] = {
 }
 
 
-# 5x7 glyphs, one string of 7 rows per character ("#" = ink). Lower case is drawn as upper case.
-_GLYPHS = {
-    " ": ".....|.....|.....|.....|.....|.....|.....",
-    "0": ".###.|#...#|#..##|#.#.#|##..#|#...#|.###.",
-    "1": "..#..|.##..|..#..|..#..|..#..|..#..|.###.",
-    "2": ".###.|#...#|....#|...#.|..#..|.#...|#####",
-    "3": "#####|...#.|..#..|...#.|....#|#...#|.###.",
-    "4": "...#.|..##.|.#.#.|#..#.|#####|...#.|...#.",
-    "5": "#####|#....|####.|....#|....#|#...#|.###.",
-    "6": "..##.|.#...|#....|####.|#...#|#...#|.###.",
-    "7": "#####|....#|...#.|..#..|.#...|.#...|.#...",
-    "8": ".###.|#...#|#...#|.###.|#...#|#...#|.###.",
-    "9": ".###.|#...#|#...#|.####|....#|...#.|.##..",
-    "A": ".###.|#...#|#...#|#####|#...#|#...#|#...#",
-    "B": "####.|#...#|#...#|####.|#...#|#...#|####.",
-    "C": ".###.|#...#|#....|#....|#....|#...#|.###.",
-    "D": "###..|#..#.|#...#|#...#|#...#|#..#.|###..",
-    "E": "#####|#....|#....|####.|#....|#....|#####",
-    "F": "#####|#....|#....|####.|#....|#....|#....",
-    "G": ".###.|#...#|#....|#.###|#...#|#...#|.####",
-    "H": "#...#|#...#|#...#|#####|#...#|#...#|#...#",
-    "I": ".###.|..#..|..#..|..#..|..#..|..#..|.###.",
-    "J": "..###|...#.|...#.|...#.|...#.|#..#.|.##..",
-    "K": "#...#|#..#.|#.#..|##...|#.#..|#..#.|#...#",
-    "L": "#....|#....|#....|#....|#....|#....|#####",
-    "M": "#...#|##.##|#.#.#|#.#.#|#...#|#...#|#...#",
-    "N": "#...#|#...#|##..#|#.#.#|#..##|#...#|#...#",
-    "O": ".###.|#...#|#...#|#...#|#...#|#...#|.###.",
-    "P": "####.|#...#|#...#|####.|#....|#....|#....",
-    "Q": ".###.|#...#|#...#|#...#|#.#.#|#..#.|.##.#",
-    "R": "####.|#...#|#...#|####.|#.#..|#..#.|#...#",
-    "S": ".####|#....|#....|.###.|....#|....#|####.",
-    "T": "#####|..#..|..#..|..#..|..#..|..#..|..#..",
-    "U": "#...#|#...#|#...#|#...#|#...#|#...#|.###.",
-    "V": "#...#|#...#|#...#|#...#|#...#|.#.#.|..#..",
-    "W": "#...#|#...#|#...#|#.#.#|#.#.#|#.#.#|.#.#.",
-    "X": "#...#|#...#|.#.#.|..#..|.#.#.|#...#|#...#",
-    "Y": "#...#|#...#|.#.#.|..#..|..#..|..#..|..#..",
-    "Z": "#####|....#|...#.|..#..|.#...|#....|#####",
-    ".": ".....|.....|.....|.....|.....|.##..|.##..",
-    ",": ".....|.....|.....|.....|.##..|..#..|.#...",
-    ":": ".....|.##..|.##..|.....|.##..|.##..|.....",
-    ";": ".....|.##..|.##..|.....|.##..|..#..|.#...",
-    "-": ".....|.....|.....|#####|.....|.....|.....",
-    "+": ".....|..#..|..#..|#####|..#..|..#..|.....",
-    "=": ".....|.....|#####|.....|#####|.....|.....",
-    "_": ".....|.....|.....|.....|.....|.....|#####",
-    "/": ".....|....#|...#.|..#..|.#...|#....|.....",
-    "%": "##...|##..#|...#.|..#..|.#...|#..##|...##",
-    "(": "...#.|..#..|.#...|.#...|.#...|..#..|...#.",
-    ")": ".#...|..#..|...#.|...#.|...#.|..#..|.#...",
-    "[": ".###.|.#...|.#...|.#...|.#...|.#...|.###.",
-    "]": ".###.|...#.|...#.|...#.|...#.|...#.|.###.",
-    "<": "...#.|..#..|.#...|#....|.#...|..#..|...#.",
-    ">": ".#...|..#..|...#.|....#|...#.|..#..|.#...",
-    "!": "..#..|..#..|..#..|..#..|..#..|.....|..#..",
-    "?": ".###.|#...#|....#|...#.|..#..|.....|..#..",
-    "*": ".....|..#..|#.#.#|.###.|#.#.#|..#..|.....",
-    "'": "..#..|..#..|.#...|.....|.....|.....|.....",
-    "|": "..#..|..#..|..#..|..#..|..#..|..#..|..#..",
-    "#": ".#.#.|#####|.#.#.|.#.#.|.#.#.|#####|.#.#.",
-}
-_FONT_CHARS = "".join(_GLYPHS)
-_FONT = np.array(
-    [[[c == "#" for c in row] for row in _GLYPHS[ch].split("|")] for ch in _FONT_CHARS],
-    dtype=bool,
-)  # (n_glyphs, 7, 5)
-_FONT_INDEX = {ch: i for i, ch in enumerate(_FONT_CHARS)}
-_UNKNOWN = _FONT_INDEX["?"]
-GLYPH_W, GLYPH_H = 6, 8  # advance per character and per line at scale 1 (5x7 ink + 1 px gap)
-
-
 def text_scale(size: int) -> int:
     """Text scale of the labels and panel of a ``size`` px map (1 below 960 px, then 2, ...)."""
     return max(1, int(size) // 480)
 
 
-def text_size(text: str, scale: int = 1) -> tuple[int, int]:
-    """(width, height) in px of ``text`` drawn by :func:`draw_text` (one line).
-
-    Examples
-    --------
-    >>> text_size("P1 100%", scale=2)
-    (82, 14)
-    """
-    n = len(text)
-    return (max(n * GLYPH_W - 1, 0) * scale, 7 * scale)
+def font_px(size: int) -> int:
+    """Font size in px (DejaVu Sans em) of the labels and panel of a ``size`` px map."""
+    return 11 * text_scale(size)
 
 
-@lru_cache(maxsize=4096)
-def text_mask(text: str, scale: int) -> np.ndarray:
-    """The read-only ink mask (7 scale, n 6 scale - scale) of one line of text."""
-    idx = np.array([_FONT_INDEX.get(c, _UNKNOWN) for c in text.upper()], dtype=np.int64)
-    glyphs = np.zeros((len(idx), 7, GLYPH_W), dtype=bool)
-    glyphs[:, :, :5] = _FONT[idx]
-    mask = glyphs.transpose(1, 0, 2).reshape(7, -1)[:, : max(len(idx) * GLYPH_W - 1, 0)]
-    if scale > 1:
-        mask = mask.repeat(scale, axis=0).repeat(scale, axis=1)
-    mask.setflags(write=False)
-    return mask
-
-
-def draw_text(
-    img: np.ndarray,
-    text: str,
-    x: int,
-    y: int,
-    color: Color = COLORS["text"],
-    scale: int = 1,
-) -> int:
-    """Draw one line of ``text`` into ``img`` (H, W, 3) uint8 with its top-left corner at
-    column ``x``, row ``y`` (clipped at the edges); return the x just after the text.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> img = np.zeros((10, 40, 3), np.uint8)
-    >>> draw_text(img, "OK", 1, 1, (255, 255, 255))  # 1 + 11 px of text + 1 px gap
-    13
-    >>> int(img[..., 0].astype(bool).sum()) > 0
-    True
-    """
-    if not text:
-        return x
-    mask = text_mask(text, int(scale))
-    blit_mask(img, mask, int(x), int(y), color)
-    return int(x) + mask.shape[1] + scale
+def clip_box(img: np.ndarray, x: int, y: int, h: int, w: int) -> tuple[int, int, int, int] | None:
+    """Rows ``r0:r1`` and columns ``c0:c1`` of the (h, w) box at (x, y) inside ``img`` as
+    ``(r0, r1, c0, c1)``, or None when none of it is."""
+    ih, iw = img.shape[:2]
+    r0, c0 = max(y, 0), max(x, 0)
+    r1, c1 = min(y + h, ih), min(x + w, iw)
+    return None if r1 <= r0 or c1 <= c0 else (r0, r1, c0, c1)
 
 
 def blit_mask(
     img: np.ndarray, mask: np.ndarray, x: int, y: int, color: Color, alpha: float = 1.0
 ) -> None:
     """Paint ``color`` where ``mask`` (h, w) is set, top-left at (x, y), clipped to ``img``."""
-    h, w = mask.shape
-    ih, iw = img.shape[:2]
-    r0, c0 = max(y, 0), max(x, 0)
-    r1, c1 = min(y + h, ih), min(x + w, iw)
-    if r1 <= r0 or c1 <= c0:
+    box = clip_box(img, x, y, *mask.shape)
+    if box is None:
         return
+    r0, r1, c0, c1 = box
     m = mask[r0 - y : r1 - y, c0 - x : c1 - x]
     region = img[r0:r1, c0:c1]
     if alpha >= 1.0:

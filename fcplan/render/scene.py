@@ -11,7 +11,10 @@
   one pixel, and on small images one more to the right and down, so 1-px trails stay visible.
 * :func:`draw_agents`: every agent's field of view (translucent ``2z x 1.1547z`` rectangle), its
   planned route (dashed line through its goals), and the agent itself: perception = blue circle,
-  action = yellow triangle, hybrid = violet diamond; the selected agent gets a white ring.
+  action = yellow triangle, hybrid = violet diamond; the selected agent gets a white ring. On maps
+  of 256 px or more each agent carries its id in bold DejaVu Sans, placed by
+  :func:`~fcplan.render.text.place_labels` so that no two labels (and no label and another
+  agent's marker) overlap when a free spot exists (agents bunched at the depot, a crowded fire).
 
 Examples
 --------
@@ -34,15 +37,14 @@ from fcplan.render.raster import (
     ROLE_SHAPES,
     blit_mask,
     cell_pixels,
-    draw_text,
+    font_px,
     halo,
     line,
     paint_px,
     rect,
     stamp,
-    text_mask,
-    text_scale,
 )
+from fcplan.render.text import draw_text, place_labels, text_size
 
 __all__ = ["check_frame", "draw_agents", "draw_background", "draw_fire", "role_of"]
 
@@ -190,10 +192,17 @@ def draw_agents(img: np.ndarray, scenario: Any, frame: FrameData, roles: list[st
             img, ROLE_SHAPES[roles[i]], x, y, r_agent, COLORS[roles[i]], outline=COLORS["outline"]
         )
     if size >= 256:
-        ts = text_scale(size)
-        for i in range(n):
-            x, y = pos[i]
-            label = scenario.agents[i].id if i < len(scenario.agents) else str(i + 1)
-            lx, ly = int(round(x + r_agent + 2)), int(round(y - r_agent - 5 * ts))
-            blit_mask(img, text_mask(label, ts), lx + 1, ly + 1, COLORS["outline"])
-            draw_text(img, label, lx, ly, COLORS["text"], ts)
+        _draw_labels(img, scenario, pos, r_agent)
+
+
+def _draw_labels(img: np.ndarray, scenario: Any, pos: np.ndarray, r_agent: float) -> None:
+    """Every agent's id next to its marker, at non-overlapping spots (greedy placement)."""
+    size = img.shape[0]
+    px = font_px(size)
+    n = len(pos)
+    labels = [scenario.agents[i].id if i < n and i < len(scenario.agents) else str(i + 1)
+              for i in range(n)]  # fmt: skip
+    sizes = [(w + 1, h + 1) for w, h in (text_size(t, px, bold=True) for t in labels)]  # + shadow
+    boxes = place_labels(pos, sizes, r_agent + 1.0, (img.shape[1], size), gap=1)
+    for label, (x0, y0, _, _) in zip(labels, boxes, strict=True):
+        draw_text(img, label, x0, y0, COLORS["text"], px, bold=True, shadow=COLORS["outline"])

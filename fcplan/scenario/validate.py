@@ -9,6 +9,9 @@ Two different questions are asked of a scenario:
   parameters in uniform fire mode. A violation raises :class:`~fcplan.errors.ScenarioError` with a
   one-line message ``<file>: <dotted.field>: <problem and allowed range> (got <value>)``.
 
+  Upper bounds (ranges, counts, ticks, the memory an episode needs) are checked next
+  (:func:`fcplan.scenario.bounds.check_bounds`): a scenario that validates also runs.
+
   A footprint may overhang the map edge: power stations are 220 px tall on a 200 px grid block, so
   the game's own scenario #7 has one (C-11) whose footprint ends 10 px below the map. Cells outside
   the map do not exist, so only the part inside is ever scored.
@@ -39,10 +42,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from numbers import Integral, Real
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from fcplan.errors import ScenarioError
+from fcplan.scenario.bounds import check_bounds
+from fcplan.scenario.fieldpaths import AgentPaths, agent_field, is_integer, is_number
+from fcplan.scenario.fieldpaths import fmt_box as _fmt_box
+from fcplan.scenario.fieldpaths import fmt_point as _fmt_point
+from fcplan.scenario.fieldpaths import fmt_value as _fmt
 from fcplan.scenario.grid import (
     GRID_BLOCKS,
     block_cell,
@@ -51,7 +60,7 @@ from fcplan.scenario.grid import (
     column_letters,
     parse_cell,
 )
-from fcplan.scenario.model import (
+from fcplan.scenario.parts import (
     ACTION_ALTITUDE,
     ACTION_GATES,
     DEFAULT_PENALTIES,
@@ -59,6 +68,7 @@ from fcplan.scenario.model import (
     FACILITY_KINDS,
     FACILITY_SIZES,
     FIRE_MODES,
+    WIND_MODELS,
     AgentSpec,
     Depot,
     Facility,
@@ -75,16 +85,6 @@ __all__ = ["check_scenario", "manual_limit_violations", "is_number", "is_integer
 
 UNIFORM_FIELDS = ("fronts", "delay_s", "fuel", "wind_speed", "wind_dir_deg")
 """Region parameters that uniform fire mode shares between all regions."""
-
-
-def is_number(v: Any) -> bool:
-    """True for int/float (numpy scalars included) but not bool."""
-    return isinstance(v, Real) and not isinstance(v, bool)
-
-
-def is_integer(v: Any) -> bool:
-    """True for int (numpy integers included) but not bool."""
-    return isinstance(v, Integral) and not isinstance(v, bool)
 
 
 def _finite(v: Any) -> bool:
@@ -124,18 +124,6 @@ def _point(field: str, v: Any, world: int) -> None:
     )
 
 
-def _fmt(v: float) -> str:
-    return f"{v:g}" if is_number(v) else repr(v)
-
-
-def _fmt_point(p: tuple[float, float]) -> str:
-    return f"({_fmt(p[0])}, {_fmt(p[1])})"
-
-
-def _fmt_box(box: tuple[float, float, float, float]) -> str:
-    return f"x in ({_fmt(box[0])}, {_fmt(box[1])}), y in ({_fmt(box[2])}, {_fmt(box[3])})"
-
-
 def _where(path: str, obj: Any) -> str:
     """``path.cell`` if the object was placed by cell, else ``path.center``."""
     return f"{path}.cell" if getattr(obj, "cell", None) is not None else f"{path}.center"
@@ -155,20 +143,11 @@ def _check_cell(path: str, obj: Any, kind: str, world: int) -> None:
     )
 
 
-def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
-    return a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]
-
-
-def agent_field(agents: list[AgentSpec], role: Role, k: int, name: str) -> str:
-    """TOML path of agent field ``name`` for the ``k``-th (0-based) agent of ``role``.
-
-    ``team.<role>.<name>`` when every agent of that role has the same value (a scalar in TOML),
-    else ``team.<role>.<name>[k]``. Start positions are always per agent.
-    """
-    same_role = [a for a in agents if a.role is role]
-    values = {repr(getattr(a, name)) for a in same_role}
-    base = f"team.{role.key}.{name}"
-    return base if len(values) == 1 and name != "start" else f"{base}[{k}]"
+def _first_overlap(boxes: np.ndarray, a: tuple[float, ...]) -> int | None:
+    """Row of the first of ``boxes`` ((m, 4) ``[x0, x1, y0, y1]``) whose open interior meets
+    box ``a``'s (a point if ``x0 == x1``, ``y0 == y1``), or None; one vectorised pass."""
+    hit = (a[0] < boxes[:, 1]) & (boxes[:, 0] < a[1]) & (a[2] < boxes[:, 3]) & (boxes[:, 2] < a[3])
+    return int(np.argmax(hit)) if hit.any() else None
 
 
 # ------------------------------------------------------------------------------------------ errors
@@ -184,7 +163,8 @@ def check_scenario(s: Scenario) -> None:
         _check_header(s)
         _check_regions(s)
         _check_sites(s)
-        _check_agents(s)
+        paths = _check_agents(s)
+        check_bounds(s, paths.of)
     except ScenarioError as err:
         raise (err.with_source(source) if source else err) from None
 
@@ -208,6 +188,7 @@ def _check_header(s: Scenario) -> None:
     _int_at_least("ticks_per_second", s.ticks_per_second, 1)
     _choice("fire.mode", s.fire_mode, FIRE_MODES)
     _choice("fire.action_gate", s.action_gate, ACTION_GATES)
+    _choice("fire.wind_model", s.wind_model, WIND_MODELS)
     if s.comm_range is not None:
         _positive("comm_range", s.comm_range, " (px), or absent for unlimited")
     _require(
@@ -268,7 +249,10 @@ def _check_sites(s: Scenario) -> None:
     _check_cell("depot", depot, f"depot_{depot.orientation}", world)
     _non_negative("scoring.penalties.depot", depot.penalty)
 
-    placed: list[tuple[str, str, tuple[float, ...]]] = [("the depot", "depot", depot.footprint)]
+    placed: list[tuple[str, str, tuple[float, float, float, float]]] = [
+        ("the depot", "depot", depot.footprint)
+    ]
+    boxes = np.array([depot.footprint] * (len(s.facilities) + 1))  # of ``placed``, in order
     last_kind = 0
     for i, f in enumerate(s.facilities):
         p = f"facilities[{i}]"
@@ -301,21 +285,26 @@ def _check_sites(s: Scenario) -> None:
             "must be a number >= 0",
             f.penalty,
         )
-        for other, other_path, box in placed:
+        hit = _first_overlap(boxes[: len(placed)], f.footprint)
+        if hit is not None:
+            other, other_path, box = placed[hit]
             _require(
-                not _overlap(f.footprint, box),
+                False,
                 _where(p, f),
                 f"footprint {_fmt_box(f.footprint)} overlaps {other} "
                 f"({other_path}: {_fmt_box(box)}); facility and depot footprints may not overlap",
                 _fmt_point(f.center),
             )
+        boxes[len(placed)] = f.footprint
         placed.append((f"{f.kind} {_fmt_point(f.center)}", p, f.footprint))
 
     for i, r in enumerate(s.regions):
         x, y = r.center
-        for other, other_path, (x0, x1, y0, y1) in placed:
+        hit = _first_overlap(boxes, (x, x, y, y))
+        if hit is not None:
+            other, other_path, (x0, x1, y0, y1) = placed[hit]
             _require(
-                not (x0 < x < x1 and y0 < y < y1),
+                False,
                 _where(f"fire.regions[{i}]", r),
                 f"region centre lies inside the footprint of {other} ({other_path}: "
                 f"{_fmt_box((x0, x1, y0, y1))}); "
@@ -330,9 +319,11 @@ def _check_sites(s: Scenario) -> None:
         _check_cell(p, lake, "lake", world)
 
 
-def _check_agents(s: Scenario) -> None:
+def _check_agents(s: Scenario) -> AgentPaths:
+    """Check every agent (linear in the team size); return the team's field paths."""
     world = s.world_size
     agents = list(s.agents)
+    paths = AgentPaths(agents)
     last_role = Role.PERCEPTION
     seen = dict.fromkeys(Role, 0)
     for n, a in enumerate(agents):
@@ -355,8 +346,8 @@ def _check_agents(s: Scenario) -> None:
             a.id,
         )
 
-        def path(name: str, a: AgentSpec = a, k: int = k) -> str:
-            return agent_field(agents, a.role, k, name)
+        def path(name: str, n: int = n) -> str:
+            return paths.of(n, name)
 
         _point(path("start"), a.start, world)
         alt = a.altitude
@@ -404,6 +395,7 @@ def _check_agents(s: Scenario) -> None:
         "and one that can act (action or hybrid)",
         counts,
     )
+    return paths
 
 
 # ----------------------------------------------------------------------------------- manual limits
@@ -500,13 +492,12 @@ def manual_limit_violations(s: Scenario) -> list[str]:
 def _agent_limits(s: Scenario, rep: _Report) -> None:
     agents = list(s.agents)
     slots = s.depot.slots(len(agents))
-    seen = dict.fromkeys(Role, 0)
+    paths = AgentPaths(agents)
     for n, a in enumerate(agents):
-        k = seen[a.role]
-        seen[a.role] += 1
+        k = paths.index[n]
 
-        def path(name: str, a: AgentSpec = a, k: int = k) -> str:
-            return agent_field(agents, a.role, k, name)
+        def path(name: str, n: int = n) -> str:
+            return paths.of(n, name)
 
         lo, hi = a.altitude
         alt = f"[{_fmt(lo)}, {_fmt(hi)}]"
@@ -544,7 +535,10 @@ def _placement_limits(s: Scenario, rep: _Report) -> None:
     objects += [(f"facilities[{i}]", f.kind, f) for i, f in enumerate(s.facilities)]
     objects += [(f"lakes[{i}]", "lake", lake) for i, lake in enumerate(s.lakes)]
 
-    placed: list[tuple[str, str, str, set[tuple[int, int]]]] = []
+    placed: list[tuple[str, str, str]] = []  # (field, grid kind, cell) in placement order
+    # grid cell -> rows of ``placed`` on it (regions may share cells: they see only not_region)
+    anyone: dict[tuple[int, int], list[int]] = {}
+    not_region: dict[tuple[int, int], list[int]] = {}
     for field, kind, obj in objects:
         cell = block_cell(obj.center, kind)
         if cell is None:
@@ -564,12 +558,16 @@ def _placement_limits(s: Scenario, rep: _Report) -> None:
             f"its {cols}x{rows} block at {cell} extends past the {n}x{n} grid",
             "objects fit inside the map",
         )
-        for other_field, other_kind, other_cell, other_cells in placed:
-            if kind == other_kind == "region" or not (cells & other_cells):
-                continue
+        occupant = not_region if kind == "region" else anyone
+        for j in sorted({j for c in cells for j in occupant.get(c, ())}):
+            other_field, _, other_cell = placed[j]
             got = f"its block at {cell} shares grid cells with {other_field} ({other_cell})"
             rep.limit(False, field, got, "objects may not overlap on the grid, except fire regions")
-        placed.append((field, kind, cell, cells))
+        for c in cells:
+            anyone.setdefault(c, []).append(len(placed))
+            if kind != "region":
+                not_region.setdefault(c, []).append(len(placed))
+        placed.append((field, kind, cell))
 
     cell = block_cell(s.depot.center, f"depot_{s.depot.orientation}")
     if cell is not None:

@@ -11,8 +11,17 @@ tasks), then a **sense auction** (the camera agents that won no dump bid on watc
 covering a search block). The plan keeps one holder per (task, service).
 
 Modules: :mod:`~solvers.cbba.comms` (who can talk to whom), :mod:`~solvers.cbba.auction` (one
-auction: bundle construction and consensus), :mod:`~solvers.cbba.scheduler` (the two auctions,
-their scores, and the plan).
+auction: bundle construction, consensus, the stopping rule), :mod:`~solvers.cbba.assembly`
+(conflict-free routes; greedy completion of an auction cut short), :mod:`~solvers.cbba.clock`
+(the wall-clock limit), :mod:`~solvers.cbba.settings` (settings checks),
+:mod:`~solvers.cbba.scheduler` (the two auctions, their scores, the modes, and the plan) and
+:mod:`~solvers.cbba.static` (the same auction on a static textbook instance, checked against an
+independent implementation in ``tests/solvers/test_cbba_reference.py``).
+
+Modes: with a ``time_limit`` (argument or setting) the scheduler stops on the wall clock and
+returns within the limit + 10 % + 5 ms (or raises, so ``solve`` falls back to greedy);
+``deterministic=True`` never reads the clock and stops on ``max_rounds`` only, so plans are the
+same in any process and under any load (use it for comparisons).
 
 Examples
 --------
@@ -23,10 +32,27 @@ Examples
 >>> plan = CBBAScheduler().plan(g, time_limit=None, rng=np.random.default_rng(0))
 >>> plan.stats.size["converged"], plan.stats.size["rounds"] > 0
 (True, True)
+>>> fixed = CBBAScheduler(deterministic=True, max_rounds=3)
+>>> fixed.plan(g, time_limit=1e-9, rng=None).routes == fixed.plan(g, time_limit=None, rng=None).routes
+True
 """
 
 from solvers.cbba.auction import StageResult
+from solvers.cbba.clock import CBBATimeLimitError
 from solvers.cbba.comms import CommGraph, communication_graph
 from solvers.cbba.scheduler import CBBAResult, CBBAScheduler
+from solvers.cbba.settings import CBBASettingsError
+from solvers.cbba.static import StaticInstance, StaticResult, solve_static
 
-__all__ = ["CBBAScheduler", "CBBAResult", "CommGraph", "StageResult", "communication_graph"]
+__all__ = [
+    "CBBAScheduler",
+    "CBBAResult",
+    "CBBASettingsError",
+    "CBBATimeLimitError",
+    "CommGraph",
+    "StageResult",
+    "StaticInstance",
+    "StaticResult",
+    "communication_graph",
+    "solve_static",
+]

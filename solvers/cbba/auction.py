@@ -23,10 +23,17 @@ to grow as its bundle grows. The time-discounted reward mostly has this property
 reaches every task later, and a detour delays more tasks), but not always: a task added to the
 bundle can offer a cheaper place to insert another one. So the bid is *warped* (Johnson, Choi,
 Ponda and How, "Allowing non-submodular score functions in distributed task allocation", CDC
-2012): the bid placed is ``min(c_j, last bid in the bundle)``. Every bundle's bids are then
-non-increasing, which is what the proof uses; with a DMG score the warp never binds, so this is
-plain CBBA. The task is chosen by its true marginal score. (The watch rule only makes bids
-drop: a watch cannot join a non-empty bundle.)
+2012): the bid placed is ``min(c_j, last bid in the bundle)``, and every bundle's bids are
+non-increasing. The task is chosen by its true marginal score. (The watch rule only makes bids
+drop: a watch cannot join a non-empty bundle.) Even with a DMG score the warp can bind: a task
+the agent could not win when it built its bundle, freed later, may score more than the tasks
+added before it. Plain CBBA bids ``c_j`` there; ``Auction.warp=False`` does that.
+
+*Append-only insertion.* With ``Auction.append_only`` a task may only join the end of a path,
+so ``c_j`` is just its discounted value at the path's end: the rule of implementations that
+promise every task in a path its arrival time and insert only where no promise is broken
+(:mod:`solvers.cbba.static`). That score is DMG (by the triangle inequality a task appended
+later is reached no earlier), and it runs as plain CBBA (no warp).
 
 Phase 2: consensus
 ------------------
@@ -37,10 +44,22 @@ index order with the update / reset / leave rules of Table I of the paper (vecto
 tasks; a sender sends what it held at the start of the round), then updates its timestamps
 (``s_ik`` = this round for a neighbour ``k``, else the newest copy a neighbour had). An agent that
 has lost a task of its bundle releases that task and every task it added after it (those it still
-believed it held are reset to "no winner", as in the authors' reference implementation). Rounds
-alternate phase 1 and phase 2 until no agent's ``y``, ``z`` or bundle has changed for
-``2 * diameter`` rounds (at least one), ``diameter`` being the largest hop diameter of a
-connected component, or until ``max_rounds``.
+believed it held are reset to "no winner", as in the authors' reference implementation).
+
+Convergence
+-----------
+Rounds alternate phase 1 and phase 2 until a round after the first ``diameter`` (the largest
+hop diameter of a connected component) changes no agent's ``y``, ``z`` or bundle; that round is
+a fixed point. Proof: a timestamp ``s_in`` is 0 until news from ``n`` first reaches ``i``, and
+from round ``hop(i, n)`` on it is ``t - hop(i, n) + 1`` at the end of round ``t`` (by induction
+over the hops), so from round ``diameter + 1`` on every comparison of Table I (``s_kn`` against
+``s_in``, within a round too) has the same outcome in every round. A round that then changes
+nothing is followed by one that starts from the same ``y``, ``z`` and bundles, compares the same
+way and so changes nothing either. ``last_change`` is the last round in which something changed
+(0: none). The simulator sees every agent, so it can stop there; agents on their own would need
+a detection protocol (e.g. ``diameter`` quiet rounds) on top. An auction also stops after
+``max_rounds``, or when the wall clock says so (:mod:`solvers.cbba.clock`; asked before each
+bundle construction and each neighbour slot; a consensus round cut short is discarded).
 
 One row of Table I differs from the paper. Synchronous rounds make equal timestamps common, and
 in the row where sender and receiver name two different third agents ``m`` (sender) and ``n``
@@ -61,16 +80,21 @@ through the table.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
 
+from solvers.cbba.clock import BUILD_OVERHEAD, Clock
 from solvers.cbba.comms import CommGraph
 
-__all__ = ["NO_WINNER", "Auction", "StageResult", "resolve_conflicts", "run_auction"]
+__all__ = ["NO_WINNER", "STOPS", "Auction", "StageResult", "insertion_scores", "run_auction"]
 
 NO_WINNER = -1  # "no winner" in a winner vector
+
+#: Why an auction stopped: it converged, it hit ``max_rounds``, or the wall clock ran out.
+STOPS = ("converged", "max_rounds", "time_limit")
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,6 +113,8 @@ class Auction:
     budget: np.ndarray  # (A,) px of flight
     speed: np.ndarray  # (A,) px/s
     rate: float  # discount rate per second: score = value * exp(-rate * t)
+    append_only: bool = False  # a task only joins the end of a path
+    warp: bool = True  # bid min(c_j, last bid in the bundle)
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,7 +134,11 @@ class StageResult:
     bundle_bids : list of list of float
         The bid placed for each bundle entry.
     rounds, messages : int
-    converged, timed_out : bool
+        Rounds started (a round cut short by the clock counts) and messages sent.
+    last_change : int
+        Last round in which an agent's ``y``, ``z`` or bundle changed (0: none did).
+    stopped_by : str
+        One of :data:`STOPS`.
     """
 
     name: str
@@ -120,11 +150,21 @@ class StageResult:
     bundle_bids: list[list[float]]
     rounds: int
     messages: int
-    converged: bool
-    timed_out: bool
+    last_change: int
+    stopped_by: str
+
+    @property
+    def converged(self) -> bool:
+        """The auction reached its fixed point (see the module docstring)."""
+        return self.stopped_by == "converged"
+
+    @property
+    def timed_out(self) -> bool:
+        """The wall clock stopped the auction."""
+        return self.stopped_by == "time_limit"
 
 
-def _insertion_scores(
+def insertion_scores(
     auc: Auction, i: int, path: list[int], cand: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Best marginal score of inserting each candidate item into agent ``i``'s path, and where.
@@ -159,6 +199,8 @@ def _insertion_scores(
     loss = tail[:, None] * -np.expm1(-rate * detour / speed)
     score = gain - loss
     feasible = total + detour <= auc.budget[i] + 1e-9
+    if auc.append_only:
+        feasible[:n] = False  # only the last slot
     if n:
         feasible[:, auc.exclusive[cand]] = False  # an exclusive item only on an empty path
         if auc.exclusive[path[0]]:
@@ -196,8 +238,8 @@ class _Agents:
             free[np.isin(cand, bundle)] = False
         added = False
         while len(bundle) < auc.limit[i]:
-            score, where = _insertion_scores(auc, i, path, cand)
-            bid = np.minimum(score, bids[-1]) if bids else score
+            score, where = insertion_scores(auc, i, path, cand)
+            bid = np.minimum(score, bids[-1]) if bids and auc.warp else score
             y, z = self.y[i, cand], self.z[i, cand]
             zz = np.where(z == NO_WINNER, self.n_agents, z)
             beats = (bid > y) | ((bid == y) & (i < zz))
@@ -216,9 +258,15 @@ class _Agents:
         return added
 
     # ---------------------------------------------------------------- phase 2
-    def consensus(self, slots: list[tuple[np.ndarray, np.ndarray]], t: int) -> np.ndarray:
+    def consensus(
+        self,
+        slots: list[tuple[np.ndarray, np.ndarray]],
+        t: int,
+        stop: Callable[[], bool] | None = None,
+    ) -> np.ndarray | None:
         """One synchronous round of message passing (Table I of the paper); returns the (A,) rows
-        whose ``y`` or ``z`` changed."""
+        whose ``y`` or ``z`` changed, or None (and changes nothing) if ``stop()`` said so before
+        a neighbour slot."""
         a = self.n_agents
         s0 = self.s.copy()
         cols = np.flatnonzero((self.z != NO_WINNER).any(axis=0))
@@ -229,8 +277,10 @@ class _Agents:
             return np.zeros(a, dtype=bool)
         y0, z0 = self.y[:, cols], self.z[:, cols]  # snapshot: what each agent sends
         y, z = y0.copy(), z0.copy()
-        s = self.s
+        s = s0.copy()
         for rec, snd in slots:
+            if stop is not None and stop():
+                return None
             # only entries where the message differs from the receiver's belief can change it
             zk_all = z0[snd]
             yk_all = y0[snd]
@@ -273,6 +323,7 @@ class _Agents:
             s[rec] = np.maximum(s[rec], s0[snd])
             s[rec, snd] = t
         changed = (y != y0).any(axis=1) | (z != z0).any(axis=1)
+        self.s = s
         self.y[:, cols] = y
         self.z[:, cols] = z
         return changed
@@ -306,36 +357,59 @@ def run_auction(
     comm: CommGraph,
     *,
     max_rounds: int,
-    deadline: float | None,
+    clock: Clock | None = None,
 ) -> StageResult:
-    """Alternate bundle construction and consensus until nothing changes for 2 * diameter
-    rounds, ``max_rounds`` or the deadline."""
+    """Alternate bundle construction and consensus until a round after the first ``diameter``
+    changes nothing, ``max_rounds``, or the ``clock`` (None: never read) says stop."""
     agents = _Agents(auc)
     bidders = cast(np.ndarray, auc.eligible.any(axis=1))
     slots = comm.slots()
     per_round = comm.messages_per_round
-    need = max(2 * comm.diameter, 1)
     dirty = bidders.copy()
-    stable = rounds = messages = 0
-    converged = timed_out = False
+    rounds = messages = last_change = 0
+    stopped_by = "max_rounds"
+    work = np.array([c.size + BUILD_OVERHEAD for c in agents.cand], dtype=np.float64)
+    pending = float(work[bidders].sum())  # work of completing the bidders holding nothing
+
+    def stop() -> bool:
+        return clock is not None and clock.past(pending)
+
     while rounds < max_rounds:
-        rounds += 1
-        changed = False
-        for i in np.flatnonzero(dirty & bidders):
-            changed |= agents.build(int(i))
-        dirty[:] = False
-        if per_round:
-            messages += per_round
-            moved = agents.consensus(slots, rounds)
-            released = agents.release()
-            changed |= bool(moved.any() or released.any())
-            dirty |= moved | released
-        stable = 0 if changed else stable + 1
-        if stable >= need:
-            converged = True
+        if stop():
+            stopped_by = "time_limit"
             break
-        if deadline is not None and time.perf_counter() > deadline:
-            timed_out = True
+        rounds += 1
+        changed = cut = False
+        for i in np.flatnonzero(dirty & bidders).tolist():
+            if stop():
+                cut = True
+                break
+            was_empty = not agents.bundles[i]
+            t = time.perf_counter() if clock is not None else 0.0
+            changed |= agents.build(i)
+            if clock is not None:
+                clock.record(time.perf_counter() - t, work[i])
+            if was_empty and agents.bundles[i]:
+                pending -= work[i]
+            dirty[i] = False
+        if not cut and per_round:
+            moved = agents.consensus(slots, rounds, stop if clock is not None else None)
+            if moved is None:
+                cut = True
+            else:
+                messages += per_round
+                released = agents.release()
+                changed |= bool(moved.any() or released.any())
+                dirty |= moved | released
+                empty = np.array([not b for b in agents.bundles], dtype=bool)
+                pending = float(work[bidders & empty].sum())
+        if changed:
+            last_change = rounds
+        if cut:
+            stopped_by = "time_limit"
+            break
+        if not changed and rounds > comm.diameter:
+            stopped_by = "converged"
             break
     return StageResult(
         name=name,
@@ -347,21 +421,6 @@ def run_auction(
         bundle_bids=agents.bids,
         rounds=rounds,
         messages=messages,
-        converged=converged,
-        timed_out=timed_out,
+        last_change=last_change,
+        stopped_by=stopped_by,
     )
-
-
-def resolve_conflicts(stage: StageResult) -> tuple[dict[int, int], int, float]:
-    """Item -> the agent that keeps it (highest own bid, ties to the lower index), the number of
-    items held by more than one agent, and the sum of the kept bids."""
-    best: dict[int, tuple[float, int]] = {}
-    held: dict[int, int] = {}
-    for i, (bundle, bids) in enumerate(zip(stage.bundles, stage.bundle_bids, strict=True)):
-        for j, b in zip(bundle, bids, strict=True):
-            held[j] = held.get(j, 0) + 1
-            cur = best.get(j)
-            if cur is None or b > cur[0]:
-                best[j] = (b, i)
-    conflicts = sum(1 for c in held.values() if c > 1)
-    return {j: i for j, (_, i) in best.items()}, conflicts, sum(b for b, _ in best.values())

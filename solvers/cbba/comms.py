@@ -15,7 +15,7 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, shortest_path
 
-__all__ = ["CommGraph", "communication_graph"]
+__all__ = ["CommGraph", "communication_graph", "graph_from_adjacency"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,16 +70,30 @@ def communication_graph(positions: np.ndarray, comm_range: float | None) -> Comm
     n = len(pos)
     if comm_range is None:
         adj = ~np.eye(n, dtype=bool)
-    else:
-        d = np.hypot(*(pos[:, None, :] - pos[None, :, :]).transpose(2, 0, 1))
-        adj = (d <= float(comm_range)) & ~np.eye(n, dtype=bool)
+        if n == 0:
+            return CommGraph(adj, np.zeros(0, dtype=np.int64), 0, 0)
+        return CommGraph(adj, np.zeros(n, dtype=np.int64), 1, 1 if n > 1 else 0)
+    d = np.hypot(*(pos[:, None, :] - pos[None, :, :]).transpose(2, 0, 1))
+    return graph_from_adjacency((d <= float(comm_range)) & ~np.eye(n, dtype=bool))
+
+
+def graph_from_adjacency(adjacency: np.ndarray) -> CommGraph:
+    """The communication graph with the given (A, A) adjacency (made symmetric, no self-loops).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> line = np.eye(4, k=1, dtype=bool)  # 0 - 1 - 2 - 3
+    >>> cg = graph_from_adjacency(line)
+    >>> cg.n_components, cg.diameter, cg.messages_per_round
+    (1, 3, 6)
+    """
+    adj = np.asarray(adjacency, dtype=bool)
+    adj = (adj | adj.T) & ~np.eye(len(adj), dtype=bool)
+    n = len(adj)
     if n == 0:
         return CommGraph(adj, np.zeros(0, dtype=np.int64), 0, 0)
     n_comp, labels = connected_components(csr_matrix(adj), directed=False)
-    if comm_range is None:
-        diameter = 1 if n > 1 else 0
-    else:
-        hops = shortest_path(csr_matrix(adj), directed=False, unweighted=True)
-        finite = hops[np.isfinite(hops)]
-        diameter = int(finite.max(initial=0))
+    hops = shortest_path(csr_matrix(adj), directed=False, unweighted=True)
+    diameter = int(hops[np.isfinite(hops)].max(initial=0))
     return CommGraph(adj, labels.astype(np.int64), int(n_comp), diameter)

@@ -29,7 +29,7 @@ the other over the same communication graph, each a complete CBBA run with fixed
    worth their task value. A watch is a whole route on its own (the agent flies there and
    hovers): it is only bid on with an empty bundle and nothing joins it.
 
-Both auctions are plain CBBA with scores fixed for the whole auction (the sense scores depend on
+Both auctions are CBBA (:mod:`solvers.cbba.auction`) with scores fixed for the whole auction (the sense scores depend on
 the dump auction's outcome, settled by then), so each converges on its own; the rounds and
 messages reported are the sums over the two.
 
@@ -37,32 +37,57 @@ Disconnected teams
 ------------------
 Each connected component reaches consensus on its own, and agents in different components may
 both win the same (task, service). Sending both would be what a truly decentralised team does, but
-the testbed executes one plan, so the plan assembly keeps the higher bid (ties to the lower agent
-index) and drops the task from the other route; dropping a task from a route never breaks its
-battery feasibility (triangle inequality). These are counted as ``conflicts_resolved`` in the
-stats, so the price of the partition is visible; with a connected team it is 0 at convergence.
+the testbed executes one plan, so the plan assembly (:mod:`solvers.cbba.assembly`) keeps the
+higher bid (ties to the lower agent index) and drops the task from the other route; dropping a
+task from a route never breaks its battery feasibility (triangle inequality). These are counted
+as ``conflicts_resolved`` in the stats, so the price of the partition is visible; with a
+connected team it is 0 at convergence. The dump auction is assembled before the sense auction
+starts, so a hybrid agent that lost all its dumps this way bids for camera work.
 
-Time limit
-----------
-The rounds stop when the time limit passes (each auction runs at least one round, so perception
-agents still get routes); the bundles the agents hold then are assembled as above (conflicts
-resolved by bid) and the status is ``time_limit``.
+Limits and modes
+----------------
+* **Wall mode** (``deterministic=False``, the default): when a time limit is given (the
+  ``time_limit`` argument of :meth:`CBBAScheduler.plan`, else the ``time_limit`` setting; None:
+  no limit), the auctions ask a clock (:mod:`solvers.cbba.clock`) before every bundle
+  construction and every neighbour slot of a consensus round and stop in time to complete
+  what is missing. The dump auction may use a share of the limit proportional to its size
+  (dumpers x fires against cameras x tasks, between 20 % and 80 %), the sense auction what is
+  left. ``plan()`` returns within the limit + 10 % + 5 ms of its own work, as long as the
+  limit is not shorter than setting up the auctions (reading the graph's views and scoring
+  the items, which is not interrupted: well under a millisecond on the manual's scenarios,
+  tens of milliseconds on 100 agents x 2,000 tasks); every other step between two looks at the
+  clock is one bundle construction or one neighbour slot (about a millisecond at most). Pauses
+  that the operating system imposes on a loaded machine come on top (``bench/README.md``).
+  Plans then depend on the machine's speed and load.
+* **Deterministic mode** (``deterministic=True``): the wall clock is never read; each auction
+  stops at convergence or after ``max_rounds`` rounds, so the same graph gives the same plan in
+  any process and under any load, whatever time limit is passed (use it for comparisons; the
+  rounds per replan in ``bench/bench_cbba.py`` help pick ``max_rounds``).
+
+An auction cut short (by either limit) is assembled from the bundles the agents hold then
+(conflicts resolved by bid), and every bidder left with nothing is completed greedily from the
+free tasks (:mod:`solvers.cbba.assembly`), so the limit never hands back idle agents as a
+decision; ``completed`` in the stats counts them. If even that does not fit in the wall limit +
+10 % + 5 ms, :class:`~solvers.cbba.clock.CBBATimeLimitError` is raised and
+:func:`fcplan.scheduling.solve` falls back to greedy for that replan (status ``fallback``, the
+reason in its message).
 
 Stats
 -----
-``status`` is ``heuristic`` (``time_limit`` when stopped by the limit); ``objective`` is the sum of
-the winning bids of the tasks in the final plan; ``size`` holds ``agents``, ``tasks``, ``rounds``,
-``messages``, ``converged``, ``components``, ``diameter`` and ``conflicts_resolved``, and
+``status`` is ``heuristic`` when both auctions converged, ``time_limit`` when the wall clock
+stopped one, ``feasible`` when ``max_rounds`` did; ``objective`` is the sum of the winning bids
+of the tasks in the final plan; ``size`` holds ``agents``, ``tasks``, ``rounds``, ``messages``,
+``last_change`` (rounds until the last change, summed over the auctions), ``converged``,
+``stopped_by`` (``converged``, ``max_rounds`` or ``time_limit``: the first auction that did not
+converge says why), ``completed``, ``components``, ``diameter`` and ``conflicts_resolved``, and
 ``message`` says the same in words. Agents on their way home for good (``HOMING``) do not bid but
 relay messages. Camera agents fly at ``watch_altitude`` when they watch and at ``search_altitude``
-when they search. The algorithm uses no randomness (ties go to lower indices), so plans
-are deterministic.
+when they search. The algorithm uses no randomness (ties go to lower indices).
 """
 
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -72,8 +97,11 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers.cbba.auction import NO_WINNER, Auction, StageResult, resolve_conflicts, run_auction
+from solvers.cbba.assembly import Assembly, assemble
+from solvers.cbba.auction import NO_WINNER, Auction, StageResult, run_auction
+from solvers.cbba.clock import Clock
 from solvers.cbba.comms import CommGraph, communication_graph
+from solvers.cbba.settings import flag, integer, number
 
 __all__ = ["CBBAResult", "CBBAScheduler"]
 
@@ -85,24 +113,27 @@ class CBBAResult:
     Attributes
     ----------
     routes : dict of int -> list of int
-        Agent row -> task rows in flying order, after cross-component conflicts were resolved.
+        Agent row -> task rows in flying order, conflict-free (and completed when cut short).
     service : dict of int -> str
         Agent row -> ``"dump"`` or ``"sense"`` for every routed agent.
+    auctions : tuple of Auction
+        The dump auction, then the sense auction, as posed.
     stages : tuple of StageResult
-        The dump auction, then the sense auction.
+        How each ran.
+    assemblies : tuple of Assembly
+        Their conflict-free routes (item indices).
     comm : CommGraph
     objective : float
         Sum of the winning bids of the tasks kept in the plan.
-    conflicts_resolved : int
-        (task, service) pairs held by more than one agent at the end, given to the highest bid.
     """
 
     routes: dict[int, list[int]]
     service: dict[int, str]
+    auctions: tuple[Auction, ...]
     stages: tuple[StageResult, ...]
+    assemblies: tuple[Assembly, ...]
     comm: CommGraph
     objective: float
-    conflicts_resolved: int
 
     @property
     def rounds(self) -> int:
@@ -115,14 +146,35 @@ class CBBAResult:
         return sum(s.messages for s in self.stages)
 
     @property
+    def last_change(self) -> int:
+        """Rounds until the last change, summed over both auctions."""
+        return sum(s.last_change for s in self.stages)
+
+    @property
     def converged(self) -> bool:
         """Both auctions converged."""
         return all(s.converged for s in self.stages)
 
     @property
+    def stopped_by(self) -> str:
+        """``converged``, or why the first auction that did not converge stopped."""
+        return next((s.stopped_by for s in self.stages if not s.converged), "converged")
+
+    @property
     def timed_out(self) -> bool:
-        """The time limit stopped an auction."""
+        """The wall clock stopped an auction."""
         return any(s.timed_out for s in self.stages)
+
+    @property
+    def conflicts_resolved(self) -> int:
+        """(task, service) pairs held by more than one agent at the end, given to the highest
+        bid."""
+        return sum(a.conflicts for a in self.assemblies)
+
+    @property
+    def completed(self) -> int:
+        """Agents given a route by the greedy completion after a cut."""
+        return sum(a.completed for a in self.assemblies)
 
 
 class CBBAScheduler:
@@ -146,7 +198,17 @@ class CBBAScheduler:
         Altitude (m) of camera agents whose route ends with a watch / only covers search blocks
         (clipped to their bounds).
     max_rounds : int
-        Cap on the rounds of each auction.
+        Cap on the rounds of each auction (the work limit of the deterministic mode).
+    time_limit : float, optional
+        Seconds per replan when :meth:`plan` gets ``time_limit=None`` (None: no limit). Ignored
+        when ``deterministic``.
+    deterministic : bool
+        Never read the wall clock: stop on ``max_rounds`` only (identical plans under any load).
+
+    Raises
+    ------
+    solvers.cbba.settings.CBBASettingsError
+        A setting has the wrong type or is out of range (one line naming it and the range).
 
     Examples
     --------
@@ -156,6 +218,8 @@ class CBBAScheduler:
     >>> res = CBBAScheduler().run(g)
     >>> res.converged, res.conflicts_resolved
     (True, 0)
+    >>> CBBAScheduler(deterministic=True, max_rounds=2).run(g).stopped_by
+    'max_rounds'
     """
 
     name = "cbba"
@@ -169,60 +233,44 @@ class CBBAScheduler:
         watch_altitude: float = 35.0,
         search_altitude: float = 70.0,
         max_rounds: int = 500,
+        time_limit: float | None = None,
+        deterministic: bool = False,
     ) -> None:
-        if int(bundle_length) < 1:
-            raise ValueError(f"bundle_length must be >= 1, got {bundle_length!r}")
-        if not float(half_life_s) > 0:
-            raise ValueError(f"half_life_s must be > 0, got {half_life_s!r}")
-        if int(max_rounds) < 1:
-            raise ValueError(f"max_rounds must be >= 1, got {max_rounds!r}")
-        self.bundle_length = int(bundle_length)
-        self.half_life_s = float(half_life_s)
-        self.fresh_s = float(fresh_s)
-        self.watch_weight = float(watch_weight)
-        self.watch_altitude = float(watch_altitude)
-        self.search_altitude = float(search_altitude)
-        self.max_rounds = int(max_rounds)
+        self.bundle_length = integer("bundle_length", bundle_length, lo=1)
+        self.half_life_s = number("half_life_s", half_life_s, lo=0.0, strict=True, unit="s")
+        self.fresh_s = number("fresh_s", fresh_s, lo=0.0, unit="s")
+        self.watch_weight = number("watch_weight", watch_weight, lo=0.0)
+        self.watch_altitude = number("watch_altitude", watch_altitude, lo=0.0, unit="m")
+        self.search_altitude = number("search_altitude", search_altitude, lo=0.0, unit="m")
+        self.max_rounds = integer("max_rounds", max_rounds, lo=1)
+        self.time_limit = (
+            None
+            if time_limit is None
+            else number("time_limit", time_limit, lo=0.0, strict=True, unit="s")
+        )
+        self.deterministic = flag("deterministic", deterministic)
 
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Run both auctions on ``graph`` and return the assembled plan (``rng`` is unused:
-        CBBA breaks ties by agent index)."""
+        CBBA breaks ties by agent index).
+
+        Raises
+        ------
+        solvers.cbba.clock.CBBATimeLimitError
+            The wall limit ran out before every bidder had a route (see the module docstring).
+        """
         res = self.run(graph, time_limit=time_limit)
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}
         for i, tasks in res.routes.items():
-            if not tasks:
-                continue
             agent = graph.agent_ids[i]
             routes[agent] = tuple(graph.task_ids[k] for k in tasks)
             if res.service[i] == "sense":
                 watch = graph.task_kind[tasks[-1]] == TaskKind.FIRE
                 z = self.watch_altitude if watch else self.search_altitude
                 alts[agent] = graph.clip_altitude(i, z)
-        comm = res.comm
-        size = {
-            "agents": graph.n_agents,
-            "tasks": graph.n_tasks,
-            "rounds": res.rounds,
-            "messages": res.messages,
-            "converged": res.converged,
-            "components": comm.n_components,
-            "diameter": comm.diameter,
-            "conflicts_resolved": res.conflicts_resolved,
-        }
-        message = (
-            f"{res.rounds} rounds, {res.messages} messages, {comm.n_components} component(s), "
-            + ("converged" if res.converged else "not converged")
-            + (f", {res.conflicts_resolved} conflicts resolved" if res.conflicts_resolved else "")
-        )
-        stats = SolveStats(
-            status="time_limit" if res.timed_out else "heuristic",
-            objective=res.objective,
-            size=size,
-            message=message,
-        )
-        return Plan(routes=routes, altitudes=alts, stats=stats)
+        return Plan(routes=routes, altitudes=alts, stats=_stats(graph, res))
 
     def run(self, graph: TaskGraph, *, time_limit: float | None = None) -> CBBAResult:
         """Run the dump auction, then the sense auction, and assemble conflict-free routes.
@@ -231,96 +279,104 @@ class CBBAScheduler:
         ----------
         graph : TaskGraph
         time_limit : float, optional
-            Seconds for both auctions together.
+            Seconds for the whole call (None: the ``time_limit`` setting); ignored when
+            ``deterministic``.
         """
-        deadline = None if time_limit is None else time.perf_counter() + float(time_limit)
+        if time_limit is None:
+            time_limit = self.time_limit
+        elif not (math.isfinite(time_limit) and time_limit >= 0):
+            raise ValueError(f"cbba: time_limit must be a finite number >= 0 s, got {time_limit!r}")
+        clock = None if self.deterministic or time_limit is None else Clock.start(time_limit)
         comm = communication_graph(graph.agent_pos, graph.comm_range)
-        a = graph.n_agents
-        forced = graph.agent_mode == Mode.RETURNING
-        free = graph.agent_mode != Mode.HOMING
-        start = graph.agent_start_pos
-        budget = graph.agent_budget_px
-        d_start = graph.start_task_distance
-        trip = graph.in_round_trip
-        rate = math.log(2.0) / self.half_life_s
-        fires = graph.fire_tasks
         stale = graph.task_staleness
         fresh = np.where(
             stale <= self.fresh_s, 1.0, np.exp(-(stale - self.fresh_s) / max(self.fresh_s, 1e-9))
         )
-
-        # 1. dump auction: action / hybrid agents with water -> fire tasks
-        tank = np.where(forced, graph.agent_tank_capacity, graph.agent_tank)
-        dumpers = free & graph.agent_can_act & (tank > 0)
-        dump_value = np.broadcast_to(graph.task_value[fires] * fresh[fires], (a, fires.size))
-        dump = Auction(
-            value=np.ascontiguousarray(dump_value),
-            eligible=dumpers[:, None] & trip[:, fires] & (dump_value > 0),
-            exclusive=np.zeros(fires.size, dtype=bool),
-            limit=np.minimum(tank, self.bundle_length),
-            item_pos=graph.task_pos[fires],
-            d_start=d_start[:, fires],
-            d_home=graph.task_home_distance[:, fires],
-            start=start,
-            home=graph.agent_home,
-            budget=budget,
-            speed=graph.agent_speed,
-            rate=rate,
-        )
-        s1 = run_auction("dump", dump, fires, comm, max_rounds=self.max_rounds, deadline=deadline)
-
-        # 2. sense auction: camera agents without a dump -> watch a fire / cover a search block
-        has_dump = np.array([bool(p) for p in s1.paths], dtype=bool)
-        sensors = free & graph.agent_can_sense & ~has_dump
-        is_fire = graph.task_kind == TaskKind.FIRE
-        value = np.broadcast_to(np.where(is_fire, 0.0, graph.task_value), (a, graph.n_tasks)).copy()
-        if fires.size and a:
-            near = d_start[:, fires]  # px from each dumper's start to each fire
-            value[:, fires] = self._watch_values(graph, s1.winners, near, fresh[fires])
-        sense = Auction(
-            value=value,
-            eligible=sensors[:, None] & trip & (value > 0),
-            exclusive=is_fire,
-            limit=np.full(a, self.bundle_length),
-            item_pos=graph.task_pos,
-            d_start=d_start,
-            d_home=graph.task_home_distance,
-            start=start,
-            home=graph.agent_home,
-            budget=budget,
-            speed=graph.agent_speed,
-            rate=rate,
-        )
-        s2 = run_auction(
-            "sense",
-            sense,
-            np.arange(graph.n_tasks),
-            comm,
-            max_rounds=self.max_rounds,
-            deadline=None if deadline is None else max(deadline, time.perf_counter()),
-        )
-
-        # 3. assembly: one holder per (task, service), the highest bid
+        fires = graph.fire_tasks
+        dump = self._dump_auction(graph, fresh)
+        if clock is not None:
+            clock.stage_deadline(_dump_share(graph, dump))
+        s1 = run_auction("dump", dump, fires, comm, max_rounds=self.max_rounds, clock=clock)
+        a1 = assemble(s1, dump, clock)
+        if clock is not None:
+            clock.stage_deadline(1.0)
+        winners = s1.winners  # what each agent learnt; after a cut, everyone gets the plan's
+        if not s1.converged:
+            winners = np.broadcast_to(a1.holders(fires.size), s1.winners.shape)
+        sense = self._sense_auction(graph, fresh, a1, winners)
+        items = np.arange(graph.n_tasks)
+        s2 = run_auction("sense", sense, items, comm, max_rounds=self.max_rounds, clock=clock)
+        a2 = assemble(s2, sense, clock)
         routes: dict[int, list[int]] = {}
         service: dict[int, str] = {}
-        objective = 0.0
-        conflicts = 0
-        for stage in (s1, s2):
-            keep, n_conf, gained = resolve_conflicts(stage)
-            conflicts += n_conf
-            objective += gained
-            for i, path in enumerate(stage.paths):
-                kept = [stage.items[j] for j in path if keep.get(j) == i]
-                if kept:
-                    routes[i] = [int(k) for k in kept]
+        for stage, asm in ((s1, a1), (s2, a2)):
+            for i, path in enumerate(asm.paths):
+                if path:
+                    routes[i] = [int(stage.items[j]) for j in path]
                     service[i] = stage.name
         return CBBAResult(
             routes=routes,
             service=service,
+            auctions=(dump, sense),
             stages=(s1, s2),
+            assemblies=(a1, a2),
             comm=comm,
-            objective=float(objective),
-            conflicts_resolved=conflicts,
+            objective=a1.objective + a2.objective,
+        )
+
+    def _common(self, graph: TaskGraph) -> dict[str, Any]:
+        """The fields every auction on ``graph`` shares (see :class:`Auction`)."""
+        return {
+            "start": graph.agent_start_pos,
+            "home": graph.agent_home,
+            "budget": graph.agent_budget_px,
+            "speed": graph.agent_speed,
+            "rate": math.log(2.0) / self.half_life_s,
+        }
+
+    def _dump_auction(self, graph: TaskGraph, fresh: np.ndarray) -> Auction:
+        """Action / hybrid agents with water bid on the fire tasks."""
+        a, fires = graph.n_agents, graph.fire_tasks
+        forced = graph.agent_mode == Mode.RETURNING
+        free = graph.agent_mode != Mode.HOMING
+        tank = np.where(forced, graph.agent_tank_capacity, graph.agent_tank)
+        dumpers = free & graph.agent_can_act & (tank > 0)
+        value = np.broadcast_to(graph.task_value[fires] * fresh[fires], (a, fires.size))
+        return Auction(
+            value=np.ascontiguousarray(value),
+            eligible=dumpers[:, None] & graph.in_round_trip[:, fires] & (value > 0),
+            exclusive=np.zeros(fires.size, dtype=bool),
+            limit=np.minimum(tank, self.bundle_length),
+            item_pos=graph.task_pos[fires],
+            d_start=graph.start_task_distance[:, fires],
+            d_home=graph.task_home_distance[:, fires],
+            **self._common(graph),
+        )
+
+    def _sense_auction(
+        self, graph: TaskGraph, fresh: np.ndarray, dumps: Assembly, winners: np.ndarray
+    ) -> Auction:
+        """Camera agents without a dump bid on watching a fire or covering a search block."""
+        a, fires = graph.n_agents, graph.fire_tasks
+        has_dump = np.array([bool(p) for p in dumps.paths], dtype=bool)
+        free = graph.agent_mode != Mode.HOMING
+        sensors = free & graph.agent_can_sense & ~has_dump
+        is_fire = graph.task_kind == TaskKind.FIRE
+        value = np.broadcast_to(np.where(is_fire, 0.0, graph.task_value), (a, graph.n_tasks)).copy()
+        if fires.size and a:
+            near = graph.start_task_distance[:, fires]  # px from each agent's start to each fire
+            if (winners == winners[0]).all():  # everyone agrees (a connected team): one row
+                winners = winners[:1]
+            value[:, fires] = self._watch_values(graph, winners, near, fresh[fires])
+        return Auction(
+            value=value,
+            eligible=sensors[:, None] & graph.in_round_trip & (value > 0),
+            exclusive=is_fire,
+            limit=np.full(a, self.bundle_length),
+            item_pos=graph.task_pos,
+            d_start=graph.start_task_distance,
+            d_home=graph.task_home_distance,
+            **self._common(graph),
         )
 
     def _watch_values(
@@ -360,3 +416,41 @@ class CBBAScheduler:
         top = float(graph.task_value[search].max()) if search.size else 0.0
         w = self.watch_weight
         return np.where(lead, w * (top + val), np.where(fought, w * val, w * val * (1.0 - fresh)))
+
+
+def _dump_share(graph: TaskGraph, dump: Auction) -> float:
+    """Share of the wall limit for the dump auction: its bidder-item pairs against the camera
+    agents' (all tasks), between 0.2 and 0.8."""
+    w_dump = float(dump.eligible.sum())
+    w_sense = float((graph.agent_can_sense[:, None] & graph.in_round_trip).sum())
+    if w_dump + w_sense == 0:
+        return 1.0
+    return min(max(w_dump / (w_dump + w_sense), 0.2), 0.8)
+
+
+def _stats(graph: TaskGraph, res: CBBAResult) -> SolveStats:
+    """The plan's :class:`SolveStats` (see the module docstring)."""
+    comm = res.comm
+    stop = res.stopped_by
+    size = {
+        "agents": graph.n_agents,
+        "tasks": graph.n_tasks,
+        "rounds": res.rounds,
+        "messages": res.messages,
+        "last_change": res.last_change,
+        "converged": res.converged,
+        "stopped_by": stop,
+        "completed": res.completed,
+        "components": comm.n_components,
+        "diameter": comm.diameter,
+        "conflicts_resolved": res.conflicts_resolved,
+    }
+    words = {"converged": "converged", "max_rounds": "stopped by max_rounds"}
+    message = (
+        f"{res.rounds} rounds, {res.messages} messages, {comm.n_components} component(s), "
+        + words.get(stop, "stopped by the time limit")
+        + (f", {res.conflicts_resolved} conflicts resolved" if res.conflicts_resolved else "")
+        + (f", {res.completed} agent(s) completed greedily" if res.completed else "")
+    )
+    status = {"converged": "heuristic", "max_rounds": "feasible"}.get(stop, "time_limit")
+    return SolveStats(status=status, objective=res.objective, size=size, message=message)

@@ -1,6 +1,7 @@
-"""
-Each replan builds and solves (with OR-Tools' routing library, ``pywrapcp.RoutingModel``) up to two
-models, first the **action** model, then the **perception** model:
+"""Routing schedulers (``routing``, ``routing-pyvrp``) and the routing core they share.
+
+Each replan builds and solves up to two models, first the **action** model, then the
+**perception** model:
 
 * **Vehicles** are the available agents of the role (not ``HOMING``). A vehicle starts where the
   agent is, or at its depot slot with a full battery if the agent is on a forced return (it
@@ -11,15 +12,16 @@ models, first the **action** model, then the **perception** model:
   vehicles (fires only, no altitude is set for them, as in ``greedy``); hybrids with an empty
   tank are perception vehicles.
 * **Visits are optional** (prize collecting): leaving task ``k`` unvisited costs a drop penalty
-  equal to its value converted to pixels (below). Each task is visited at most once per model.
+  equal to its value converted to pixels. Each task is visited at most once per model.
 
-Each model is a prize-collecting vehicle routing problem on plain arrays
-(:func:`~solvers.routing.model.solve_routes`): travel plus the drop penalties of the tasks left
-out is minimised, within each vehicle's battery and visit limits.
-
-Modules: :mod:`~solvers.routing.model` (the model on plain arrays and its solution),
-:mod:`~solvers.routing.search` (how OR-Tools searches it), :mod:`~solvers.routing.scheduler`
-(:class:`RoutingScheduler`: task values, candidate nodes, time split and the plan).
+Each model is a prize-collecting vehicle routing problem on a distance matrix,
+:func:`solve_routes` (the **core**, :mod:`solvers.routing.core`): travel plus the prizes of the
+tasks left out is minimised, within each vehicle's battery and visit limits. Two backends search
+it: OR-Tools (:mod:`~solvers.routing.ortools_backend`, the ``routing`` scheduler) and PyVRP
+(:mod:`~solvers.routing.pyvrp_backend`, the ``routing-pyvrp`` scheduler). The scheduler
+(:mod:`~solvers.routing.scheduler`) turns the task graph into the models (task values, candidate
+tasks, time split, warm start from its last plan) and the routes into a plan;
+:mod:`~solvers.routing.tsplib` reads TSPLIB instances to check the core against known optima.
 
 Examples
 --------
@@ -27,21 +29,34 @@ Examples
 >>> from fcplan.taskgraph import synthetic_task_graph
 >>> g = synthetic_task_graph(4, 20, np.random.default_rng(0))
 >>> plan = RoutingScheduler(deterministic=True).plan(g, time_limit=None, rng=None)
->>> plan.stats.status in ("feasible", "time_limit"), plan.stats.size["vehicles"]
-(True, 4)
+>>> plan.stats.status, plan.stats.size["vehicles"]
+('feasible', 4)
+>>> plan = PyVRPRoutingScheduler(deterministic=True).plan(g, time_limit=None, rng=None)
+>>> plan.stats.status, plan.stats.size["vehicles"]
+('feasible', 4)
 
-:func:`solve_routes` is the model on plain arrays (one vehicle from (0, 0) to its depot slot at
-(0, 10), two mandatory stops):
+The core on a plain distance matrix (a 4-city tour from city 0, every city required):
 
->>> sol = solve_routes(
-...     start=np.array([[0.0, 0.0]]), end=np.array([[0.0, 10.0]]),
-...     nodes=np.array([[10.0, 10.0], [10.0, 0.0]]), penalty=np.full(2, np.inf),
-...     budget=np.array([100.0]), charge_return=True, deterministic=True)
->>> sol.routes, round(sol.travel_px, 3)
-(((1, 0),), 30.0)
+>>> xy = np.array([[0, 0], [0, 10], [10, 10], [10, 0]], dtype=float)
+>>> dist = np.linalg.norm(xy[:, None] - xy[None], axis=2)
+>>> res = solve_routes(dist, starts=[0], deterministic=True, backend="pyvrp")
+>>> res.objective, sorted(res.routes[0])
+(40.0, [1, 2, 3])
 """
 
-from solvers.routing.model import RouteSolution, RoutingFailedError, solve_routes
-from solvers.routing.scheduler import RoutingScheduler
+from solvers.routing.core import BACKENDS, RoutesResult, RoutingFailedError
+from solvers.routing.ortools_backend import OrToolsOptions
+from solvers.routing.pyvrp_backend import PyVRPOptions
+from solvers.routing.scheduler import PyVRPRoutingScheduler, RoutingScheduler
+from solvers.routing.solve import solve_routes
 
-__all__ = ["RoutingScheduler", "RouteSolution", "RoutingFailedError", "solve_routes"]
+__all__ = [
+    "BACKENDS",
+    "OrToolsOptions",
+    "PyVRPOptions",
+    "PyVRPRoutingScheduler",
+    "RoutesResult",
+    "RoutingFailedError",
+    "RoutingScheduler",
+    "solve_routes",
+]

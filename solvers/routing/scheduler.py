@@ -51,33 +51,49 @@ most valuable tasks that one of its ``V`` vehicles can reach (default 60, or 2 p
 teams); the others are not offered this replan. On big task graphs this is what keeps a replan
 within its time limit. Routes hold at most ``max_visits`` (4) tasks.
 
-**Search and time**: the search starts from ``first_solution`` (default
-``PARALLEL_CHEAPEST_INSERTION``, which weighs insertions against drop penalties) and improves it
-with ``metaheuristic`` (default ``GUIDED_LOCAL_SEARCH``):
+**Search and time**: each model is a :func:`solvers.routing.solve_routes` problem (locations:
+the ``V`` vehicles' starts, their depot slots, the candidate tasks) searched by ``backend``:
+``ortools`` (first solution ``first_solution``, default ``"auto"``: ``PARALLEL_CHEAPEST_INSERTION``
+on these prize-collecting models, then ``metaheuristic``, default guided local search) or ``pyvrp`` (iterated local search; the
+``routing-pyvrp`` scheduler is this class with ``backend="pyvrp"``).
 
 * default mode: until ``time_limit`` seconds per replan (default 0.1 s; the ``time_limit``
   argument of :meth:`RoutingScheduler.plan` overrides it when given), model building included
-  and about 10 % (at most 5 ms) kept back for turning routes into the plan. The action model gets
-  a share in proportion to its node count (25 % to 50 %), the perception model the rest. A
-  ``branch_limit`` (search steps, a machine-independent count) ends the search of small models
-  early so they do not spin until the limit. If the limit ends a model's search before any
-  solution, the first-solution heuristic is run alone past the limit (about a millisecond;
-  ``rescue=True``, status ``time_limit``, noted in the message) rather than failing. The plan
-  depends on the machine's speed in this mode: it is **not** reproducible run to run;
-* ``deterministic=True``: the search stops after ``solution_limit`` solutions or
-  ``branch_limit`` branches, whichever comes first, never on a wall time (also the LNS
-  sub-searches' own time limit is made unreachable), so the same graph gives the same plan run
-  to run and on any machine: use it for reproducible benchmarks (its time per replan then
-  depends on the model, not on a limit).
+  and ``min(10 %, 5 ms)`` of the limit kept back for turning routes into the plan. The action
+  model gets a share of the time in proportion to its node count (25 % to 50 %), the perception
+  model the rest; each backend sets its own limit from the time left once its model is built.
+  On a loaded machine every step takes longer than the clock checks expect (OR-Tools overshot a
+  30 ms limit by 60-80 % at p90 under a load of 12 on 2 cores): the scheduler tracks how many
+  times longer than asked its recent model calls took (``stretch``: starts at 1.5, rises at
+  once, decays by 10 % a call towards what it measures) and asks for that much less;
+  The plan depends on the machine's speed in this mode: it is **not** reproducible run to run;
+* ``deterministic=True``: the search stops on work limits only (OR-Tools: ``solution_limit``
+  solutions or ``branch_limit`` branches; PyVRP: ``iterations`` with seed ``seed``), never on
+  the clock, so the same graphs give the same plans run to run and on any machine.
 
-**Status**: routing never proves optimality. ``feasible``: a solution was found and the local
-search reached a local optimum (OR-Tools ``ROUTING_SUCCESS``; guided local search then goes on
-until the limit), or the deterministic limits stopped it; ``time_limit``: the wall-time limit
-stopped the search before the local search converged
-(``ROUTING_PARTIAL_SUCCESS_LOCAL_OPTIMUM_NOT_REACHED``) or the plan was rescued; the worse of the
-two models is reported. If a model finds no solution (only possible with ``rescue=False``),
-:class:`RoutingFailedError` is raised and :func:`fcplan.scheduling.solve` falls back to
-``greedy`` for that replan (``status="fallback"``, the reason in the message).
+**Warm start**: the scheduler keeps its last plan (per agent, the task ids of its route); its
+warm routes are the tasks of an agent's last route that are still candidates of its role, in
+order, cut to fit its tank, visits and battery. ``warm_start="fallback"`` (default) keeps them
+only as the answer when the clock ends a search before it found anything;
+``warm_start="search"`` also starts each search from them; ``"off"`` never uses them. The
+memory is dropped when the graph's time does not advance (a new episode) or the agents change.
+Starting the search from the last plan scored -11.5 [-19.2, -3.8] points against the previous
+scheduler, paired over scenarios 1-24 x seeds 0-2 (wall-clock mode on a loaded machine; see
+``bench/README.md``), so it is not the default.
+
+**Time limit**: a search cut by the clock is never handed back as a decision
+(:mod:`solvers.routing.core`): if it found nothing, the warm start is kept; unfinished routes
+are completed by cheapest insertion; with neither, :class:`~solvers.routing.RoutingFailedError`
+is raised and :func:`fcplan.scheduling.solve` falls back to ``greedy`` for that replan
+(``status="fallback"``, the reason in the message).
+
+**Status**: routing never proves optimality. ``feasible``: the work limits or a local optimum
+ended the search; ``time_limit``: the clock did (the worse of the two models is reported; the
+message says whether a warm start was kept or routes were completed).
+
+**Tours**: ``max_visits=0`` and ``max_nodes=0`` lift the caps on route length and candidate
+tasks, and ``charge_return=True`` charges the way home: the model is then a full prize-collecting
+VRP (with infinite prizes and one agent, a TSP).
 """
 
 from __future__ import annotations
@@ -91,14 +107,19 @@ from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
-from solvers.routing.model import RouteSolution, _pairwise, solve_routes
-from solvers.routing.search import FIRST_SOLUTIONS, METAHEURISTICS
+from solvers.routing.core import BACKENDS, RoutesResult
+from solvers.routing.ortools_backend import OrToolsOptions
+from solvers.routing.pyvrp_backend import PyVRPOptions
+from solvers.routing.solve import solve_routes
 
-__all__ = ["RoutingScheduler"]
+__all__ = ["WARM_STARTS", "PyVRPRoutingScheduler", "RoutingScheduler"]
+
+#: The ways the scheduler uses its last plan (``warm_start``).
+WARM_STARTS = ("fallback", "search", "off")
 
 
 class RoutingScheduler:
-    """Prize-collecting vehicle routing per role with OR-Tools (see the module docstring).
+    """Prize-collecting vehicle routing per role (see the module docstring).
 
     Parameters
     ----------
@@ -106,17 +127,21 @@ class RoutingScheduler:
         Default seconds per replan (both models together), used when :meth:`plan` gets
         ``time_limit=None``.
     deterministic : bool
-        Stop each model's search after ``solution_limit`` solutions instead of a wall time:
-        identical plans run to run.
-    solution_limit : int
-        Solutions per model in deterministic mode.
-    branch_limit : int, optional
-        Search branches per model (both modes; ends the search of small models early).
+        Stop each model's search on work limits, never on the clock: identical plans run to run.
+    backend : {"ortools", "pyvrp"}
+        Which solver searches the models.
+    solution_limit, branch_limit : int, optional
+        OR-Tools work limits per model: solutions (deterministic mode only) and search branches
+        (both modes; None: no such limit).
+    iterations : int
+        PyVRP iterations per model in deterministic mode.
+    seed : int
+        PyVRP's seed.
     max_visits : int
-        Most tasks per route.
+        Most tasks per route (0: no limit).
     max_nodes, nodes_per_vehicle : int
         Candidate tasks per role per replan: the ``max(max_nodes, nodes_per_vehicle * V)`` most
-        valuable reachable ones, ``V`` the role's vehicles.
+        valuable reachable ones, ``V`` the role's vehicles (``max_nodes=0``: all of them).
     fire_base_px : float
         Drop penalty (px) of any fire task for action agents, on top of the value term: action
         agents have nothing else to do, so every reachable fire is worth a trip this long.
@@ -140,13 +165,13 @@ class RoutingScheduler:
     charge_return : bool
         Count the way back to the depot slot in the objective (it always counts for the battery).
     first_solution, metaheuristic : str
-        OR-Tools ``FirstSolutionStrategy`` / ``LocalSearchMetaheuristic`` names.
+        OR-Tools ``FirstSolutionStrategy`` (or ``"auto"``, see
+        :mod:`solvers.routing.ortools_backend`) / ``LocalSearchMetaheuristic`` names.
     scale : float
-        Integer units per px in the model (10: decimetres).
-    rescue : bool
-        When the time limit ends a model's search before any solution, use the first-solution
-        heuristic's routes found just after the limit (status ``time_limit``, noted in the
-        message) rather than raising (and falling back to greedy).
+        Integer units per px in the models (10: decimetres).
+    warm_start : {"fallback", "search", "off"}
+        How the last plan's routes are used (see the module docstring); ``True`` / ``False``
+        mean ``"search"`` / ``"off"``.
     """
 
     name = "routing"
@@ -155,8 +180,11 @@ class RoutingScheduler:
         self,
         time_limit: float = 0.1,
         deterministic: bool = False,
+        backend: str = "ortools",
         solution_limit: int = 40,
         branch_limit: int | None = 2000,
+        iterations: int = 200,
+        seed: int = 0,
         max_visits: int = 4,
         max_nodes: int = 60,
         nodes_per_vehicle: int = 2,
@@ -170,24 +198,26 @@ class RoutingScheduler:
         search_altitude: float = 70.0,
         max_watch_fraction: float = 0.5,
         charge_return: bool = False,
-        first_solution: str = "PARALLEL_CHEAPEST_INSERTION",
+        first_solution: str = "auto",
         metaheuristic: str = "GUIDED_LOCAL_SEARCH",
         scale: float = 10.0,
-        rescue: bool = True,
+        warm_start: str | bool = "fallback",
     ) -> None:
-        for what, value, enum in (
-            ("first_solution", first_solution, FIRST_SOLUTIONS),
-            ("metaheuristic", metaheuristic, METAHEURISTICS),
-        ):
-            names = list(enum.keys())
-            if value not in names:
-                raise ValueError(f"unknown {what} {value!r}; one of {', '.join(names)}")
+        if isinstance(warm_start, bool):
+            warm_start = "search" if warm_start else "off"
+        if warm_start not in WARM_STARTS:
+            raise ValueError(f"unknown warm_start {warm_start!r}; one of {', '.join(WARM_STARTS)}")
+        if backend not in BACKENDS:
+            raise ValueError(f"unknown backend {backend!r}; one of {', '.join(BACKENDS)}")
         if not time_limit > 0:
             raise ValueError(f"time_limit must be > 0 s, got {time_limit!r}")
         self.time_limit = float(time_limit)
         self.deterministic = bool(deterministic)
+        self.backend = backend
         self.solution_limit = int(solution_limit)
         self.branch_limit = None if branch_limit is None else int(branch_limit)
+        self.iterations = int(iterations)
+        self.seed = int(seed)
         self.max_visits = int(max_visits)
         self.max_nodes = int(max_nodes)
         self.nodes_per_vehicle = int(nodes_per_vehicle)
@@ -204,7 +234,23 @@ class RoutingScheduler:
         self.first_solution = first_solution
         self.metaheuristic = metaheuristic
         self.scale = float(scale)
-        self.rescue = bool(rescue)
+        self.warm_start = warm_start
+        # the search settings, checked now (unknown OR-Tools names raise ValueError)
+        self._options: OrToolsOptions | PyVRPOptions = (
+            OrToolsOptions(
+                first_solution=first_solution, metaheuristic=metaheuristic,
+                solution_limit=self.solution_limit,
+                branch_limit=self.branch_limit if self.branch_limit is not None else 1 << 62,
+                wall_branch_limit=self.branch_limit, scale=self.scale,
+            )
+            if backend == "ortools"
+            else PyVRPOptions(iterations=self.iterations, seed=self.seed, scale=self.scale)
+        )  # fmt: skip
+        # how many times longer than asked a wall-clock model call took lately (>= 1)
+        # (starts cautious: the first replan of an episode has no warm start to fall back on)
+        self._stretch = 1.5
+        # the last plan: (graph time, agent ids, per agent the task ids of its route)
+        self._last: tuple[float, tuple[str, ...], dict[str, tuple[str, ...]]] | None = None
 
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
@@ -213,8 +259,8 @@ class RoutingScheduler:
         Raises
         ------
         RoutingFailedError
-            If a model finds no solution in time (:func:`fcplan.scheduling.solve` then falls
-            back to greedy).
+            If a model's search finds nothing in time and there is no warm start
+            (:func:`fcplan.scheduling.solve` then falls back to greedy).
         """
         limit = self.time_limit if time_limit is None else float(time_limit)
         # keep a little of the limit for turning routes into the plan and freeing the models
@@ -224,12 +270,17 @@ class RoutingScheduler:
         sensors = np.flatnonzero(
             free & graph.agent_can_sense & ~(graph.agent_can_act & (graph.agent_tank > 0))
         )
+        last = self._last
+        if last is not None and (last[0] >= graph.time_s or last[1] != graph.agent_ids):
+            last = None  # a new episode, or other agents: the last plan means nothing here
+        warm = last[2] if last is not None and self.warm_start != "off" else {}
         routes: dict[str, tuple[str, ...]] = {}
         alts: dict[str, float] = {}
-        sols: dict[str, RouteSolution] = {}
-        first_fires = self._route_actors(graph, actors, sensors, deadline, routes, sols)
+        sols: dict[str, RoutesResult] = {}
+        first_fires = self._route_actors(graph, actors, sensors, deadline, warm, routes, sols)
         if sensors.size:
-            self._route_sensors(graph, sensors, first_fires, deadline, routes, alts, sols)
+            self._route_sensors(graph, sensors, first_fires, deadline, warm, routes, alts, sols)
+        self._last = (graph.time_s, graph.agent_ids, dict(routes))
         return Plan(routes=routes, altitudes=alts, stats=_stats(graph, sols))
 
     def _route_actors(
@@ -238,8 +289,9 @@ class RoutingScheduler:
         actors: np.ndarray,
         sensors: np.ndarray,
         deadline: float,
+        warm: dict[str, tuple[str, ...]],
         routes: dict[str, tuple[str, ...]],
-        sols: dict[str, RouteSolution],
+        sols: dict[str, RoutesResult],
     ) -> list[int]:
         """Action agents -> fires (one visit per dump left in the tank); the routes go into
         ``routes``, the model's solution into ``sols``. Returns the first fire of each route."""
@@ -261,13 +313,12 @@ class RoutingScheduler:
         if actors.size and act_nodes[0].size:
             share = act_nodes[0].size / (act_nodes[0].size + n_sense)
             share = 1.0 if n_sense == 0 else min(max(share, 0.25), 0.5)
-            sol = self._solve(
-                graph, actors, act_nodes, deadline, share, capacity=graph.agent_tank[actors]
+            sol, rows = self._solve(
+                graph, actors, act_nodes, deadline, share, warm, capacity=graph.agent_tank[actors]
             )
             sols["action"] = sol
-            for v, route in enumerate(sol.routes):
-                if route:
-                    ks = act_nodes[0][list(route)]
+            for v, ks in enumerate(rows):
+                if ks.size:
                     routes[graph.agent_ids[actors[v]]] = tuple(graph.task_ids[k] for k in ks)
                     first_fires.append(int(ks[0]))
         return first_fires
@@ -278,9 +329,10 @@ class RoutingScheduler:
         sensors: np.ndarray,
         first_fires: list[int],
         deadline: float,
+        warm: dict[str, tuple[str, ...]],
         routes: dict[str, tuple[str, ...]],
         alts: dict[str, float],
-        sols: dict[str, RouteSolution],
+        sols: dict[str, RoutesResult],
     ) -> None:
         """Perception agents -> search blocks and fires to watch; the routes and altitudes go
         into ``routes`` and ``alts``, the model's solution into ``sols``."""
@@ -303,13 +355,12 @@ class RoutingScheduler:
         nodes = self._candidates(graph, sensors, tasks, value)
         if not nodes[0].size:
             return
-        sol = self._solve(graph, sensors, nodes, deadline, 1.0)
+        sol, rows = self._solve(graph, sensors, nodes, deadline, 1.0, warm)
         sols["perception"] = sol
-        for v, route in enumerate(sol.routes):
-            if not route:
+        for v, ks in enumerate(rows):
+            if not ks.size:
                 continue
             i = int(sensors[v])
-            ks = nodes[0][list(route)]
             if graph.task_kind[ks[0]] == TaskKind.FIRE:
                 ks, z = ks[:1], self.watch_altitude  # watch: hover over the fire
             else:
@@ -336,7 +387,9 @@ class RoutingScheduler:
         return out
 
     def _n_candidates(self, n_vehicles: int) -> int:
-        """Candidate nodes for a model with ``n_vehicles`` vehicles."""
+        """Candidate nodes for a model with ``n_vehicles`` vehicles (huge: no cap)."""
+        if self.max_nodes <= 0:
+            return 1 << 62
         return max(self.max_nodes, self.nodes_per_vehicle * n_vehicles)
 
     def _candidates(
@@ -365,52 +418,94 @@ class RoutingScheduler:
         nodes: tuple[np.ndarray, np.ndarray],
         deadline: float,
         share: float,
+        warm: dict[str, tuple[str, ...]],
         capacity: np.ndarray | None = None,
-    ) -> RouteSolution:
-        """Solve one role's model with ``share`` of the time left before ``deadline``."""
+    ) -> tuple[RoutesResult, list[np.ndarray]]:
+        """Solve one role's model with ``share`` of the time left before ``deadline``, from the
+        warm start's routes; returns the result and per agent its route as task rows."""
         tasks, penalty = nodes
-        left = max(deadline - time.perf_counter(), 0.0) * share
-        return solve_routes(
-            graph.agent_start_pos[agents],
-            graph.agent_home[agents],
-            graph.task_pos[tasks],
-            penalty,
-            graph.agent_budget_px[agents],
-            capacity=capacity,
-            allowed=graph.in_round_trip[np.ix_(agents, tasks)],
-            max_visits=self.max_visits,
+        n_v, m = agents.size, tasks.size
+        # locations: the V starts, the V depot slots, then the m candidate tasks
+        pos = np.concatenate([graph.agent_start_pos[agents], graph.agent_home[agents],
+                              graph.task_pos[tasks]])  # fmt: skip
+        allowed = np.ones((n_v, 2 * n_v + m), dtype=bool)
+        allowed[:, 2 * n_v :] = graph.in_round_trip[np.ix_(agents, tasks)]
+        caps = None
+        if self.max_visits > 0:
+            caps = np.full(n_v, self.max_visits, dtype=np.int64)
+        if capacity is not None:
+            caps = capacity if caps is None else np.minimum(caps, capacity)
+        warm_routes = None
+        if warm:
+            where = {graph.task_ids[k]: 2 * n_v + j for j, k in enumerate(tasks.tolist())}
+            warm_routes = [
+                [where[t] for t in warm.get(graph.agent_ids[i], ()) if t in where]
+                for i in agents.tolist()
+            ]
+        t0 = time.perf_counter()
+        ask = max(deadline - t0, 0.0) * share / self._stretch
+        res = solve_routes(
+            _pairwise(pos, pos),
+            starts=np.arange(n_v),
+            ends=n_v + np.arange(n_v),
+            prizes=np.r_[np.zeros(2 * n_v), penalty],
+            budgets=graph.agent_budget_px[agents],
+            capacities=caps,
+            allowed=allowed,
             charge_return=self.charge_return,
-            time_limit=max(left, 1e-6),
+            time_limit=ask,
             deterministic=self.deterministic,
-            solution_limit=self.solution_limit,
-            branch_limit=self.branch_limit,
-            first_solution=self.first_solution,
-            metaheuristic=self.metaheuristic,
-            scale=self.scale,
-            rescue=self.rescue,
+            warm_start=warm_routes,
+            search_from_warm=self.warm_start == "search",
+            backend=self.backend,
+            options=self._options,
         )
+        if not self.deterministic and ask > 1e-3:
+            # how much longer than asked the call took: rises at once, decays slowly
+            ratio = min(max((time.perf_counter() - t0) / ask, 1.0), 4.0)
+            self._stretch = max(ratio, 0.9 * self._stretch + 0.1 * ratio)
+        rows = [tasks[np.asarray(r, dtype=np.int64) - 2 * n_v] for r in res.routes]
+        return res, rows
 
 
-def _stats(graph: TaskGraph, sols: dict[str, RouteSolution]) -> SolveStats:
-    """The plan's stats from the models' solutions (the worse status of the two)."""
+def _stats(graph: TaskGraph, sols: dict[str, RoutesResult]) -> SolveStats:
+    """The plan's stats from the models' results (the worse status of the two)."""
     status = "time_limit" if any(s.status == "time_limit" for s in sols.values()) else "feasible"
     size = {
         "models": len(sols),
         "vehicles": sum(s.size["vehicles"] for s in sols.values()),
-        "nodes": sum(s.size["nodes"] for s in sols.values()),
-        "dimensions": sum(s.size["dimensions"] for s in sols.values()),
+        "nodes": sum(s.size["tasks"] for s in sols.values()),
         "agents": graph.n_agents,
         "tasks": graph.n_tasks,
     }
     message = "; ".join(
-        f"{role}: {s.size['vehicles']} vehicles x {s.size['nodes']} nodes, travel "
-        f"{s.travel_px:.0f} px, dropped {s.dropped_px:.0f} px, {s.status}"
-        + (" (rescued: first solution after the limit)" if s.rescued else "")
+        f"{role}: {s.backend}, {s.size['vehicles']} vehicles x {s.size['tasks']} nodes, travel "
+        f"{s.travel:.0f} px, dropped {s.dropped:.0f} px, {s.status}"
+        + (", from the warm start" if s.warm_started else "")
+        + (", warm start kept (nothing better in time)" if s.kept_warm_start else "")
+        + (", completed by insertion after the time-out" if s.repaired else "")
         for role, s in sols.items()
     )
     return SolveStats(
         status=status,
-        objective=float(sum(s.objective_px for s in sols.values())),
+        objective=float(sum(s.objective for s in sols.values())),
         size=size,
         message=message,
     )
+
+
+class PyVRPRoutingScheduler(RoutingScheduler):
+    """:class:`RoutingScheduler` searched by PyVRP (``backend="pyvrp"``), registered as
+    ``routing-pyvrp``; takes the same settings."""
+
+    name = "routing-pyvrp"
+
+    def __init__(self, **settings: Any) -> None:
+        settings.setdefault("backend", "pyvrp")
+        super().__init__(**settings)
+
+
+def _pairwise(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    d = a[:, None, :] - b[None, :, :]
+    out: np.ndarray = np.sqrt(np.einsum("ijk,ijk->ij", d, d))
+    return out

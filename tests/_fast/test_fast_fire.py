@@ -12,8 +12,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import fcplan.fire as fire_mod
-from fcplan._fast.fire import advance_whole, draw_ahead, ignite_cells, unique
-from fcplan.fire import BURNING, WIND_DIR_SD_RAD, WIND_SPEED_SD, Fire, wind_draws
+from fcplan._fast.fire import advance_whole, draw_ahead, draw_ahead_tables, ignite_cells, unique
+from fcplan.farsite import interp_ratio, ratio_tabulated, wind_from_tables
+from fcplan.fire import BURNING, WIND_DIR_SD_RAD, WIND_SPEED_SD, Fire, spread_rate_ratio, wind_draws
 from fcplan.scenario import load_scenario
 from fcplan.world import World
 from tests._fast.bits import bits
@@ -83,20 +84,28 @@ def _run_pair(a: Fire, b: Fire, ticks: int, prune_every: int, small_b: int | Non
 _SEED, _COORD = st.integers(0, 2**31 - 1), st.integers(0, 1199)
 _FRONTS = st.integers(1, 300)  # (over 256: C/R is not drawn ahead)
 # one region anywhere on the x axis (some fronts leave the map), pruned every few ticks
-_ONE_REGION_RUN = {"seed": _SEED, "fronts": _FRONTS, "cx": _COORD, "prune_every": st.integers(0, 7)}
+_WIND = st.sampled_from(["fresh", "tables"])
+_ONE_REGION_RUN = {
+    "seed": _SEED,
+    "fronts": _FRONTS,
+    "cx": _COORD,
+    "prune_every": st.integers(0, 7),
+    "wind": _WIND,
+}
 
 
 @settings(max_examples=25, deadline=None)
 @given(**_ONE_REGION_RUN)
-def test_draws_ahead_move_fronts_exactly_as_tick_by_tick_draws(seed, fronts, cx, prune_every):
-    """Drawing and precomputing 64 ticks ahead gives bit-identical fronts, cells and visits to
-    drawing every tick (also with more than 256 fronts, pruning and fronts leaving the map)."""
+def test_draws_ahead_move_fronts_exactly_as_tick_by_tick_draws(seed, fronts, cx, prune_every, wind):
+    """Drawing and precomputing 64 steps ahead gives bit-identical fronts, cells and visits to
+    drawing every step (also with more than 256 fronts, pruning, fronts leaving the map, and in
+    both wind models)."""
     regions = [region(center=(cx, 600), fronts=fronts, fuel=20, delay_s=0.5)]
-    ahead = Fire(regions, 1200, 10, np.random.default_rng(seed))
+    ahead = Fire(regions, 1200, 10, np.random.default_rng(seed), wind_model=wind)
     saved = fire_mod._PRE_TICKS
     fire_mod._PRE_TICKS = 1
     try:
-        per_tick = Fire(regions, 1200, 10, np.random.default_rng(seed))
+        per_tick = Fire(regions, 1200, 10, np.random.default_rng(seed), wind_model=wind)
     finally:
         fire_mod._PRE_TICKS = saved
     assert per_tick._pre_len == 1 and ahead._pre_len > 1
@@ -104,29 +113,56 @@ def test_draws_ahead_move_fronts_exactly_as_tick_by_tick_draws(seed, fronts, cx,
 
 
 @settings(max_examples=25, deadline=None)
-@given(seed=_SEED, cx=_COORD, cy=_COORD, fuel=st.integers(1, 30), prune_every=st.integers(0, 7))
-def test_edge_margin_shortcut_agrees_with_the_full_map_check(seed, cx, cy, fuel, prune_every):
+@given(
+    seed=_SEED,
+    cx=_COORD,
+    cy=_COORD,
+    fuel=st.integers(1, 30),
+    prune_every=st.integers(0, 7),
+    wind=_WIND,
+)
+def test_edge_margin_shortcut_agrees_with_the_full_map_check(seed, cx, cy, fuel, prune_every, wind):
     """Skipping the per-front map check while the burn box keeps ``_edge_margin`` from the edges
     changes nothing: fronts die at exactly the same ticks as with the check on every tick (also
     once fronts freeze and the whole-array step moves idle fronts by a zero spread)."""
     regions = [region(center=(cx, cy), fronts=15, fuel=fuel)]
-    fast = Fire(regions, 1200, 10, np.random.default_rng(seed))
-    full = Fire(regions, 1200, 10, np.random.default_rng(seed))
+    fast = Fire(regions, 1200, 10, np.random.default_rng(seed), wind_model=wind)
+    full = Fire(regions, 1200, 10, np.random.default_rng(seed), wind_model=wind)
     full._edge_margin = float("inf")  # never trust the box: check every front every tick
     _run_pair(fast, full, 200, prune_every)
 
 
 @settings(max_examples=25, deadline=None)
 @given(**_ONE_REGION_RUN)
-def test_small_fire_kernels_move_fronts_exactly_as_the_vector_rule(seed, fronts, cx, prune_every):
+def test_small_fire_kernels_move_fronts_exactly_as_the_vector_rule(
+    seed, fronts, cx, prune_every, wind
+):
     """With a few fresh cells per tick the fire ignites on Python ints (ignite_cells) and checks
     landings on lists; with ``_SMALL = 0`` every tick takes the numpy rule (``Fire._ignite``):
     fronts, cells, blocks, burn box and visits stay bit-identical (with pruning, freezing and
     fronts leaving the map)."""
     regions = [region(center=(cx, 600), fronts=fronts, fuel=20, delay_s=0.3)]
-    kernel = Fire(regions, 1200, 10, np.random.default_rng(seed))
-    rule = Fire(regions, 1200, 10, np.random.default_rng(seed))
+    kernel = Fire(regions, 1200, 10, np.random.default_rng(seed), wind_model=wind)
+    rule = Fire(regions, 1200, 10, np.random.default_rng(seed), wind_model=wind)
     _run_pair(kernel, rule, 120, prune_every, small_b=0)
+
+
+def _assert_rows_are_the_per_step_rule(seed, fill, per_step_wind, ratio_of, ticks, n):
+    """Rows of the (T, 2, n) and (T, n) buffers that ``fill(rng, z, sc, ratio)`` fills are bit
+    for bit ``T`` successive ``per_step_wind(rng)`` (and ``ratio_of`` their U), and the two
+    streams stay in step."""
+    z, sc = np.empty((ticks, 2, n)), np.empty((ticks, 2, n))
+    ratio = np.empty((ticks, n))
+    rng = np.random.default_rng(seed)
+    fill(rng, z, sc, ratio)
+    per_step = np.random.default_rng(seed)
+    for t in range(ticks):
+        u, sin_t, cos_t = per_step_wind(per_step)
+        assert bits(z[t, 0]) == bits(u)
+        assert bits(sc[t, 0]) == bits(sin_t)
+        assert bits(sc[t, 1]) == bits(cos_t)
+        assert bits(ratio[t]) == bits(ratio_of(u))
+    assert bits(rng.random(3)) == bits(per_step.random(3))
 
 
 @settings(max_examples=100, deadline=None)
@@ -136,20 +172,44 @@ def test_wind_drawn_ahead_is_the_per_tick_rule(seed, n, ticks):
     for bit what T successive calls of wind_draws (and the tabulated C/R of their U) give."""
     g = np.random.default_rng(seed + 1)
     wind, theta = g.uniform(0.0, 15.0, n), g.uniform(0.0, 2.0 * np.pi, n)
-    z, sc = np.empty((ticks, 2, n)), np.empty((ticks, 2, n))
-    ratio = np.empty((ticks, n))
-    rng = np.random.default_rng(seed)
-    draw_ahead(
-        rng, z, sc, ratio, wind, theta, WIND_SPEED_SD, WIND_DIR_SD_RAD, fire_mod._interp_ratio
+    sd = (WIND_SPEED_SD, WIND_DIR_SD_RAD)
+
+    def fill(rng, z, sc, ratio):
+        draw_ahead(rng, z, sc, ratio, wind, theta, *sd, interp_ratio)
+
+    _assert_rows_are_the_per_step_rule(
+        seed, fill, lambda rng: wind_draws(rng, wind, theta), interp_ratio, ticks, n
     )
-    per_tick = np.random.default_rng(seed)
-    for t in range(ticks):
-        u, sin_t, cos_t = wind_draws(per_tick, wind, theta)
-        assert bits(z[t, 0]) == bits(u)
-        assert bits(sc[t, 0]) == bits(sin_t)
-        assert bits(sc[t, 1]) == bits(cos_t)
-        assert bits(ratio[t]) == bits(fire_mod._interp_ratio(u))
-    assert bits(rng.random(3)) == bits(per_tick.random(3))  # the streams stay in step
+
+
+@settings(max_examples=100, deadline=None)
+@given(seed=_SEED, n=_FRONTS, ticks=st.integers(1, 70), regions=st.integers(1, 4))
+def test_wind_drawn_ahead_from_tables_is_the_per_step_rule(seed, n, ticks, regions):
+    """draw_ahead_tables fills T steps of U, sin(Theta), cos(Theta) and C/R that are, row by
+    row, bit for bit what T successive calls of wind_from_tables (and the exact C/R of each
+    table entry) give."""
+    g = np.random.default_rng(seed + 1)
+    length = int(g.integers(1, 1300))
+    fire_regions = [region(wind_speed=float(g.uniform(0, 15))) for _ in range(regions)]
+    fire = Fire(fire_regions, length, 10, np.random.default_rng(seed), wind_model="tables")
+    tables = fire.wind_tables
+    region_of = g.integers(0, regions, size=n)
+    base = region_of.astype(np.int64) * length
+    tab_u = np.ascontiguousarray(tables[:, 0]).reshape(-1)
+    theta = np.ascontiguousarray(tables[:, 1]).reshape(-1)
+    tab = (tab_u, np.sin(theta), np.cos(theta), spread_rate_ratio(tab_u))
+
+    def fill(rng, z, sc, ratio):
+        draw_ahead_tables(rng, z, sc, ratio, base, length, *tab)
+
+    _assert_rows_are_the_per_step_rule(
+        seed,
+        fill,
+        lambda rng: wind_from_tables(rng, tables, region_of),
+        spread_rate_ratio,
+        ticks,
+        n,
+    )
 
 
 @settings(max_examples=50, deadline=None)
@@ -160,9 +220,10 @@ def test_wind_drawn_ahead_is_the_per_tick_rule(seed, n, ticks):
     ticks=st.integers(1, 80),
     freeze_every=st.integers(0, 4),
     delayed=st.booleans(),
+    wind=_WIND,
 )
 def test_whole_array_step_is_the_rule_on_the_moving_fronts(
-    seed, fronts, cx, ticks, freeze_every, delayed
+    seed, fronts, cx, ticks, freeze_every, delayed, wind
 ):
     """Where Fire.step takes it (every front moves, or C/R of every front was drawn ahead),
     advance_whole moves the moving fronts to the positions of ``Fire._advance_moving`` bit for
@@ -170,7 +231,9 @@ def test_whole_array_step_is_the_rule_on_the_moving_fronts(
     regions = [region(center=(cx, 600), fronts=fronts, fuel=20)]
     if delayed:  # fronts that do not move yet
         regions.append(region(center=(600, 300), fronts=3, fuel=5, delay_s=60))
-    fires = [Fire(regions, 1200, 10, np.random.default_rng(seed)) for _ in range(2)]
+    fires = [
+        Fire(regions, 1200, 10, np.random.default_rng(seed), wind_model=wind) for _ in range(2)
+    ]
     for fire in fires:
         for _ in range(ticks):
             fire.step()
@@ -183,7 +246,7 @@ def test_whole_array_step_is_the_rule_on_the_moving_fronts(
     if idx.size == 0 or not (kernel._all_moving or pre_ratio is not None):
         return
     before = kernel._xy.copy()
-    ratio = fire_mod._ratio(kernel._pre_u[t]) if pre_ratio is None else pre_ratio[t]
+    ratio = ratio_tabulated(kernel._pre_u[t]) if pre_ratio is None else pre_ratio[t]
     xy = advance_whole(kernel, t, ratio, kernel._all_moving)
     moved = rule._advance_moving(idx, t)
     assert xy is kernel._xy

@@ -330,7 +330,7 @@ def test_hybrid_action_table():
 def test_small_team_python_path_equals_numpy_path(monkeypatch):
     """Agent vectors and action masks are identical whether built by the small-team Python loop
     or by the numpy code used for large teams."""
-    import fcplan.env.motion as motion
+    import fcplan.env.motion_obs as motion_obs
 
     env = MotionEnv(_short("open_world_example", 20.0))
     obs, _ = env.reset(seed=2)
@@ -338,10 +338,10 @@ def test_small_team_python_path_equals_numpy_path(monkeypatch):
     while env.agents:
         obs, *_ = env.step(_legal_random(env, obs, rng))
         if env.world.tick % 25 == 0:
-            vec, mask, cx, cy = env._agent_arrays()
-            monkeypatch.setattr(motion, "_PY_AGENTS", 0)
-            vec_np, mask_np, cx_np, cy_np = env._agent_arrays()
-            monkeypatch.setattr(motion, "_PY_AGENTS", 16)
+            vec, mask, cx, cy = env.observations.agent_arrays()
+            monkeypatch.setattr(motion_obs, "_PY_AGENTS", 0)
+            vec_np, mask_np, cx_np, cy_np = env.observations.agent_arrays()
+            monkeypatch.setattr(motion_obs, "_PY_AGENTS", 16)
             assert len(mask) == len(mask_np) == len(env.possible_agents)
             for m, m_np in zip(mask, mask_np, strict=True):
                 assert m.dtype == m_np.dtype == np.int8

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from fcplan.experiments.backends import select_backend
 
 
@@ -35,3 +37,20 @@ def test_substitute_player_runs_on_every_backend():
         _, outcomes = select_backend(specs, jobs, play=_square)
         got = {spec.key: (result, lost) for spec, result, lost in outcomes}
         assert got == {str(k): (k * k, None) for k in range(4)}
+
+
+@pytest.mark.parametrize("method", ["fork", "forkserver", "spawn"])
+def test_workers_that_die_with_their_parent_run_under_every_start_method(method):
+    """init_worker's parent watch (the sweep's pid, and the process that forked the worker,
+    which is a fork server under 'forkserver') does not end healthy workers."""
+    import multiprocessing as mp
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+
+    from fcplan.experiments.workers import init_worker
+
+    ctx = mp.get_context(method)
+    with ProcessPoolExecutor(
+        2, mp_context=ctx, initializer=init_worker, initargs=({}, os.getpid())
+    ) as ex:
+        assert list(ex.map(abs, [-1, -2, -3])) == [1, 2, 3]

@@ -192,7 +192,7 @@ def test_failing_episode_is_recorded_and_others_complete(monkeypatch):
     real = compare_mod.run_episode
 
     def flaky(scenario, scheduler, *, seed, **kw):
-        if scheduler == "idle" and seed == 1:
+        if scheduler.name == "idle" and seed == 1:
             raise ValueError("boom\nsecond line")
         return real(scenario, scheduler, seed=seed, **kw)
 
@@ -272,8 +272,8 @@ def test_csv_round_trip(base, tmp_path):
     assert len(rows) == len(table) and list(rows[0]) == list(table[0])
     for got, want in zip(rows, table, strict=True):
         for k, v in want.items():
-            if isinstance(v, str):
-                assert got[k] == v
+            if isinstance(v, (str, bool)) or v is None:
+                assert got[k] == ("" if v is None else str(v))
             else:
                 assert float(got[k]) == pytest.approx(v, rel=1e-12, nan_ok=True), k
 
@@ -300,3 +300,56 @@ def test_scheduler_specs_are_compared_as_separate_rows():
     rows = {r["scheduler"]: r for r in res.table()}
     assert set(rows) == {"greedy", "greedy:route_length=1"}
     assert all(r["episodes"] == 1 and r["errors"] == 0 for r in rows.values())
+
+
+# ---- deterministic mode ---------------------------------------------------------------------
+
+
+def test_jobs_do_not_change_the_tables_in_the_deterministic_mode():
+    """The same comparison with --jobs 1 and --jobs 2 gives identical tables (every column but
+    the timing ones) and episodes for greedy, routing (deterministic mode by default), idle and
+    random; every row records the mode."""
+    scen = [short(3, 8), short(12, 8)]
+    names = ["greedy", "routing", "idle", "random"]
+    serial = compare(scen, names, [0, 1], jobs=1)
+    pooled = compare(scen, names, [0, 1], jobs=2)
+    for a, b in zip(_scores(serial.table()), _scores(pooled.table()), strict=True):
+        _same(a, b)
+    for a, b in zip(_scores(serial.episodes), _scores(pooled.episodes), strict=True):
+        _same(a, b)
+    assert all(r["deterministic"] is True for r in serial.table())
+    assert serial.settings["deterministic"] is True
+    assert " det " in serial.format().splitlines()[2] + " "
+
+
+def test_the_wall_time_mode_is_explicit_and_recorded():
+    """deterministic=False (--wall-time) leaves routing's wall-clock limit on, and a spec's own
+    deterministic=false wins over the default; both show as 'wall' in the table."""
+    scen = [short(3, 3)]
+    wall = compare(scen, ["routing", "greedy"], [0], jobs=1, deterministic=False)
+    rows = {r["scheduler"]: r for r in wall.table()}
+    assert rows["routing"]["deterministic"] is False and rows["greedy"]["deterministic"] is True
+    assert wall.settings["deterministic"] is False
+    spec = compare(scen, ["routing:deterministic=false"], [0], jobs=1)
+    assert spec.table()[0]["deterministic"] is False
+    assert "wall" in spec.format()
+
+
+def test_episodes_that_mostly_fell_back_are_flagged(monkeypatch):
+    """An episode whose scheduler fell back on more than half of its replans carries
+    fallback_majority; the table counts them and the text warns under the table."""
+
+    class Broken:
+        name = "broken-test"
+
+        def plan(self, graph, *, time_limit=None, rng=None):
+            raise RuntimeError("always")
+
+    monkeypatch.setitem(scheduling._RUNTIME, "broken-test", Broken)
+    res = compare([short(3, 5)], ["greedy", "broken-test"], [0], jobs=1)
+    rows = {r["scheduler"]: r for r in res.table()}
+    assert (
+        rows["broken-test"]["fallback_majority"] == 1 and rows["greedy"]["fallback_majority"] == 0
+    )
+    assert res.episodes[1]["fallback_majority"] is True
+    assert "broken-test: 1 of 1 episode(s) fell back to greedy" in res.format()

@@ -49,7 +49,7 @@ def test_toml_grid_expands_in_documented_order(tmp_path):
         ('scenarios = [1]\nschedulers = ["greedy"]\nseeds = 0\nreplan_period = -1\n', "> 0"),
         (
             'scenarios = [1]\nschedulers = ["greedy:bogus=1"]\nseeds = 0\n',
-            "schedulers\\[0\\]: scheduler 'greedy': bad settings",
+            "schedulers\\[0\\]: scheduler 'greedy': bad setting bogus=1",
         ),
         (
             'scenarios = [1]\nschedulers = ["greedy"]\nseeds = 0\n[overrides]\n"tem.x" = 1\n',

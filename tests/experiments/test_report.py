@@ -64,3 +64,28 @@ def test_unknown_metric_and_empty_folder_are_clear_errors(results, tmp_path, cap
     assert "not a numeric result column" in capsys.readouterr().err
     assert main(["report", str(tmp_path)]) == 2
     assert "no episodes stored" in capsys.readouterr().err
+
+
+def test_report_warns_about_episodes_that_mostly_fell_back(tmp_path, monkeypatch):
+    """A scheduler that fell back on more than half of its replans gets a 'Fallback warning'
+    section naming it with its count; a report without such episodes has none."""
+    from fcplan import scheduling
+    from fcplan.experiments import report, sweep
+
+    class Broken:
+        name = "broken-report-test"
+
+        def plan(self, graph, *, time_limit=None, rng=None):
+            raise RuntimeError("always")
+
+    monkeypatch.setitem(scheduling._RUNTIME, "broken-report-test", Broken)
+    config = {
+        "scenarios": ["practice"],
+        "schedulers": ["greedy", "broken-report-test"],
+        "seeds": [0],
+        "overrides": {"duration_s": 4},
+    }
+    sweep(config, tmp_path, jobs=1, progress=False)
+    md = report(tmp_path, plots=False).markdown
+    assert "## Fallback warning" in md
+    assert "| broken-report-test | 1 | 1 |" in md and "| greedy | 1" not in md.split("Fallback")[1]

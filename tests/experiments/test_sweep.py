@@ -158,3 +158,29 @@ def test_progress_callback_and_summary(tmp_path):
     s = sweep(config, tmp_path, jobs=1, progress=lambda d, t, r: calls.append((d, t)))
     assert calls == [(1, 4), (2, 4), (3, 4), (4, 4)]
     assert "4 run now" in s.format() and s.backend == "serial"
+
+
+def test_sweeps_run_schedulers_in_their_deterministic_mode_by_default(tmp_path):
+    """A sweep adds deterministic=true to schedulers that support it (recorded in the settings
+    and deterministic columns); deterministic=False or a file's deterministic = false leaves it
+    out, and a variant's own setting always wins."""
+    config = {
+        "scenarios": ["practice"],
+        "schedulers": ["greedy", "routing", "routing:deterministic=false"],
+        "seeds": [0],
+        "overrides": {"duration_s": 3},
+    }
+    cfg = load_sweep_config(config)
+    settings = {v.label: v.settings for v in cfg.schedulers}
+    assert settings == {
+        "greedy": {},
+        "routing": {"deterministic": True},
+        "routing:deterministic=false": {"deterministic": False},
+    }
+    assert load_sweep_config({**config, "deterministic": False}).schedulers[1].settings == {}
+    assert load_sweep_config(config, deterministic=False).schedulers[1].settings == {}
+    s = sweep({**config, "schedulers": ["greedy", "routing"]}, tmp_path, jobs=1, progress=False)
+    df = s.load().set_index("scheduler")
+    assert df.loc["routing", "settings"] == '{"deterministic": true}'
+    assert bool(df.loc["routing", "deterministic"]) and bool(df.loc["greedy", "deterministic"])
+    assert not df["fallback_majority"].any()

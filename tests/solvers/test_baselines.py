@@ -129,3 +129,30 @@ def test_greedy_beats_idle_and_random_on_average():
     assert all(np.isfinite(v) for v in mean.values()), mean
     assert mean["greedy"] > mean["idle"], mean
     assert mean["greedy"] > mean["random"], mean
+
+
+@pytest.mark.parametrize("bad", [float("nan"), -0.1, 1.5, "half", True, None])
+def test_random_keep_probability_is_checked_at_construction(bad):
+    """keep_probability outside [0, 1], NaN or not a number is a SettingError naming it; the
+    ends 0 and 1 are accepted."""
+    from fcplan.scheduling import SettingError
+
+    with pytest.raises(SettingError, match="keep_probability"):
+        RandomScheduler(keep_probability=bad)
+    assert RandomScheduler(keep_probability=0).keep_probability == 0.0
+    assert RandomScheduler(keep_probability=1).keep_probability == 1.0
+
+
+def test_idle_takes_no_settings():
+    """idle refuses any setting with a one-line SettingError listing that it takes none."""
+    from fcplan.scheduling import SettingError
+
+    with pytest.raises(SettingError, match="idle takes: none"):
+        make_scheduler("idle:speed=2")
+
+
+def test_baselines_and_greedy_declare_they_do_not_depend_on_wall_time():
+    """greedy, idle and random have deterministic = True (no time-limited search), which the
+    comparison tables record."""
+    for name in BUILTINS:
+        assert make_scheduler(name).deterministic is True

@@ -277,3 +277,42 @@ def test_incremental_picks_equal_full_recomputation(seed, n_agents, n_tasks, spr
         g, agents, tasks, g.task_value, start, budget, limit, spread, sched.spread_px
     )
     assert fast == slow
+
+
+# ------------------------------------------------------------------ settings
+@pytest.mark.parametrize(
+    "setting, bad",
+    [
+        ("route_length", 0),
+        ("route_length", 1001),
+        ("route_length", 2.0),
+        ("route_length", True),
+        ("search_route_length", 0),
+        ("fresh_s", 0.0),
+        ("fresh_s", float("nan")),
+        ("watch_altitude", -5.0),
+        ("search_altitude", float("inf")),
+        ("max_watch_fraction", -0.1),
+        ("max_watch_fraction", float("nan")),
+        ("spread_px", "wide"),
+    ],
+)
+def test_meaningless_settings_are_refused_at_construction(setting, bad):
+    """Every setting is checked at construction: wrong types, NaN and values outside the
+    documented range (e.g. route_length=0, which used to score -108 silently) raise a
+    SettingError naming the setting."""
+    from fcplan.scheduling import SettingError
+
+    with pytest.raises(SettingError) as exc:
+        GreedyScheduler(**{setting: bad})
+    assert exc.value.setting == setting and "\n" not in str(exc.value)
+
+
+def test_settings_at_the_edges_of_their_ranges_are_accepted():
+    """The ends of each documented range are valid settings and give valid plans."""
+    g = synthetic_task_graph(6, 20, np.random.default_rng(3))
+    for kw in (
+        dict(route_length=1, search_route_length=1, max_watch_fraction=0.0, spread_px=0.0),
+        dict(route_length=1000, search_route_length=1000, max_watch_fraction=1.0),
+    ):
+        validate_plan(GreedyScheduler(**kw).plan(g, rng=None), g)

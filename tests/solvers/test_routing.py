@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import itertools
 
 import numpy as np
 import pytest
@@ -16,15 +15,19 @@ from fcplan.plan import Plan, validate_plan
 from fcplan.scheduling import SolveStats, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph, TaskKind, synthetic_task_graph
 from fcplan.team import Mode
-from solvers.routing import RoutingFailedError, RoutingScheduler, solve_routes
+from solvers.routing import PyVRPRoutingScheduler, RoutingScheduler
 from tests.solvers.graphs import SCENARIOS, episode_graphs
 from tests.solvers.test_greedy import known_fire_graph
 
 #: replan ticks of the greedy episodes the real graphs come from (shared with test_greedy's cache)
 TICKS = (0, 100, 300, 600)
+#: two consecutive replans (one simulated second apart)
+CONSECUTIVE = (300, 310)
 
 #: fast settings for feasibility tests (feasibility does not depend on the search effort)
-FAST = {"deterministic": True, "solution_limit": 20, "branch_limit": 1000}
+FAST = {"deterministic": True, "solution_limit": 20, "branch_limit": 1000, "iterations": 50}
+
+BACKENDS = ["ortools", "pyvrp"]
 
 
 def check_routing_plan(g: TaskGraph, plan: Plan, max_visits: int = 4) -> None:
@@ -67,7 +70,8 @@ def plan_of(g: TaskGraph, **settings_) -> Plan:
 
 
 # ---------------------------------------------------------------------------- feasibility
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@pytest.mark.parametrize("backend", BACKENDS)
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     seed=st.integers(0, 2**31 - 1),
     n_agents=st.integers(2, 6),
@@ -75,7 +79,7 @@ def plan_of(g: TaskGraph, **settings_) -> Plan:
     battery=st.sampled_from([40.0, 120.0, 500.0]),
     data=st.data(),
 )
-def test_routes_are_feasible_on_random_graphs(seed, n_agents, n_tasks, battery, data):
+def test_routes_are_feasible_on_random_graphs(backend, seed, n_agents, n_tasks, battery, data):
     """On random synthetic graphs (up to 6 agents x 30 tasks, any mix of modes, small tanks and
     batteries), the plan validates; action routes hold at most the tank's dumps and only fires;
     every route from the agent's start (its depot slot on a forced return) through its tasks and
@@ -88,15 +92,17 @@ def test_routes_are_feasible_on_random_graphs(seed, n_agents, n_tasks, battery, 
         agent_mode=np.array(modes, dtype=np.int8),
         agent_tank=np.where(g.agent_can_act, tanks, 0).astype(np.int64),
     )
-    check_routing_plan(g, plan_of(g, **FAST))
+    check_routing_plan(g, plan_of(g, backend=backend, **FAST))
 
 
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_routes_are_feasible_on_episode_graphs(name):
     """On graphs from every shipped scenario (and the open-world example with hybrids), the plan
-    validates and respects tanks, ranges and roles (see :func:`check_routing_plan`)."""
+    of either backend validates and respects tanks, ranges and roles (see
+    :func:`check_routing_plan`)."""
     for g in episode_graphs(name, TICKS):
-        check_routing_plan(g, plan_of(g, **FAST))
+        for backend in BACKENDS:
+            check_routing_plan(g, plan_of(g, backend=backend, **FAST))
 
 
 def test_hybrids_act_while_they_have_water_and_search_without():
@@ -154,149 +160,141 @@ def test_top_n_candidates_bound_the_model():
     assert plan.stats.size["vehicles"] == 6
 
 
-# ---------------------------------------------------------------------------- tour quality
-def brute_force_path(start, end, pts) -> float:
-    """Shortest open path start -> every point -> end, by enumerating all orders."""
-    n = len(pts)
-    perms = np.array(list(itertools.permutations(range(n))))
-    seq = pts[perms]  # (P, n, 2)
-    legs = np.linalg.norm(np.diff(seq, axis=1), axis=2).sum(axis=1)
-    legs += np.linalg.norm(seq[:, 0] - start, axis=1) + np.linalg.norm(seq[:, -1] - end, axis=1)
-    return float(legs.min())
-
-
-@pytest.mark.parametrize("n", range(4, 10))
-@pytest.mark.parametrize("seed", range(3))
-def test_single_vehicle_tour_is_within_2_percent_of_optimum(n, seed):
-    """One vehicle, ``n`` mandatory stops (4..9), open path from its start to its depot slot: the
-    routing model's tour is within 2 % of the brute-force optimum (deterministic mode)."""
-    rng = np.random.default_rng(100 * n + seed)
-    start, end = rng.uniform(0, 1000, (1, 2)), rng.uniform(0, 1000, (1, 2))
-    pts = rng.uniform(0, 1000, (n, 2))
-    sol = solve_routes(
-        start, end, pts, np.full(n, np.inf), np.array([1e6]),
-        charge_return=True, deterministic=True, solution_limit=2000, branch_limit=50_000,
-    )  # fmt: skip
-    assert sorted(sol.routes[0]) == list(range(n))
-    best = brute_force_path(start[0], end[0], pts)
-    assert sol.travel_px <= 1.02 * best + 1e-6
-    assert sol.objective_px == pytest.approx(sol.travel_px, abs=0.1 * (n + 1))
-
-
-def test_solve_routes_collects_prizes_within_budget_and_capacity():
-    """Prize collecting on plain arrays: a stop worth less than its detour is dropped, one worth
-    more is visited, a stop beyond the budget is never visited whatever its prize, and the
-    capacity caps the visits; the objective is travel plus dropped penalties."""
-    start = end = np.zeros((1, 2))
-    pts = np.array([[100.0, 0.0], [0.0, 300.0], [2000.0, 0.0], [100.0, 10.0], [110.0, 0.0]])
-    penalty = np.array([1e5, 10.0, 1e9, 1e5, 1e5])
-    sol = solve_routes(start, end, pts, penalty, np.array([1000.0]), deterministic=True)
-    assert set(sol.routes[0]) == {0, 3, 4}
-    assert sol.dropped_px == pytest.approx(10.0 + 1e9)
-    assert sol.objective_px == pytest.approx(sol.travel_px + sol.dropped_px, abs=1.0)
-    capped = solve_routes(
-        start, end, pts, penalty, np.array([1000.0]), capacity=np.array([2]), deterministic=True
-    )
-    assert len(capped.routes[0]) == 2
-    assert set(capped.routes[0]) <= {0, 3, 4}
-
-
-def test_solve_routes_respects_allowed_vehicles_and_empty_inputs():
-    """A node only one vehicle may serve goes to that vehicle; no nodes or no vehicles give
-    empty routes."""
-    start = end = np.array([[0.0, 0.0], [1000.0, 0.0]])
-    pts = np.array([[990.0, 0.0]])
-    allowed = np.array([[True], [False]])
-    sol = solve_routes(start, end, pts, np.array([1e6]), np.array([5000.0, 5000.0]),
-                       allowed=allowed, deterministic=True)  # fmt: skip
-    assert sol.routes == ((0,), ())
-    empty = solve_routes(start, end, np.zeros((0, 2)), np.zeros(0), np.array([1.0, 1.0]))
-    assert empty.routes == ((), ()) and empty.objective_px == 0.0
-
-
 # ---------------------------------------------------------------------------- reproducibility
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("name", [1, 9, 21, "open_world_example"])
-def test_deterministic_mode_gives_identical_plans(name):
+def test_deterministic_mode_gives_identical_plans(name, backend):
     """In deterministic mode the same graph gives the same routes, altitudes and objective."""
     for g in episode_graphs(name, TICKS):
-        a, b = plan_of(g, deterministic=True), plan_of(g, deterministic=True)
+        a, b = (plan_of(g, deterministic=True, backend=backend) for _ in range(2))
         assert dict(a.routes) == dict(b.routes)
         assert dict(a.altitudes) == dict(b.altitudes)
         assert a.stats.objective == b.stats.objective
 
 
-def test_deterministic_mode_on_a_synthetic_graph():
-    """Deterministic mode is reproducible on a 6 x 30 synthetic graph too."""
-    g = synthetic_task_graph(6, 30, np.random.default_rng(7))
-    a, b = plan_of(g, deterministic=True), plan_of(g, deterministic=True)
-    assert dict(a.routes) == dict(b.routes) and a.stats.objective == b.stats.objective
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_deterministic_episode_replans_are_identical(backend):
+    """Two schedulers replanning the same sequence of graphs in deterministic mode (each warm
+    started from its own last plan) make identical plans at every replan."""
+    graphs = episode_graphs(21, TICKS)
+    a, b = (RoutingScheduler(deterministic=True, backend=backend) for _ in range(2))
+    for g in graphs:
+        pa, pb = (s.plan(g, time_limit=None, rng=None) for s in (a, b))
+        assert dict(pa.routes) == dict(pb.routes) and pa.stats.objective == pb.stats.objective
 
 
+# ---------------------------------------------------------------------------- warm start
+def test_warm_start_from_the_last_plan_and_reset_on_a_new_episode():
+    """With ``warm_start="search"``, from the second replan on each model's search starts from
+    the scheduler's last plan (said in the message); a graph whose time does not advance (a new
+    episode) drops that memory; the default ``"fallback"`` and ``"off"`` never start from it."""
+    g0, g1 = episode_graphs(21, CONSECUTIVE)
+    sched = RoutingScheduler(warm_start="search", **FAST)
+    assert "warm start" not in sched.plan(g0, time_limit=None, rng=None).stats.message
+    assert "from the warm start" in sched.plan(g1, time_limit=None, rng=None).stats.message
+    assert "warm start" not in sched.plan(g0, time_limit=None, rng=None).stats.message
+    for mode in ("fallback", "off"):
+        cold = RoutingScheduler(warm_start=mode, **FAST)
+        for g in (g0, g1):
+            assert "warm start" not in cold.plan(g, time_limit=None, rng=None).stats.message
+    with pytest.raises(ValueError, match="warm_start"):
+        RoutingScheduler(warm_start="nope")
+
+
+# ---------------------------------------------------------------------------- time limit
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("name", [1, 12, 21, "open_world_example"])
-def test_one_millisecond_limit_never_crashes(name):
-    """With a 1 ms limit, :func:`fcplan.scheduling.solve` returns a valid plan: routing's own
-    (feasible or time_limit) or greedy's, recorded as a fallback with the reason."""
-    sched = make_scheduler("routing")
+def test_tiny_limits_still_make_the_team_act(name, backend):
+    """With a 1 microsecond or 1 millisecond limit, :func:`fcplan.scheduling.solve` returns a
+    valid plan that gives some agent a route whenever greedy would: routing's own (from its
+    warm start or complete routes) or greedy's, recorded as a fallback with the reason. An empty
+    plan never stands for a search cut by the clock."""
+    sched = make_scheduler("routing", backend=backend)
     graphs = list(episode_graphs(name, TICKS)) + [
         synthetic_task_graph(6, 30, np.random.default_rng(1))
     ]
-    for g in graphs:
-        plan = solve(sched, g, time_limit=0.001, rng=np.random.default_rng(0))
-        validate_plan(plan, g)
-        assert plan.stats.status in ("feasible", "time_limit", "fallback")
-        assert plan.stats.time_limit_s == 0.001
-        if plan.stats.status == "fallback":
-            assert plan.stats.message
+    for limit in (1e-6, 1e-3):
+        for g in graphs:
+            plan = solve(sched, g, time_limit=limit, rng=np.random.default_rng(0))
+            validate_plan(plan, g)
+            assert plan.stats.status in ("feasible", "time_limit", "fallback")
+            assert plan.stats.time_limit_s == limit
+            if plan.stats.status == "fallback":
+                assert "RoutingFailedError" in plan.stats.message
+            greedy = solve(make_scheduler("greedy"), g, time_limit=None, rng=None)
+            if greedy.routes:
+                assert plan.routes, f"{name} t={g.time_s}: nobody acts"
 
 
-def test_exhausted_limit_is_rescued_or_raises():
-    """When the wall-time limit ends the search before any solution, ``solve_routes`` returns
-    the first-solution heuristic's feasible routes flagged ``rescued`` with status
-    ``time_limit`` (default), or raises :class:`RoutingFailedError` with ``rescue=False``; the
-    scheduler's failure becomes a recorded greedy fallback in :func:`fcplan.scheduling.solve`."""
-    rng = np.random.default_rng(0)
-    start = rng.uniform(0, 1000, (3, 2))
-    pts = rng.uniform(0, 1000, (30, 2))
-    args = (start, start, pts, np.full(30, 500.0), np.full(3, 5000.0))
-    sol = solve_routes(*args, time_limit=1e-6, max_visits=4)
-    assert sol.rescued and sol.status == "time_limit"
-    assert all(len(r) <= 4 for r in sol.routes)
-    with pytest.raises(RoutingFailedError, match="no routing solution"):
-        solve_routes(*args, time_limit=1e-6, rescue=False)
-    g = known_fire_graph()
-    plan = solve(RoutingScheduler(rescue=False), g, time_limit=1e-6, rng=rng)
-    validate_plan(plan, g)
-    assert plan.stats.status == "fallback"
-    assert "RoutingFailedError" in plan.stats.message
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_time_out_keeps_the_warm_start_or_falls_back(backend):
+    """A replan with no time left and no earlier plan raises (greedy stands in, recorded); after
+    a plan, the same replan keeps that plan's routes (status ``time_limit``, said in the
+    message) instead of handing back an empty plan."""
+    g0, g1 = episode_graphs(21, CONSECUTIVE)
+    sched = RoutingScheduler(backend=backend)
+    plan = solve(sched, g1, time_limit=1e-9, rng=np.random.default_rng(0))
+    assert plan.stats.status == "fallback" and "RoutingFailedError" in plan.stats.message
+    sched = RoutingScheduler(backend=backend)
+    first = sched.plan(g0, time_limit=2.0, rng=None)  # (ample, even on a loaded machine)
+    kept = sched.plan(g1, time_limit=1e-9, rng=None)
+    validate_plan(kept, g1)
+    assert kept.stats.status == "time_limit" and "warm start kept" in kept.stats.message
+    assert kept.routes and set(kept.routes) <= set(first.routes) | set(g1.agent_ids)
 
 
 def test_registry_and_settings():
     """``make_scheduler("routing")`` builds the scheduler, passes settings, and rejects unknown
-    settings and OR-Tools strategy names."""
+    settings, backends and OR-Tools strategy names; ``PyVRPRoutingScheduler`` is the same
+    scheduler on PyVRP, named ``routing-pyvrp``."""
     s = make_scheduler("routing", time_limit=0.05, max_visits=3, deterministic=True)
     assert s.name == "routing" and s.time_limit == 0.05 and s.max_visits == 3 and s.deterministic
+    p = PyVRPRoutingScheduler(iterations=10)
+    assert p.name == "routing-pyvrp" and p.backend == "pyvrp" and p.iterations == 10
     with pytest.raises(FcplanError):
         make_scheduler("routing", no_such_setting=1)
+    with pytest.raises(ValueError, match="backend"):
+        RoutingScheduler(backend="nope")
     with pytest.raises(ValueError, match="first_solution"):
         RoutingScheduler(first_solution="NOPE")
     with pytest.raises(ValueError, match="metaheuristic"):
         RoutingScheduler(metaheuristic="NOPE")
 
 
-def test_stats_report_size_and_objective():
-    """The plan carries SolveStats with the model size and a finite objective in px."""
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_stats_report_size_and_objective(backend):
+    """The plan carries SolveStats with the model size, a finite objective in px and the
+    backend in its message."""
     g = known_fire_graph()
-    plan = plan_of(g, **FAST)
+    plan = plan_of(g, backend=backend, **FAST)
     s = plan.stats
     assert s.size["models"] == 2
     assert s.size["vehicles"] == g.n_agents
-    assert s.size["nodes"] > 0 and s.size["dimensions"] >= 2
+    assert s.size["nodes"] > 0
     assert np.isfinite(s.objective) and s.objective > 0
+    assert backend in s.message
 
 
-def test_episode_completes_and_prunes_fire():
-    """An episode of scenario #1 with the routing scheduler (20 ms per replan to keep the test
-    short) completes without fallbacks and puts fire out (OFS > 0)."""
-    r = fcplan.run_episode(1, "routing", seed=0, time_limit=0.02)
+def test_uncapped_settings_route_every_reachable_task():
+    """With ``max_visits=0`` and ``max_nodes=0`` routes and candidates are uncapped: a lone
+    perception agent (the other one is sent home) with a large battery and large prizes visits
+    every search block, in one route."""
+    g = synthetic_task_graph(2, 12, np.random.default_rng(5), battery=5000.0)
+    g = dataclasses.replace(
+        g, agent_can_sense=np.array([True, False]), agent_can_act=np.array([False, True]),
+        agent_mode=np.array([Mode.IDLE, Mode.HOMING], dtype=np.int8),
+        task_kind=np.full(12, TaskKind.SEARCH, np.int8), task_value=np.full(12, 1e4),
+    )  # fmt: skip
+    assert g.in_round_trip[0].all()
+    plan = plan_of(g, max_visits=0, max_nodes=0, charge_return=True, deterministic=True)
+    check_routing_plan(g, plan, max_visits=12)
+    assert sorted(plan.routes[g.agent_ids[0]]) == sorted(g.task_ids)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_episode_completes_and_prunes_fire(backend):
+    """An episode of scenario #1 with either backend (deterministic mode, small work limits)
+    completes without fallbacks and puts fire out (OFS > 0)."""
+    r = fcplan.run_episode(1, RoutingScheduler(backend=backend, **FAST), seed=0)
     assert r.fallbacks == 0
     assert r.metrics["manual"].overall_firefighting > 0

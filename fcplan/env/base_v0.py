@@ -1,0 +1,30 @@
+"""``base_v0``: the reference preset ``base`` as a versioned PettingZoo module.
+
+:class:`raw_env` is :class:`fcplan.env.presets.BaseEnv` (the documentation page:
+:mod:`fcplan.env.presets.base`) with ``metadata["name"] = "base_v0"``;
+``parallel_env(**kwargs)`` and ``env(**kwargs)`` (AEC) take its keyword arguments plus
+``obs_layout``, ``pad_actions`` and ``render_mode="human"`` (:mod:`fcplan.env.versions`).
+
+Examples
+--------
+>>> from fcplan.env import base_v0
+>>> env = base_v0.parallel_env(max_steps=4)
+>>> env.metadata["name"], env.possible_agents[0]
+('base_v0', 'perception_0')
+"""
+
+from __future__ import annotations
+
+from fcplan.env.presets import BaseEnv
+from fcplan.env.versions import versioned
+
+__all__ = ["env", "parallel_env", "raw_env"]
+
+
+class raw_env(BaseEnv):  # noqa: N801 (PettingZoo's name for the env class)
+    """:class:`fcplan.env.presets.BaseEnv`, named ``base_v0``."""
+
+    metadata = {**BaseEnv.metadata, "name": "base_v0"}
+
+
+env, parallel_env = versioned(raw_env)

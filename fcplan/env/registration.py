@@ -1,0 +1,60 @@
+"""Gymnasium ids of fcplan's single-agent views, registered when :mod:`fcplan.env` is imported.
+
+=========================  ==============================================  =====================
+id                         environment                                     default kwargs
+=========================  ==============================================  =====================
+``fcplan/Task-v0``         :class:`fcplan.env.gym_view.TaskGymEnv`: the    ``scenario="practice"``
+                           task level, joint ``MultiDiscrete`` action
+``fcplan/Motion-v0``       :class:`fcplan.env.joint_gym.JointGymEnv` on    ``scenario="practice"``
+                           :class:`fcplan.env.motion.MotionEnv`
+``fcplan/MotionBase-v0``   the ``base`` preset (:mod:`~fcplan.env.presets`) ``preset="base"``
+``fcplan/MotionCmplx1-v0`` the ``cmplx1`` preset                            ``preset="cmplx1"``
+``fcplan/MotionCmplx2-v0`` the ``cmplx2`` preset                            ``preset="cmplx2"``
+=========================  ==============================================  =====================
+
+Any keyword of the environment goes through ``gymnasium.make``: ``gymnasium.make("fcplan/Task-v0",
+scenario=24, k=8)``, ``gymnasium.make("fcplan/MotionBase-v0", reward="rf1")``. Every id accepts
+``render_mode="rgb_array"`` and ``render_mode="human"`` (:mod:`fcplan.env.human`).
+
+Gymnasium 1.x reads no plugin entry points: an id is known once :mod:`fcplan.env` is imported
+(``import fcplan.env`` or ``gymnasium.register_envs(fcplan.env)``), or through the module prefix
+of ``gymnasium.make``, which imports it: ``gymnasium.make("fcplan.env:fcplan/Task-v0")`` works
+after ``import gymnasium`` alone. A version number changes whenever a change of the env would
+change its observations, rewards or episodes for the same seed and actions.
+
+Examples
+--------
+>>> import gymnasium
+>>> import fcplan.env
+>>> env = gymnasium.make("fcplan/Task-v0", k=4, max_steps=2)
+>>> env.spec.id, env.unwrapped.action_space.nvec.tolist()
+('fcplan/Task-v0', [5, 5, 5, 5])
+>>> sorted(ENV_IDS)[:2]
+['fcplan/Motion-v0', 'fcplan/MotionBase-v0']
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["ENV_IDS", "register_envs"]
+
+_JOINT = "fcplan.env.joint_gym:JointGymEnv"
+
+#: Gymnasium id -> (entry point, default keyword arguments).
+ENV_IDS: dict[str, tuple[str, dict[str, Any]]] = {
+    "fcplan/Task-v0": ("fcplan.env.gym_view:TaskGymEnv", {"scenario": "practice"}),
+    "fcplan/Motion-v0": (_JOINT, {"scenario": "practice"}),
+    "fcplan/MotionBase-v0": (_JOINT, {"preset": "base"}),
+    "fcplan/MotionCmplx1-v0": (_JOINT, {"preset": "cmplx1"}),
+    "fcplan/MotionCmplx2-v0": (_JOINT, {"preset": "cmplx2"}),
+}
+
+
+def register_envs() -> None:
+    """Register every id of :data:`ENV_IDS` with Gymnasium (ids already there are kept)."""
+    import gymnasium
+
+    for env_id, (entry_point, kwargs) in ENV_IDS.items():
+        if env_id not in gymnasium.registry:
+            gymnasium.register(env_id, entry_point=entry_point, kwargs=dict(kwargs))

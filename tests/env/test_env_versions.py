@@ -1,0 +1,115 @@
+"""Versioned PettingZoo modules (task_v0, motion_v0, base_v0, cmplx1_v0, cmplx2_v0) and the
+layout options (obs_layout="flat", pad_actions=True)."""
+
+from __future__ import annotations
+
+import importlib
+import warnings
+
+import numpy as np
+import pytest
+from pettingzoo.test import api_test, parallel_api_test, parallel_seed_test
+
+from fcplan.env import EnvError, parallel_env
+from fcplan.env.motion import MotionEnv
+from fcplan.env.task import TaskEnv
+from tests.conftest import scenario_with
+
+MODULES = ["task_v0", "motion_v0", "base_v0", "cmplx1_v0", "cmplx2_v0"]
+
+
+def _kwargs(name: str) -> dict:
+    """Short episodes for every module."""
+    if name == "task_v0":
+        return {"scenario": 24, "k": 4, "max_steps": 8}
+    if name == "motion_v0":
+        return {"scenario": scenario_with("practice", duration_s=4.0)}
+    return {"max_steps": 60}
+
+
+@pytest.mark.parametrize("name", MODULES)
+def test_module_convention(name):
+    """Each module exports env, parallel_env and raw_env; metadata["name"] is the module's name;
+    parallel_env() without options is a raw_env."""
+    mod = importlib.import_module(f"fcplan.env.{name}")
+    assert sorted(mod.__all__) == ["env", "parallel_env", "raw_env"]
+    par = mod.parallel_env(**_kwargs(name))
+    assert type(par) is mod.raw_env and par.metadata["name"] == name
+    assert mod.env(**_kwargs(name)).metadata["name"] == name
+
+
+@pytest.mark.parametrize("name", MODULES)
+@pytest.mark.parametrize("options", [{}, {"obs_layout": "flat", "pad_actions": True}])
+def test_pettingzoo_checkers(name, options):
+    """parallel_api_test, api_test on env() and parallel_seed_test pass, with and without the
+    layout options."""
+    mod = importlib.import_module(f"fcplan.env.{name}")
+    kw = {**_kwargs(name), **options}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        parallel_api_test(mod.parallel_env(**kw), num_cycles=30)
+        api_test(mod.env(**kw), num_cycles=30)
+        parallel_seed_test(lambda: mod.parallel_env(**kw))
+
+
+def test_default_is_unchanged():
+    """Without options fcplan.env.parallel_env returns the env classes themselves."""
+    assert type(parallel_env(24, k=4)) is TaskEnv
+    assert type(parallel_env("practice", mode="motion")) is MotionEnv
+
+
+@pytest.mark.parametrize(
+    "mode, scenario, fields",
+    [("task", 24, ["agent", "tasks"]), ("motion", "practice", ["agent", "fov"]),
+     ("motion", "base", ["agent", "fov"])],
+)  # fmt: skip
+def test_flat_layout_is_the_dict_layout_flattened(mode, scenario, fields):
+    """obs_layout="flat" gives {"observation", "action_mask"}: observation is the dict
+    layout's fields (sorted keys) flattened and concatenated, inside its Box; the mask is the
+    same; rewards agree step by step."""
+    d = parallel_env(scenario, mode=mode)
+    f = parallel_env(scenario, mode=mode, obs_layout="flat")
+    od, _ = d.reset(seed=2)
+    of, _ = f.reset(seed=2)
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        for a in d.possible_agents:
+            want = np.concatenate([od[a][k].ravel() for k in fields]).astype(np.float32)
+            assert np.array_equal(of[a]["observation"], want)
+            assert np.array_equal(of[a]["action_mask"], od[a]["action_mask"])
+            assert f.observation_space(a).contains(of[a])
+        act = {a: int(rng.choice(np.flatnonzero(od[a]["action_mask"]))) for a in d.agents}
+        od, rd, *_ = d.step(act)
+        of, rf, *_ = f.step(act)
+        assert rd == rf
+
+
+@pytest.mark.parametrize("scenario", ["practice", "open_world_example", "cmplx2"])
+def test_padded_actions_are_masked_noops(scenario):
+    """pad_actions=True: one Discrete(n_max) for all agents, extra mask entries 0, and an
+    extra action does what leaving the agent out does (its no-op)."""
+    p = parallel_env(scenario, mode="motion", pad_actions=True)
+    q = parallel_env(scenario, mode="motion")
+    n = {a: int(q.action_space(a).n) for a in q.possible_agents}
+    n_max = max(n.values())
+    first = p.action_space(p.possible_agents[0])
+    assert all(p.action_space(a) is first for a in p.possible_agents)
+    assert int(p.action_space("P1" if "P1" in n else "perception_0").n) == n_max
+    op, _ = p.reset(seed=1)
+    oq, _ = q.reset(seed=1)
+    for a in p.possible_agents:
+        assert op[a]["action_mask"][n[a] :].sum() == 0
+    extra = {a: n_max - 1 for a in p.agents if n[a] < n_max}
+    assert extra
+    op, rp, *_ = p.step(extra)
+    oq, rq, *_ = q.step({})
+    assert rp == rq
+    for a in p.possible_agents:
+        assert np.array_equal(op[a]["fov"], oq[a]["fov"])
+        assert np.array_equal(op[a]["agent"], oq[a]["agent"])
+
+
+def test_unknown_layout_is_one_line_error():
+    """An unknown obs_layout is refused with a one-line error naming the allowed values."""
+    with pytest.raises(EnvError, match=r"obs_layout: must be one of dict, flat"):
+        parallel_env(24, obs_layout="nested")

@@ -1,0 +1,111 @@
+"""Mutated shipped scenarios (issue 17's audit): every file either fails to load with one line
+naming the problem, or loads and runs, within a time and a memory bound."""
+
+from __future__ import annotations
+
+import contextlib
+import random
+import signal
+import tracemalloc
+from collections.abc import Iterator
+
+import pytest
+from hypothesis import HealthCheck, given, note, settings
+from hypothesis import strategies as st
+
+from fcplan import run_episode
+from fcplan.errors import FcplanError
+from fcplan.scenario import load_scenario
+from fcplan.scenario.bounds import MEMORY_LIMIT_BYTES, estimate_bytes
+from tests.hardening.mutate import mutant, to_toml
+
+TIME_BOUND_S = 120
+MEMORY_BOUND = 2 * 2**30  # bytes traced (numpy included) while loading and running one mutant,
+# or the validator's own estimate for a scenario that loads, if larger (up to MEMORY_LIMIT_BYTES)
+RUN_S = 5.0  # simulated seconds played of a mutant that loads
+
+
+class HangError(Exception):
+    """A mutant took longer than the time bound."""
+
+
+@contextlib.contextmanager
+def bounded(seconds: int) -> Iterator[list[int]]:
+    """Raise HangError after ``seconds``; fail if the traced memory peaked above the bound (the
+    yielded one-item list, which the caller may raise to a loaded scenario's own estimate)."""
+
+    def stop(signum, frame):
+        raise HangError(f"over {seconds} s")
+
+    previous = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(seconds)
+    tracemalloc.start()
+    bound = [MEMORY_BOUND]
+    try:
+        yield bound
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+        _, peak = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        assert peak < bound[0], f"peak traced memory {peak / 2**20:.0f} MiB"
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
+@given(seed=st.integers(0, 2**32 - 1))
+def test_a_mutated_file_fails_in_one_line_or_runs(seed, tmp_path_factory):
+    """Load a mutated shipped scenario: either a one-line FcplanError (no other exception, no
+    traceback-worthy crash), or a valid scenario whose memory estimate is within the cap and
+    whose first seconds play to the end, all within the time and memory bounds."""
+    what, doc = mutant(random.Random(seed))
+    note(what)
+    path = tmp_path_factory.mktemp("mutant") / "mutant.toml"
+    path.write_text(to_toml(doc), encoding="utf-8")
+    with bounded(TIME_BOUND_S) as bound:
+        try:
+            s = load_scenario(path)
+        except FcplanError as exc:
+            assert "\n" not in str(exc)
+            return
+        assert estimate_bytes(s) <= MEMORY_LIMIT_BYTES
+        # a valid big map may use what validation estimated for it, and no more
+        bound[0] = max(MEMORY_BOUND, estimate_bytes(s))
+        short = s.replace(duration_s=min(s.duration_s, RUN_S))
+        res = run_episode(short, "greedy", seed=0)
+        assert res.ticks == short.n_ticks
+
+
+@pytest.mark.parametrize(
+    "path, value",
+    [
+        ("scoring.temporal_exponent", 1000),
+        ("fire.regions.0.half_width", 1e-300),
+        ("duration_s", 1e12),
+        ("world_size", 10_000_000),
+        ("fire.regions.0.fronts", 1_000_000_000),
+        ("ticks_per_second", 1_000_000),
+    ],
+)
+def test_the_audits_crashing_files_are_one_line_errors(path, value, tmp_path):
+    """The six files of the issue that validated and then crashed or ran out of memory are now
+    refused by load_scenario with one line naming the field."""
+    doc = load_scenario(12).to_dict()
+    node = doc
+    keys = path.split(".")
+    for k in keys[:-1]:
+        node = node[int(k)] if k.isdigit() else node[k]
+    node[keys[-1]] = value
+    f = tmp_path / "crash.toml"
+    f.write_text(to_toml(doc), encoding="utf-8")
+    with pytest.raises(FcplanError) as exc:
+        load_scenario(f)
+    msg = str(exc.value)
+    assert "\n" not in msg and keys[-1] in msg
+
+
+def test_deeply_nested_arrays_are_refused_before_the_parser_recurses(tmp_path):
+    """A file nesting arrays 100,000 deep (the audit's RecursionError) is a one-line error."""
+    f = tmp_path / "deep.toml"
+    f.write_text('name = "x"\nnotes = ' + "[" * 100_000 + "]" * 100_000 + "\n", encoding="utf-8")
+    with pytest.raises(FcplanError, match="nest more than 16 levels"):
+        load_scenario(f)

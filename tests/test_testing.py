@@ -1,0 +1,115 @@
+"""The scheduler conformance kit (:mod:`fcplan.testing`): it passes every built-in scheduler (the
+README's example: tests/test_readme.py) and catches the faults it promises to catch."""
+
+from __future__ import annotations
+
+import itertools
+from typing import Any
+
+import pytest
+
+from fcplan import Plan
+from fcplan.scheduling import make_scheduler
+from fcplan.testing import check_scheduler, episode_graphs
+
+#: a spread of shipped scenarios for the default suite (all of them: the slow test below)
+SUBSET = ("practice", "1", "12", "24", "open_world_example", "scale_example")
+BUILTIN = ("greedy", "idle", "random", "routing", "milp", "milp-cvxpy", "cbba", "oracle")
+#: settings that make a scheduler's plans independent of wall time and load
+DETERMINISTIC = {
+    "routing": {"deterministic": True},
+    # wall-clock solvers: a limit far above their solve times (ms) keeps the run load-proof
+    "milp": {"time_limit": 30.0},
+    "milp-cvxpy": {"time_limit": 30.0},
+}
+
+
+def _factory(name: str, **extra: Any):
+    settings = {**DETERMINISTIC.get(name, {}), **extra}
+    return lambda: make_scheduler(name, **settings)
+
+
+@pytest.mark.parametrize("name", BUILTIN)
+def test_builtin_schedulers_conform(name):
+    """Every built-in scheduler, in its deterministic mode, returns valid plans, the same plan
+    for the same seed, and leaves the graph unchanged, on graphs of several shipped scenarios."""
+    report = check_scheduler(_factory(name), scenarios=SUBSET, ticks=(0, 300), time_limit=None)
+    assert report.graphs == 2 * len(SUBSET) and report.failures == []
+
+
+@pytest.mark.slow  # a wall-clock check: meaningful on a quiet machine only, so not by default
+@pytest.mark.parametrize("name", ["greedy", "routing", "milp", "cbba"])
+def test_builtin_schedulers_respect_a_time_limit(name):
+    """In wall-clock mode each optimisation scheduler returns within its limit (+10 % +50 ms)."""
+    settings = {"deterministic": False} if name == "routing" else {}
+    report = check_scheduler(
+        _factory(name, **settings),
+        scenarios=("1", "24"),
+        ticks=(0, 300),
+        time_limit=0.2,
+        determinism_every=0,
+    )
+    assert report.failures == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", BUILTIN)
+def test_builtin_schedulers_conform_on_every_shipped_scenario(name):
+    """The same checks on every shipped scenario at three ticks of the episode."""
+    check_scheduler(_factory(name), time_limit=None)
+
+
+_CALLS = itertools.count()
+
+
+class _Faulty:
+    """A scheduler whose fault is chosen by ``kind``."""
+
+    name = "faulty"
+
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+        self.calls = 0
+
+    def plan(self, graph, *, time_limit=None, rng=None) -> Plan:
+        self.calls += 1
+        if self.kind == "invalid":
+            return Plan(routes={graph.agent_ids[0]: ("no-such-task",)})
+        if self.kind == "mutates":
+            graph.agent_pos[0, 0] += 1.0
+        if self.kind == "stateful":  # a process-wide counter: each call differs from the last
+            agent = graph.agent_ids[next(_CALLS) % graph.n_agents]
+            return Plan(routes={agent: ()})
+        return Plan()
+
+
+@pytest.mark.parametrize(
+    ("kind", "message"),
+    [
+        ("invalid", "invalid plan"),
+        ("mutates", "changed graph arrays"),
+        ("stateful", "deterministic"),
+    ],
+)
+def test_kit_reports_each_fault(kind, message):
+    """An invalid plan, a mutated graph and state shared between instances each fail the kit with a
+    line naming the scenario, the tick and the fault."""
+    report = check_scheduler(
+        lambda: _Faulty(kind),
+        scenarios=["1"],
+        ticks=(0, 100, 200, 300),
+        time_limit=None,
+        determinism_every=1,
+        raise_on_failure=False,
+    )
+    assert any(message in f and "scenario 1 tick" in f for f in report.failures), report.failures
+    with pytest.raises(AssertionError, match="conformance"):
+        check_scheduler(lambda: _Faulty(kind), scenarios=["1"], ticks=(0, 100, 200, 300),
+                        time_limit=None, determinism_every=1)  # fmt: skip
+
+
+def test_episode_graphs_are_taken_at_replan_ticks():
+    """Graphs come from the greedy episode's replans: ticks round up to the next replan, the
+    episode's end drops the rest."""
+    graphs = episode_graphs("practice", (0, 5, 10, 10**6))
+    assert [g.tick for g in graphs] == [0, 10]
