@@ -40,7 +40,7 @@ Examples
 >>> MilpScheduler(slots=0)
 Traceback (most recent call last):
 ...
-ValueError: slots must be an integer in 1..4, got 0
+fcplan.scheduling.SettingError: bad setting slots=0: must be an integer in 1..4
 """
 
 from __future__ import annotations

@@ -18,17 +18,24 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import fields
 from typing import Any
 
 import numpy as np
 
 from fcplan.plan import Plan
-from fcplan.scheduling import SolveStats
+from fcplan.scheduling import (
+    SettingError,
+    SolveStats,
+    bool_setting,
+    float_setting,
+    int_setting,
+)
 from fcplan.taskgraph import TaskGraph
 from solvers.milp_model.build import build_milp_model
 from solvers.milp_model.decode import decode_plan
 from solvers.milp_model.start import idle_agents, initial_solution
-from solvers.milp_model.types import MilpModel, MilpParams, check_setting
+from solvers.milp_model.types import MilpModel, MilpParams
 
 __all__ = ["MilpSchedulerBase", "SolverLimits", "IncompletePlanError"]
 
@@ -88,22 +95,20 @@ class MilpSchedulerBase:
         seed: int = 0,
         **model_settings: Any,
     ) -> None:
-        if not isinstance(deterministic, bool | np.bool_):
-            raise ValueError(f"deterministic must be true or false, got {deterministic!r}")
-        check_setting("time_limit", time_limit, float, 1e-9)
+        self.deterministic = bool_setting("deterministic", deterministic)
+        self.time_limit = float_setting("time_limit", time_limit, 0.0, lo_open=True, unit=" s")
         work = self.default_work_limit if work_limit is None else work_limit
-        check_setting(
-            "work_limit", work, self.work_limit_kind, 1e-9 if self.work_limit_kind is float else 1
-        )
-        check_setting("seed", seed, int, 0, 2**31 - 1)
-        self.deterministic = bool(deterministic)
-        self.time_limit = float(time_limit)
-        self.work_limit = work
-        self.seed = int(seed)
-        try:
-            self.params = MilpParams(**model_settings)
-        except TypeError as exc:
-            raise ValueError(f"{self.name}: {exc}") from None
+        if self.work_limit_kind is int:
+            self.work_limit: float = int_setting("work_limit", work, 1)
+        else:
+            self.work_limit = float_setting("work_limit", work, 0.0, lo_open=True)
+        self.seed = int_setting("seed", seed, 0, 2**31 - 1)
+        known = [f.name for f in fields(MilpParams)]
+        for key, value in model_settings.items():
+            if key not in known:
+                takes = ", ".join(["deterministic", "time_limit", "work_limit", "seed", *known])
+                raise SettingError(key, f"unknown setting; {self.name} takes: {takes}", value=value)
+        self.params = MilpParams(**model_settings)
         self._previous: dict[str, tuple[str, ...]] = {}
         self._previous_time = -math.inf
         self._recent: list[tuple[float, np.ndarray, np.ndarray]] = []
@@ -125,7 +130,7 @@ class MilpSchedulerBase:
         """
         t0 = time.perf_counter()
         if time_limit is not None:
-            check_setting("time_limit", time_limit, float, 0.0)
+            float_setting("time_limit", time_limit, 0.0, unit=" s")
         limit = (
             time_limit
             if time_limit is not None

@@ -15,8 +15,8 @@ Examples
 >>> x = initial_solution(m, g, previous={})
 >>> bool(m.is_feasible(x)), idle_agents(m, x).tolist()
 (True, [])
->>> idle_agents(m, np.zeros(m.n_vars)).tolist()  # nobody flies: everyone is idle
-[0, 1, 2]
+>>> idle_agents(m, np.zeros(m.n_vars)).tolist()  # P2 may only watch: worth nothing alone
+[0, 2]
 """
 
 from __future__ import annotations

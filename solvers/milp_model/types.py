@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+
+from fcplan.scheduling import float_setting, int_setting
 
 __all__ = [
     "COVER",
@@ -20,7 +21,6 @@ __all__ = [
     "WATCH",
     "MilpModel",
     "MilpParams",
-    "check_setting",
 ]
 
 #: Variable kinds (:attr:`MilpModel.var_kind`): one route of one agent, a search block's detected
@@ -32,36 +32,6 @@ DUMP, WATCH, SEARCH = 0, 1, 2
 #: Objective coefficients are whole multiples of ``1 / OBJECTIVE_SCALE`` penalty units, so every
 #: backend (and the brute force) optimises the very same integral objective, exactly.
 OBJECTIVE_SCALE = 1e4
-
-
-def check_setting(name: str, value: Any, kind: type, lo: float, hi: float = math.inf) -> None:
-    """Raise a one-line :class:`ValueError` naming ``name`` and its range unless ``value`` is a
-    ``kind`` (``int``: a whole number, not a bool; ``float``: any real number) in ``lo..hi``.
-
-    Examples
-    --------
-    >>> check_setting("slots", 2, int, 1, 4)
-    >>> check_setting("slots", 0, int, 1, 4)
-    Traceback (most recent call last):
-    ...
-    ValueError: slots must be an integer in 1..4, got 0
-    """
-    is_int = isinstance(value, int | np.integer) and not isinstance(value, bool | np.bool_)
-    span = f"in {_num(lo)}..{_num(hi)}" if math.isfinite(hi) else f">= {_num(lo)}"
-    if kind is int:
-        ok = is_int and lo <= value <= hi
-        what = f"an integer {span}"
-    else:
-        real = is_int or isinstance(value, float | np.floating)
-        ok = real and math.isfinite(float(value)) and lo <= float(value) <= hi
-        what = f"a number {span}"
-    if not ok:
-        raise ValueError(f"{name} must be {what}, got {value!r}")
-
-
-def _num(v: float) -> str:
-    """A bound as written: whole numbers without a decimal point, others in ``%g``."""
-    return str(int(v)) if float(v).is_integer() else f"{v:g}"
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,26 +111,26 @@ class MilpParams:
     max_routes: int = 20_000
 
     def __post_init__(self) -> None:
-        check_setting("slots", self.slots, int, 1, 4)
-        check_setting("search_slots", self.search_slots, int, 1, 4)
-        check_setting("horizon_s", self.horizon_s, float, 1e-3)
-        check_setting("search_horizon_s", self.search_horizon_s, float, 1e-3)
-        check_setting("search_reach_s", self.search_reach_s, float, 0.0)
+        int_setting("slots", self.slots, 1, 4)
+        int_setting("search_slots", self.search_slots, 1, 4)
+        float_setting("horizon_s", self.horizon_s, 0.0, lo_open=True, unit=" s")
+        float_setting("search_horizon_s", self.search_horizon_s, 0.0, lo_open=True, unit=" s")
+        float_setting("search_reach_s", self.search_reach_s, 0.0, unit=" s")
         for name in ("fire_candidates", "search_candidates", "watch_candidates"):
-            check_setting(name, getattr(self, name), int, 1, 64)
-        check_setting("prune_confidence", self.prune_confidence, float, 0.0, 1.0)
-        check_setting("threat_weight", self.threat_weight, float, 0.0)
-        check_setting("growth_cells_s", self.growth_cells_s, float, 0.0)
-        check_setting("search_weight", self.search_weight, float, 0.0)
-        check_setting("search_age_exponent", self.search_age_exponent, float, 0.0, 4.0)
-        check_setting("search_age_cap_s", self.search_age_cap_s, float, 1e-3)
-        check_setting("recent_fire_s", self.recent_fire_s, float, 0.0)
-        check_setting("search_block_px", self.search_block_px, float, 1e-3)
-        check_setting("cover_levels", self.cover_levels, int, 1, 1000)
-        check_setting("watch_altitude", self.watch_altitude, float, 0.0)
+            int_setting(name, getattr(self, name), 1, 64)
+        float_setting("prune_confidence", self.prune_confidence, 0.0, 1.0)
+        float_setting("threat_weight", self.threat_weight, 0.0)
+        float_setting("growth_cells_s", self.growth_cells_s, 0.0)
+        float_setting("search_weight", self.search_weight, 0.0)
+        float_setting("search_age_exponent", self.search_age_exponent, 0.0, 4.0)
+        float_setting("search_age_cap_s", self.search_age_cap_s, 0.0, lo_open=True, unit=" s")
+        float_setting("recent_fire_s", self.recent_fire_s, 0.0, unit=" s")
+        float_setting("search_block_px", self.search_block_px, 0.0, lo_open=True, unit=" px")
+        int_setting("cover_levels", self.cover_levels, 1, 1000)
+        float_setting("watch_altitude", self.watch_altitude, 0.0, unit=" m")
         if self.search_altitude is not None:
-            check_setting("search_altitude", self.search_altitude, float, 0.0)
-        check_setting("max_routes", self.max_routes, int, 1)
+            float_setting("search_altitude", self.search_altitude, 0.0, unit=" m")
+        int_setting("max_routes", self.max_routes, 1)
 
     def replace(self, **changes: Any) -> MilpParams:
         """A copy with ``changes`` (validated)."""

@@ -14,7 +14,7 @@ import pytest
 
 import fcplan
 from fcplan.plan import validate_plan
-from fcplan.scheduling import make_scheduler, solve
+from fcplan.scheduling import SettingError, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph
 from solvers.milp import MilpScheduler
 from solvers.milp_cvxpy import MilpCvxpyScheduler
@@ -34,27 +34,33 @@ def episode_graphs(name) -> tuple[TaskGraph, ...]:
 @pytest.mark.parametrize(
     ("settings", "match"),
     [
-        ({"slots": 0}, r"^slots must be an integer in 1\.\.4, got 0$"),
-        ({"slots": 2.5}, r"^slots must be an integer in 1\.\.4, got 2\.5$"),
-        ({"time_limit": math.nan}, r"^time_limit must be a number >= 1e-09, got nan$"),
-        ({"time_limit": -1}, r"^time_limit must be a number >= 1e-09, got -1$"),
-        ({"time_limit": "1"}, r"^time_limit must be a number >= 1e-09, got '1'$"),
-        ({"work_limit": 0}, r"^work_limit must be "),
-        ({"seed": -1}, r"^seed must be an integer in 0\.\.2147483647, got -1$"),
-        ({"deterministic": "yes"}, r"^deterministic must be true or false, got 'yes'$"),
-        ({"horizon_s": math.inf}, r"^horizon_s must be a number >= 0\.001, got inf$"),
-        ({"prune_confidence": 1.5}, r"^prune_confidence must be a number in 0\.\.1, got 1\.5$"),
-        ({"search_weight": -0.1}, r"^search_weight must be a number >= 0, got -0\.1$"),
-        ({"search_altitude": math.nan}, r"^search_altitude must be a number >= 0, got nan$"),
-        ({"slot": 2}, r"unexpected keyword argument 'slot'"),
+        ({"slots": 0}, r"bad setting slots=0: must be an integer in 1\.\.4$"),
+        ({"slots": 2.5}, r"bad setting slots=2\.5: must be an integer in 1\.\.4$"),
+        ({"time_limit": math.nan}, r"bad setting time_limit=nan: must be a finite number > 0 s$"),
+        ({"time_limit": -1}, r"bad setting time_limit=-1: must be a finite number > 0 s$"),
+        ({"time_limit": "1"}, r"bad setting time_limit=1: must be a finite number > 0 s$"),
+        ({"work_limit": 0}, r"bad setting work_limit=0: must be "),
+        ({"seed": -1}, r"bad setting seed=-1: must be an integer in 0\.\.2147483647$"),
+        ({"deterministic": "yes"}, r"bad setting deterministic=yes: must be true or false$"),
+        ({"horizon_s": math.inf}, r"bad setting horizon_s=inf: must be a finite number > 0 s$"),
+        ({"prune_confidence": 1.5}, r"prune_confidence=1\.5: must be a number in \[0, 1\]$"),
+        (
+            {"search_weight": -0.1},
+            r"bad setting search_weight=-0\.1: must be a finite number >= 0$",
+        ),
+        ({"search_altitude": math.nan}, r"search_altitude=nan: must be a finite number >= 0 m$"),
+        ({"slot": 2}, r"bad setting slot=2: unknown setting; milp(-cvxpy)? takes: deterministic, "),
     ],
 )
 def test_bad_settings_raise_one_line_errors(name, settings, match):
     """Settings are checked at construction: a wrong type, a value out of range or NaN raises a
-    one-line ValueError naming the setting and its allowed range (unknown names too)."""
-    with pytest.raises(ValueError, match=match) as info:
+    one-line SettingError (a ValueError) naming the scheduler, the setting, its value and the
+    allowed range (unknown names too)."""
+    with pytest.raises(SettingError, match=match) as info:
         make_scheduler(name, **settings)
     assert "\n" not in str(info.value)
+    assert str(info.value).startswith(f"scheduler {name!r}: bad setting ")
+    assert isinstance(info.value, ValueError)
 
 
 @pytest.mark.parametrize("limit", [math.nan, -1.0])
