@@ -79,6 +79,7 @@ class MilpScheduler(MilpSchedulerBase):
     """
 
     name = "milp"
+    solver_name = "cp-sat"
     default_work_limit = 5.0
 
     def _solve(

@@ -81,6 +81,7 @@ class MilpCvxpyScheduler(MilpSchedulerBase):
     """
 
     name = "milp-cvxpy"
+    solver_name = "highs (cvxpy)"
     default_work_limit = 5000
     work_limit_kind = int
 

@@ -97,7 +97,8 @@ True
 from solvers.milp_model.brute_force import brute_force_optimum
 from solvers.milp_model.build import build_milp_model
 from solvers.milp_model.decode import decode_plan, plan_objective
-from solvers.milp_model.scheduler import IncompletePlanError, MilpSchedulerBase, SolverLimits
+from solvers.milp_model.scheduler import MilpSchedulerBase
+from solvers.milp_model.solve import SolverLimits
 from solvers.milp_model.types import (
     COVER,
     DUMP,
@@ -106,6 +107,7 @@ from solvers.milp_model.types import (
     ROUTE,
     SEARCH,
     WATCH,
+    IncompletePlanError,
     MilpModel,
     MilpParams,
 )

@@ -20,6 +20,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from fcplan.taskgraph import TaskGraph, TaskKind
 from solvers.milp_model.constraints import model_rows
@@ -31,8 +32,9 @@ from solvers.milp_model.objective import (
     route_cover,
     straight_cover,
 )
+from solvers.milp_model.prune import dominated, route_keys
 from solvers.milp_model.routes import AgentRoles, agent_roles, enumerate_routes, top_candidates
-from solvers.milp_model.sensing import best_search_altitude
+from solvers.milp_model.sensing import TAN_Y, best_search_altitude
 from solvers.milp_model.types import (
     COVER,
     DUMP,
@@ -45,7 +47,12 @@ from solvers.milp_model.types import (
     MilpParams,
 )
 
-__all__ = ["RouteSet", "build_milp_model"]
+__all__ = ["MAX_SCORED_ENDS", "RouteSet", "build_milp_model"]
+
+#: Search blocks scored as the end of a searcher's straight flight (the candidates' ranking): all
+#: of them up to this many (every shipped scenario), else half of this the nearest and half the
+#: ones of most value per second of flight.
+MAX_SCORED_ENDS = 256
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,7 +66,7 @@ class RouteSet:
     length: np.ndarray  # (R,) float64 px
     value: np.ndarray  # (R,) float64 own objective coefficient
     altitude: np.ndarray  # (R,) float64 (NaN: no camera)
-    cover: np.ndarray  # (R, B) int64 detected share of each block, percent
+    cover: sp.csr_array  # (R, B) int64 detected share of each block, in 1 / cover_levels
 
 
 class _Context:
@@ -74,7 +81,19 @@ class _Context:
         self.fire = graph.task_kind == TaskKind.FIRE
         self.blocks = np.flatnonzero(~self.fire)
         self.block_value = block_values(graph, p, self.blocks, recent_fire)
+        self.block_pos = graph.task_pos[self.blocks]
         self.width = max(p.slots, p.search_slots)
+
+    def near_blocks(self, agent: int, z: float, factor: float = 1.0) -> np.ndarray:
+        """Positions (in ``blocks``) of the search blocks a flight of ``agent`` at altitude ``z``
+        can cover before the look-ahead ends (``factor`` times that radius): nothing farther
+        from its start than ``v (H_s - t0)+`` plus the field of view and half a block diagonal
+        is ever in view in time, so its cover is provably 0."""
+        g, p = self.graph, self.p
+        fly = float(g.agent_speed[agent]) * max(p.search_horizon_s - float(self.roles.t0[agent]), 0)
+        reach = factor * fly + z * (1.0 + TAN_Y) + p.search_block_px / np.sqrt(2.0)
+        d = np.hypot(*(self.block_pos - g.agent_start_pos[agent]).T)
+        return np.flatnonzero(d <= reach)
 
     def altitudes(self, agent: int) -> tuple[float, float]:
         """(watch, search) altitudes of a camera agent, clipped to its bounds."""
@@ -109,10 +128,17 @@ def _agent_routes(ctx: _Context, a: int) -> list[tuple[int, np.ndarray, np.ndarr
         out.append((WATCH, *enumerate_routes(g, a, cands, 1, t0)))
     if roles.sensor[a] and ctx.blocks.size:
         _, z = ctx.altitudes(a)
-        ends = g.task_pos[ctx.blocks]
-        score_b = straight_cover(g, a, ends, ctx.blocks, z, t0, p) @ ctx.block_value
+        seen = ctx.near_blocks(a, z)  # every block with a positive score is among these
+        ends = ctx.near_blocks(a, z, factor=2.0)  # heading for a farther block: as for these
+        if ends.size > MAX_SCORED_ENDS:  # the nearest ends and those of most value per second
+            eta = t0 + g.start_task_distance[a, ctx.blocks[ends]] / speed
+            proxy = ctx.block_value[ends] / (1.0 + eta)
+            pick = np.r_[np.argsort(eta, kind="stable")[: MAX_SCORED_ENDS // 2],
+                         np.argsort(-proxy, kind="stable")[: MAX_SCORED_ENDS // 2]]  # fmt: skip
+            ends = ends[np.unique(pick)]
+        score_b = straight_cover(g, a, ctx.block_pos[ends], ctx.blocks[seen], z, t0, p)
         score = np.zeros(g.n_tasks)
-        score[ctx.blocks] = score_b
+        score[ctx.blocks[ends]] = score_b @ ctx.block_value[seen]
         ok = roles.ok1[a] & ~ctx.fire
         near = top_candidates(score, ok & (direct <= t0 + p.search_reach_s), p.search_candidates)
         far = top_candidates(score, ok, p.search_candidates)
@@ -145,9 +171,15 @@ def _given_routes(
 
 
 def _valued(
-    ctx: _Context, a: int, kind: int, tasks: np.ndarray, arrival: np.ndarray, length: np.ndarray
+    ctx: _Context,
+    a: int,
+    kind: int,
+    route: tuple[np.ndarray, np.ndarray, np.ndarray],
+    prune: bool,
 ) -> RouteSet:
-    """The routes of one agent and kind with their values, altitudes and covers."""
+    """The routes of one agent and kind with their values, altitudes and covers, without the
+    dominated ones when ``prune`` (:mod:`solvers.milp_model.prune`)."""
+    tasks, arrival, length = route
     g, p = ctx.graph, ctx.p
     n = len(tasks)
     width = max(ctx.width, tasks.shape[1])
@@ -155,41 +187,55 @@ def _valued(
     if kind == DUMP:
         fire_only = np.where((tasks >= 0) & ctx.fire[np.maximum(tasks, 0)], tasks, -1)
         value = dump_value(g, p, ctx.weight, fire_only, arrival).sum(axis=1)
-    cover = np.zeros((n, ctx.blocks.size), dtype=np.int64)
     alt = np.full(n, np.nan)
+    cover = sp.csr_array((n, ctx.blocks.size), dtype=np.int64)
     if ctx.roles.sensor[a]:
         z_watch, z_search = ctx.altitudes(a)
         z = z_search if kind == SEARCH else z_watch
         alt[:] = z
-        share = route_cover(g, a, tasks, arrival, ctx.blocks, z, float(ctx.roles.t0[a]), p)
-        cover = np.floor(p.cover_levels * share + 0.5).astype(np.int64)
+        near = ctx.near_blocks(a, z)
+        t0 = float(ctx.roles.t0[a])
+        share = route_cover(g, a, tasks, arrival, ctx.blocks[near], z, t0, p)
+        level = np.floor(p.cover_levels * share + 0.5).astype(np.int64)
+        rr, bb = np.nonzero(level)
+        cover = sp.csr_array((level[rr, bb], (rr, near[bb])), shape=(n, ctx.blocks.size))
+    keep = np.ones(n, dtype=bool)
+    if prune:
+        keep = ~dominated(route_keys(tasks, by_first=kind == SEARCH), value, cover)
     return RouteSet(
-        agent=np.full(n, a, dtype=np.int64),
-        kind=np.full(n, kind, dtype=np.int8),
-        tasks=_pad(tasks, width, -1),
-        arrival=_pad(arrival, width, np.nan),
-        length=length,
-        value=value,
-        altitude=alt,
-        cover=cover,
+        agent=np.full(int(keep.sum()), a, dtype=np.int64),
+        kind=np.full(int(keep.sum()), kind, dtype=np.int8),
+        tasks=_pad(tasks[keep], width, -1),
+        arrival=_pad(arrival[keep], width, np.nan),
+        length=length[keep],
+        value=value[keep],
+        altitude=alt[keep],
+        cover=cover[keep] if not keep.all() else cover,
     )
 
 
 def _route_set(
-    ctx: _Context, given: Mapping[int, Sequence[Sequence[int]]] | None, deadline: float | None
+    ctx: _Context,
+    given: Mapping[int, Sequence[Sequence[int]]] | None,
+    deadline: float | None,
+    prune: bool,
 ) -> RouteSet:
     parts = []
     for a in range(ctx.graph.n_agents):
         if deadline is not None and time.perf_counter() > deadline:
             raise TimeoutError(f"the wall-clock limit passed while enumerating routes (agent {a})")
         raw = _agent_routes(ctx, a) if given is None else _given_routes(ctx, a, given.get(a, ()))
-        parts += [_valued(ctx, a, kind, t, arr, px) for kind, t, arr, px in raw if len(t)]
+        parts += [
+            _valued(ctx, a, kind, (t, arr, px), prune and given is None)
+            for kind, t, arr, px in raw
+            if len(t)
+        ]
     width = max([ctx.width] + [r.tasks.shape[1] for r in parts])
     if not parts:
         z = np.zeros(0)
         return RouteSet(
             z.astype(np.int64), z.astype(np.int8), np.zeros((0, width), np.int64),
-            np.zeros((0, width)), z, z, z, np.zeros((0, ctx.blocks.size), np.int64),
+            np.zeros((0, width)), z, z, z, sp.csr_array((0, ctx.blocks.size), dtype=np.int64),
         )  # fmt: skip
     return RouteSet(
         agent=np.concatenate([r.agent for r in parts]),
@@ -199,7 +245,7 @@ def _route_set(
         length=np.concatenate([r.length for r in parts]),
         value=np.concatenate([r.value for r in parts]),
         altitude=np.concatenate([r.altitude for r in parts]),
-        cover=np.concatenate([r.cover for r in parts]),
+        cover=sp.vstack([r.cover for r in parts], format="csr"),
     )
 
 
@@ -228,7 +274,10 @@ def _freeze(
     speed = np.maximum(g.agent_speed, 1e-9)[:, None]
     direct = roles.t0[:, None] + g.start_task_distance / speed  # (A, K)
     direct = np.where(roles.ok1 & roles.dumper[:, None] & ctx.fire[None, :], direct, np.inf)
-    t_first = np.array([direct[:, g.task_cluster == c].min() for c in labels.tolist()])
+    per_task = direct.min(axis=0) if len(direct) else np.full(g.n_tasks, np.inf)  # (K,)
+    t_first = np.full(labels.size, np.inf)
+    mine = np.isin(g.task_cluster, labels)
+    np.minimum.at(t_first, np.searchsorted(labels, g.task_cluster[mine]), per_task[mine])
     gap = np.maximum(p.horizon_s - t_first, 0.0)
     coef = CELL_RATE * p.prune_confidence * p.growth_cells_s * gap * gap / 2.0
     return labels.astype(np.int64), coef
@@ -241,6 +290,7 @@ def build_milp_model(
     routes: Mapping[int, Sequence[Sequence[int]]] | None = None,
     recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
     deadline: float | None = None,
+    prune: bool = True,
 ) -> MilpModel:
     """Build the route model of ``graph`` (see :mod:`solvers.milp_model`).
 
@@ -255,6 +305,8 @@ def build_milp_model(
         the schedulers pass those of the last ``recent_fire_s`` seconds.
     deadline : float, optional
         A :func:`time.perf_counter` time: past it, building stops with ``TimeoutError``.
+    prune : bool
+        Leave out dominated routes (:mod:`solvers.milp_model.prune`; the optimum is the same).
 
     Raises
     ------
@@ -265,10 +317,10 @@ def build_milp_model(
     """
     p = params or MilpParams()
     ctx = _Context(graph, p, recent_fire)
-    rs = _route_set(ctx, routes, deadline)
+    rs = _route_set(ctx, routes, deadline, prune)
     if len(rs.agent) > p.max_routes:
         raise ValueError(f"{len(rs.agent)} routes exceed max_routes={p.max_routes}")
-    swept = np.flatnonzero(rs.cover.any(axis=0))
+    swept = np.unique(rs.cover.indices)
     cl, dump, sees = _fire_visits(ctx, rs)
     labels, freeze_coef = _freeze(ctx, rs, cl, dump, sees)
     n_r, n_b, n_z = len(rs.agent), swept.size, labels.size

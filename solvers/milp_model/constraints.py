@@ -87,8 +87,8 @@ def model_rows(
         Agent row of each route.
     tasks : ndarray, (R, L)
         Task rows of each route (-1 padded).
-    cover : ndarray, (R, B) int
-        Detected share (percent) of each cover variable's block by each route.
+    cover : ndarray or sparse array, (R, B) int
+        Detected share (in ``1 / cover_levels``) of each cover variable's block by each route.
     cluster, dump, sees : ndarray, (R, L)
         Connected fire of each route entry, and whether the entry dumps on it / senses it.
     labels : ndarray, (Z,)
@@ -112,11 +112,12 @@ def model_rows(
     lead = np.flatnonzero(search)
     rows.add(tasks[lead, 0], lead, np.ones(lead.size), 1, "search_once", min_terms=2)
     # cover[b] <= sum_r share[r, b] y_r
-    rb, bb = np.nonzero(cover)
+    cov = sp.coo_array(cover)
+    rb, bb = cov.row.astype(np.int64), cov.col.astype(np.int64)
     rows.add(
         np.r_[np.arange(n_b), bb],
         np.r_[n_r + np.arange(n_b), rb],
-        np.r_[np.ones(n_b), -cover[rb, bb].astype(np.float64)],
+        np.r_[np.ones(n_b), -cov.data.astype(np.float64)],
         0,
         "cover",
     )

@@ -8,17 +8,21 @@ that has just been put out.
 
 Examples
 --------
->>> import time
->>> limits = SolverLimits(deadline=time.perf_counter() + 1.0, work=5.0)
->>> 0.0 < limits.seconds_left() <= 1.0, SolverLimits(None, 5.0).seconds_left()
-(True, None)
+>>> import numpy as np
+>>> from fcplan.taskgraph import synthetic_task_graph
+>>> from solvers.milp import MilpScheduler
+>>> g = synthetic_task_graph(30, 60, np.random.default_rng(0))
+>>> s = MilpScheduler(exact_routes=200, lns_routes=200)
+>>> plan = s.plan(g)
+>>> plan.stats.status, plan.stats.size["parts"], plan.stats.bound >= plan.stats.objective
+('feasible', 1, True)
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import fields
+from dataclasses import fields, replace
 from typing import Any
 
 import numpy as np
@@ -34,30 +38,14 @@ from fcplan.scheduling import (
 from fcplan.taskgraph import TaskGraph
 from solvers.milp_model.build import build_milp_model
 from solvers.milp_model.decode import decode_plan
+from solvers.milp_model.solve import LnsSettings, SolverLimits, solve_model
 from solvers.milp_model.start import idle_agents, initial_solution
-from solvers.milp_model.types import MilpModel, MilpParams
+from solvers.milp_model.types import IncompletePlanError, MilpModel, MilpParams
 
-__all__ = ["MilpSchedulerBase", "SolverLimits", "IncompletePlanError"]
-
-
-class IncompletePlanError(RuntimeError):
-    """A limit stopped the solver before it had a plan for every agent that has work."""
+__all__ = ["MilpSchedulerBase"]
 
 
-class SolverLimits:
-    """The limits of one solve: a wall-clock deadline (``perf_counter`` seconds, or None) and a
-    deterministic work limit (the backend's unit)."""
-
-    __slots__ = ("deadline", "work")
-
-    def __init__(self, deadline: float | None, work: float) -> None:
-        self.deadline, self.work = deadline, work
-
-    def seconds_left(self, reserve: float = 0.0) -> float | None:
-        """Wall seconds left before the deadline minus ``reserve`` (None: no deadline)."""
-        if self.deadline is None:
-            return None
-        return self.deadline - time.perf_counter() - reserve
+_LNS = ("exact_routes", "lns_routes", "lns_rounds")
 
 
 class MilpSchedulerBase:
@@ -76,12 +64,17 @@ class MilpSchedulerBase:
     work_limit : float or int
         The backend's deterministic work limit (CP-SAT: deterministic seconds; HiGHS: nodes).
     seed : int
-        The backend's random seed (one worker / thread).
+        The backend's random seed (one worker / thread) and the search's seed.
+    exact_routes, lns_routes, lns_rounds : int
+        Parts of the model with at most ``exact_routes`` routes are solved at once; larger ones
+        by large-neighbourhood search, at most ``lns_rounds`` rounds freeing at most
+        ``lns_routes`` routes each (:mod:`solvers.milp_model.solve`).
     **model_settings
         Fields of :class:`MilpParams`.
     """
 
     name = "milp-base"
+    solver_name = "none"
     default_work_limit: float = 1.0
     work_limit_kind: type = float
     #: share of the wall-clock limit kept back for decoding and validation
@@ -93,6 +86,9 @@ class MilpSchedulerBase:
         time_limit: float = 0.2,
         work_limit: float | None = None,
         seed: int = 0,
+        exact_routes: int = LnsSettings.exact_routes,
+        lns_routes: int = LnsSettings.lns_routes,
+        lns_rounds: int = LnsSettings.lns_rounds,
         **model_settings: Any,
     ) -> None:
         self.deterministic = bool_setting("deterministic", deterministic)
@@ -103,10 +99,12 @@ class MilpSchedulerBase:
         else:
             self.work_limit = float_setting("work_limit", work, 0.0, lo_open=True)
         self.seed = int_setting("seed", seed, 0, 2**31 - 1)
+        self.lns = LnsSettings(exact_routes, lns_routes, lns_rounds)
         known = [f.name for f in fields(MilpParams)]
         for key, value in model_settings.items():
             if key not in known:
-                takes = ", ".join(["deterministic", "time_limit", "work_limit", "seed", *known])
+                own = ["deterministic", "time_limit", "work_limit", "seed", *_LNS]
+                takes = ", ".join([*own, *known])
                 raise SettingError(key, f"unknown setting; {self.name} takes: {takes}", value=value)
         self.params = MilpParams(**model_settings)
         self._previous: dict[str, tuple[str, ...]] = {}
@@ -151,14 +149,22 @@ class MilpSchedulerBase:
                 f"building the model took {time.perf_counter() - t0:.4f} s of {limit} s"
             )
         hint = initial_solution(model, graph, self._previous, deadline=deadline)
-        x, stats = self._solve(model, limits=limits, seed=self.seed, hint=hint)
-        if stats.status != "optimal":
-            idle = idle_agents(model, x)
-            if idle.size:
-                names = ", ".join(graph.agent_ids[a] for a in idle.tolist())
-                raise IncompletePlanError(
-                    f"the {stats.status} stop left agents {names} idle with routes to fly"
-                )
+        x, stats = solve_model(
+            model,
+            hint,
+            graph.agent_start_pos,
+            self._solve,
+            limits=limits,
+            seed=self.seed,
+            settings=self.lns,
+        )
+        idle = idle_agents(model, x)
+        if idle.size:  # only when the deadline passed before the warm start was complete
+            names = ", ".join(graph.agent_ids[a] for a in idle.tolist())
+            raise IncompletePlanError(
+                f"the wall-clock limit left agents {names} idle with routes to fly"
+            )
+        stats = replace(stats, size=dict(stats.size, solver=self.solver_name))
         plan = decode_plan(model, x, graph, stats)
         self._previous = dict(plan.routes)
         self._previous_time = graph.time_s

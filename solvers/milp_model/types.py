@@ -13,6 +13,7 @@ from fcplan.scheduling import float_setting, int_setting
 __all__ = [
     "COVER",
     "FREEZE",
+    "IncompletePlanError",
     "KIND_NAMES",
     "OBJECTIVE_SCALE",
     "ROUTE",
@@ -32,6 +33,10 @@ DUMP, WATCH, SEARCH = 0, 1, 2
 #: Objective coefficients are whole multiples of ``1 / OBJECTIVE_SCALE`` penalty units, so every
 #: backend (and the brute force) optimises the very same integral objective, exactly.
 OBJECTIVE_SCALE = 1e4
+
+
+class IncompletePlanError(RuntimeError):
+    """A limit stopped the solver before it had a plan for every agent that has work."""
 
 
 @dataclass(frozen=True, slots=True)
