@@ -1,117 +1,124 @@
-"""
-Both MILP schedulers (:mod:`solvers.milp`, OR-Tools; :mod:`solvers.milp_cvxpy`, cvxpy + HiGHS) solve
-the model built here, from the same arrays, so they solve the *identical* problem. This package also
-decodes a solution vector into a :class:`fcplan.plan.Plan` and holds a brute-force enumerator for
-tiny models (used by the tests as ground truth).
+"""The route model both MILP schedulers solve: team orienteering over enumerated short routes.
 
-The model
----------
-Every agent that is not sent home (``HOMING``) gets ``S`` ordered **slots** (``slots``, default 2);
-each slot holds at most one task. A binary variable ``x[a, k, s]`` says that agent ``a`` serves task
-``k`` in slot ``s``, in one of three **kinds** fixed by the agent's role and the task:
+Both MILP schedulers (:mod:`solvers.milp`, OR-Tools CP-SAT; :mod:`solvers.milp_cvxpy`, cvxpy +
+HiGHS) solve the model built here, from the same arrays, so they solve the *identical* problem.
+This package also decodes a solution into a :class:`fcplan.plan.Plan`, scores any plan on the
+model (:func:`plan_objective`) and holds a brute-force enumerator for tiny models (the tests'
+ground truth).
 
-* ``DUMP``: an action or hybrid agent with water (on a forced return: a full tank, it refills first)
-  dumps on fire task ``k``;
-* ``WATCH``: a perception agent (or a hybrid with an empty tank) hovers over fire task ``k`` at a low
-  altitude, keeping its connected fire freshly sensed;
-* ``SEARCH``: an agent with a camera (re)explores search block ``k``.
+What is optimised
+-----------------
+The manual scores an episode by its negative reward, the integral of ``0.1 |A(t)| + sum_f PC_f
+n_f(t)`` (active cells, active cells inside facility ``f``; :mod:`fcplan.metrics`). The model
+maximises the part of it a replan's routes avoid over a rolling horizon ``H`` (``horizon_s``):
+a cell put out or found ``t`` seconds from now stops costing (or can be put out) for the
+``H - t`` seconds left of it. All values below are in those penalty units.
 
-Auxiliary binaries ``z[k, s]`` (kind ``AUX``) mark a fire task ``k`` dumped in slot ``s`` while
-its connected fire is sensed (see the coupling below).
+Routes (set partitioning)
+-------------------------
+For every agent, every route of at most ``slots`` fire tasks (dumps, capped by the tank), of one
+fire task to **watch** (a camera agent without water hovers over it at ``watch_altitude``), or of
+at most ``search_slots`` search blocks (flown at the altitude of best detection rate,
+:func:`~solvers.milp_model.sensing.best_search_altitude`) is enumerated over the agent's best
+``fire_candidates`` / ``watch_candidates`` / ``search_candidates`` tasks
+(:mod:`~solvers.milp_model.routes`). Each route has **exact** arrival times ``t_j`` from the
+agent's start and own speed, and is kept only if the whole flight, the way home included, fits
+the agent's budget (:meth:`fcplan.taskgraph.TaskGraph.route_ok`). Agents on a forced return
+start from their depot slot once they get there; agents sent home may be given a route again.
+
+Variables: ``y_r`` (binary) chooses route ``r``; ``x_b`` (integer ``0..L``) is the detected
+share of search block ``b`` in steps of ``1 / L`` (``L = cover_levels``); ``u_c`` (binary) marks a connected fire ``c`` that is
+both dumped on and watched.
 
 Objective (maximise)::
 
-    sum  search_weight * v_k * disc[a,k,s] * x      (SEARCH: v_k = coverage-age value of the block)
-  + sum  watch_weight  * v_k * disc[a,k,s] * x      (WATCH: a watched fire's new cells get sensed)
-  + sum  v_k * disc[a,k,s] * x                      (DUMP on a fresh fire)
-  - sum  v_k * (1 - disc[a,k,s]) * x                (DUMP on a stale fire ...)
-  + sum  v_k * z[k,s]                               (... worth v_k * disc only when sensed)
-  + sum  support_weight * v_k * z[k,s]              (fresh fire dumped *and* watched)
+    sum_r D_r y_r  +  sum_b (V_b / L) x_b  +  sum_c F_c u_c
 
-``v_k`` is the task graph's ``task_value``: for fires ``cells * (1 + threat)``, so the facility
-threat weights are already in it; for search blocks the capped coverage age times a bonus near
-known fire (``search_weight`` puts it on the fire scale). The **travel-time discount** is
-``disc = 1 / (1 + eta / tau_s)`` with ``eta`` the estimated arrival time: ``d(start, k) / speed``
-for slot 0 (exact, straight line), and the same plus ``s * slot_delay_s`` for slot ``s >= 1`` (an
-estimate: the previous task is not known when the coefficient is fixed; ``d(start, k) / speed`` is
-a lower bound on the arrival time by the triangle inequality and ``slot_delay_s`` stands for
-serving the earlier tasks and the detour). Later slots are therefore worth less, and the solver
-puts the better task first.
+* **dumps**: ``D_r = sum_{j: fire} q n_k w_k (H - t_j)+`` with ``q`` the prune confidence
+  (``prune_confidence``), ``n_k`` the task's known (sensed, hence prunable) cells and
+  ``w_k = 0.1 + theta sum_f PC_f (1 - tau_kf / H)+`` the penalty rate of one of its cells:
+  ``tau_kf`` is the graph's estimated time for fire ``k`` to reach facility ``f``
+  (``threat_time_s``, the ``threatens`` edges), ``theta`` is ``threat_weight``;
+* **search** (expected detection): block ``b`` is taken to hide ``E_b`` undiscovered burning
+  cells, ``E_b = kappa 60 (A_b / 60) ** alpha (1 + min(n_b, 50) / 10)`` with ``A_b`` its
+  coverage age (``task_staleness``, capped at ``search_age_cap_s``) and ``n_b`` the known
+  cells in the 3 x 3 blocks around it (``kappa = search_weight``,
+  ``alpha = search_age_exponent``; :func:`~solvers.milp_model.objective.hidden_cells`); found
+  now they are worth ``V_b = 0.1 E_b H``. A route sweeping ``b`` ``t`` seconds from now finds
+  them with probability ``s_rb`` = covered share x sensing probability at the route's altitude
+  (:mod:`~solvers.milp_model.sensing`) x ``(H_s - t)+ / H_s``, the best of the route's legs
+  (``H_s = search_horizon_s``: the agent replans long before a far sweep would happen);
+* **growth stopped**: fronts move on into unsensed cells, and only sensed cells can be put out,
+  so a connected fire stops growing only when it is watched (by a watch route or a dumping agent
+  with a camera) *and* dumped on: ``F_c = 0.1 q gamma (H - t_c)+^2 / 2`` for ``gamma``
+  (``growth_cells_s``) cells per second stopped from ``t_c``, the earliest arrival of an agent
+  with water at a task of ``c`` (straight from its start: a property of the graph).
 
-**Coupling** (only sensed cells can be pruned): a dump is worth its value only if its fire is
-freshly sensed, either already (``task_staleness <= fresh_s``) or because a sensor is assigned to
-that fire's connected fire (``task_cluster``) in the same or an earlier slot. For a fire task ``k``
-with a dump candidate in slot ``s``::
+Constraints (all ``A_ub [y; x; u] <= b_ub``, integral)::
 
-    z[k, s] <= sum_a x_DUMP[a, k, s]
-    z[k, s] <= sum { x[a', k', s'] : WATCH, or DUMP by a hybrid (it senses before it dumps),
-                     cluster(k') = cluster(k), s' <= s }
+    sum_{r of agent a} y_r <= 1                      (agent: one route each)
+    sum_{r dumps on k} y_r <= 1                      (dump_once: one dump per fire task)
+    sum_{r watches c} y_r <= 1                       (watch_once: one watcher per fire)
+    sum_{r searches b first} y_r <= 1                (search_once: one searcher heads for b)
+    x_b - sum_r round(L s_rb) y_r <= 0,  x_b <= L     (cover: a block is found once)
+    u_c - sum_{r dumps in c} y_r <= 0                (freeze_dump)
+    u_c - sum_{r senses c} y_r <= 0                  (freeze_watch)
 
-For a *stale* fire, a dump nets ``v_k * disc`` when ``z = 1`` and ``-v_k * (1 - disc) <= 0``
-otherwise: a stale fire that nobody watches is worth nothing (the spec's ``z <= fresh + watch``,
-``z <= dump``, objective ``value * discount * z``, written with one ``z`` per (fire, slot) and the
-discount moved into a travel penalty so that it can differ between agents). For a *fresh* fire the
-dump is worth ``v_k * disc`` on its own, and ``z`` (only built when ``support_weight > 0``) adds
-``support_weight * v_k`` when a sensor watches its connected fire too: the cells that ignite between
-the last look and the dump are unsensed and cannot be pruned unless someone is watching.
-
-Constraints (all ``A_ub x <= b_ub``, every variable binary):
-
-* one task per agent and slot; slots filled in order (``sum_k x[a,k,s] <= sum_k x[a,k,s-1]``);
-* each fire task dumped by at most one agent and watched by at most one agent over all slots;
-* **spread** (search blocks): at most one search assignment (any agent, any slot) among the blocks
-  within ``spread_px`` of any candidate block, so each block is taken at most once and searchers do
-  not crowd (rows whose block set is contained in another row's are dropped);
-* **tank**: DUMP assignments of an agent ``<=`` its tank (rows only where the tank is smaller than
-  the number of slots; otherwise the row is implied by one task per slot);
-* **battery** (linear, conservative): ``(d(start,k) + d(k,home)) x[a,k,0] + sum_{s>=1} 2 d(home,k)
-  x[a,k,s] <= range`` with ``range`` the agent's budget,
-  :attr:`fcplan.taskgraph.TaskGraph.agent_budget_px` (full battery on a forced return). By the
-  triangle inequality ``d(k_i, k_{i+1}) <= d(k_i, home) + d(home, k_{i+1})``, so the true length of
-  the route start -> k_1 -> ... -> k_n -> home is at most the left-hand side: a plan within the row
-  is flyable without a stop at the depot. Coefficients are rounded *up* to whole px and the range
-  *down*, which keeps the row conservative and integral (CP-SAT needs integer rows). Rows only where
-  the agent's worst case could exceed its range.
-
-**Pre-filtering and pruning** keep the model small: an ``(a, k, s)`` variable exists only when the
-role fits, the task is within a full-battery round trip of the agent's depot slot, and the slot's
-battery term fits on its own (``d(start,k) + d(k,home) <= range`` for slot 0,
-``min first leg + 2 d(home,k) <= range`` for later slots). Among the remaining tasks each agent keeps
-its ``fire_candidates`` best fire tasks and ``search_candidates`` best search blocks by slot-0
-discounted value (ties by task order). All of it is numpy: no Python loop over tasks.
+Battery, tank, roles and the round-trip rule hold route by route, so they need no rows. The
+cover rows make overlapping sweeps count once (a share above 100 % is worth 100 %), which
+spreads the searchers without any spacing rule. Shares are rounded to ``1 / L``: a sweep that
+finds less than half a step of a block does not count for it.
 
 Modules: :mod:`~solvers.milp_model.types` (settings and the model's arrays),
-:mod:`~solvers.milp_model.variables`, :mod:`~solvers.milp_model.objective`,
-:mod:`~solvers.milp_model.constraints`, :mod:`~solvers.milp_model.build` (the model),
-:mod:`~solvers.milp_model.decode` (plans from solutions, and any plan's objective),
+:mod:`~solvers.milp_model.sensing` (field of view, detection, swept blocks),
+:mod:`~solvers.milp_model.routes` (roles, candidates, enumeration),
+:mod:`~solvers.milp_model.objective` (values), :mod:`~solvers.milp_model.constraints` (rows),
+:mod:`~solvers.milp_model.build` (the model), :mod:`~solvers.milp_model.decode` (plans from
+solutions, any plan's objective), :mod:`~solvers.milp_model.start` (warm start, idle agents),
 :mod:`~solvers.milp_model.brute_force` (exact optimum of tiny models) and
-:mod:`~solvers.milp_model.scheduler` (what both schedulers share).
+:mod:`~solvers.milp_model.scheduler` (what both schedulers share). Tuning history and measured
+tables are in ``bench/README.md``.
 
 Examples
 --------
 >>> import numpy as np
 >>> from fcplan.taskgraph import synthetic_task_graph
 >>> g = synthetic_task_graph(3, 6, np.random.default_rng(0))
->>> m = build_milp_model(g)
+>>> m = build_milp_model(g, MilpParams(search_candidates=3))
 >>> m.n_vars == m.c.size == m.A_ub.shape[1]
 True
 >>> x, obj = brute_force_optimum(m)
->>> plan = decode_plan(m, x, g)
->>> bool(np.isclose(m.c @ x, obj))
+>>> bool(m.is_feasible(x)) and bool(np.isclose(m.objective(x), obj))
 True
+>>> sorted(decode_plan(m, x, g).routes)
+['A3', 'P1', 'P2']
 """
 
 from solvers.milp_model.brute_force import brute_force_optimum
 from solvers.milp_model.build import build_milp_model
 from solvers.milp_model.decode import decode_plan, plan_objective
 from solvers.milp_model.scheduler import MilpSchedulerBase
-from solvers.milp_model.types import AUX, DUMP, KIND_NAMES, SEARCH, WATCH, MilpModel, MilpParams
+from solvers.milp_model.solve import SolverLimits
+from solvers.milp_model.types import (
+    COVER,
+    DUMP,
+    FREEZE,
+    KIND_NAMES,
+    ROUTE,
+    SEARCH,
+    WATCH,
+    IncompletePlanError,
+    MilpModel,
+    MilpParams,
+)
 
 __all__ = [
+    "ROUTE",
+    "COVER",
+    "FREEZE",
     "DUMP",
     "WATCH",
     "SEARCH",
-    "AUX",
     "KIND_NAMES",
     "MilpParams",
     "MilpModel",
@@ -120,4 +127,6 @@ __all__ = [
     "brute_force_optimum",
     "plan_objective",
     "MilpSchedulerBase",
+    "SolverLimits",
+    "IncompletePlanError",
 ]

@@ -1,18 +1,22 @@
-"""The model's constraint rows, all ``A_ub x <= b_ub`` with integral entries, by family (see
-:mod:`solvers.milp_model` for each): ``slot``, ``order``, ``once``, ``spread``, ``tank``,
-``battery``, ``couple_dump`` and ``couple_watch``.
+"""The model's rows, all ``A_ub x <= b_ub`` with integral entries, by family (see
+:mod:`solvers.milp_model`): ``agent``, ``dump_once``, ``watch_once``, ``search_once``, ``cover``,
+``freeze_dump`` and ``freeze_watch``.
+
+Examples
+--------
+>>> import numpy as np
+>>> agent = np.array([0, 0, 1]); tasks = np.array([[0], [1], [0]])
+>>> dump = np.ones((3, 1), bool); cl = np.zeros((3, 1), np.int64)
+>>> mat, b, fam = model_rows(agent, tasks, np.zeros((3, 0), np.int64), cl, dump,
+...                          np.zeros((3, 1), bool), np.zeros(0, np.int64), np.zeros(3, bool))
+>>> fam, mat.toarray().tolist(), b.tolist()
+(('agent', 'dump_once'), [[1.0, 1.0, 0.0], [1.0, 0.0, 1.0]], [1.0, 1.0])
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 import scipy.sparse as sp
-
-from fcplan.taskgraph import TaskGraph
-from solvers.milp_model.types import DUMP, SEARCH, WATCH, MilpParams
-from solvers.milp_model.variables import Variables
 
 __all__ = ["model_rows"]
 
@@ -29,23 +33,26 @@ class _Rows:
         self.n_rows = 0
 
     def add(
-        self,
-        group: np.ndarray,
-        cols: np.ndarray,
-        coef: np.ndarray,
-        b_of_group: Callable[[np.ndarray], np.ndarray],
-        name: str,
-    ) -> None:
-        """Rows from a group label per entry (entries with the same label share a row)."""
+        self, group: np.ndarray, cols: np.ndarray, coef: np.ndarray, rhs: float, name: str,
+        *, min_terms: int = 1,
+    ) -> None:  # fmt: skip
+        """Rows from a group label per entry (entries with the same label share a row); rows
+        with fewer than ``min_terms`` entries are left out (they cannot bind)."""
         if group.size == 0:
             return
-        labels, inv = np.unique(group, return_inverse=True)
-        self.rows_i.append(self.n_rows + inv)
-        self.cols_j.append(cols)
-        self.vals.append(np.asarray(coef, dtype=np.float64))
-        self.rhs.append(np.asarray(b_of_group(labels), dtype=np.float64))
-        self.fam.extend([name] * labels.size)
-        self.n_rows += labels.size
+        labels, inv, counts = np.unique(group, return_inverse=True, return_counts=True)
+        keep = counts >= min_terms
+        if not keep.any():
+            return
+        new_id = np.cumsum(keep) - 1
+        sel = keep[inv]
+        self.rows_i.append(self.n_rows + new_id[inv[sel]])
+        self.cols_j.append(cols[sel])
+        self.vals.append(np.asarray(coef, dtype=np.float64)[sel])
+        n = int(keep.sum())
+        self.rhs.append(np.full(n, float(rhs)))
+        self.fam.extend([name] * n)
+        self.n_rows += n
 
     def matrix(self, n: int) -> tuple[sp.csr_array, np.ndarray]:
         """The (rows, n) matrix and the right-hand sides."""
@@ -62,115 +69,71 @@ class _Rows:
         return mat, np.concatenate(self.rhs)
 
 
-def _ones(lab: np.ndarray) -> np.ndarray:
-    return np.ones(lab.size)
-
-
-def _zeros(lab: np.ndarray) -> np.ndarray:
-    return np.zeros(lab.size)
-
-
 def model_rows(
-    graph: TaskGraph, p: MilpParams, v: Variables
+    agent: np.ndarray,
+    tasks: np.ndarray,
+    cover: np.ndarray,
+    cluster: np.ndarray,
+    dump: np.ndarray,
+    sees: np.ndarray,
+    labels: np.ndarray,
+    search: np.ndarray,
 ) -> tuple[sp.csr_array, np.ndarray, tuple[str, ...]]:
-    """The constraint matrix, right-hand sides and row families of the model (module
-    docstring), in the order slot, order, once, spread, tank, battery, couple_dump,
-    couple_watch."""
+    """The constraint matrix, right-hand sides and row families.
+
+    Parameters
+    ----------
+    agent : ndarray, (R,)
+        Agent row of each route.
+    tasks : ndarray, (R, L)
+        Task rows of each route (-1 padded).
+    cover : ndarray or sparse array, (R, B) int
+        Detected share (in ``1 / cover_levels``) of each cover variable's block by each route.
+    cluster, dump, sees : ndarray, (R, L)
+        Connected fire of each route entry, and whether the entry dumps on it / senses it.
+    labels : ndarray, (Z,)
+        Connected fire of each freeze variable.
+    search : ndarray, (R,) bool
+        Search routes.
+    """
+    n_r, n_b, n_z = agent.size, cover.shape[1], labels.size
     rows = _Rows()
-    _assignment_rows(rows, p, v)
-    _spread_rows(rows, graph, p, v)
-    _resource_rows(rows, graph, p, v)
-    if v.n_z:
-        _coupling_rows(rows, graph, v)
-    mat, b = rows.matrix(v.n_x + v.n_z)
-    return mat, b, tuple(rows.fam)
-
-
-def _assignment_rows(rows: _Rows, p: MilpParams, v: Variables) -> None:
-    """``slot``, ``order`` and ``once`` rows."""
-    va, vk, vs, vkind, n_slots = v.va, v.vk, v.vs, v.vkind, p.slots
-    n_x = v.n_x
-    xi = np.arange(n_x)
-    ones = np.ones(n_x)
-    # one task per (agent, slot)
-    rows.add(va * n_slots + vs, xi, ones, _ones, "slot")
-    # slots in order: slot-s vars (+1) and slot-(s-1) vars (-1) of the same agent, for s >= 1
-    later = vs >= 1
-    ord_group = np.r_[va[later] * n_slots + vs[later], va * n_slots + vs + 1]
-    ord_cols = np.r_[xi[later], xi]
-    ord_coef = np.r_[np.ones(later.sum()), -np.ones(n_x)]
-    has_later = np.isin(ord_group, va[later] * n_slots + vs[later])
-    rows.add(ord_group[has_later], ord_cols[has_later], ord_coef[has_later], _zeros, "order")
-    # each task at most once per kind (dump, watch, search) over all agents and slots; with
-    # spread_px > 0 the search rows are replaced by the spread rows below (which imply them)
-    once = (vkind != SEARCH) | (p.spread_px <= 0)
-    rows.add(vk[once] * 3 + vkind[once], xi[once], ones[once], _ones, "once")
-
-
-def _spread_rows(rows: _Rows, graph: TaskGraph, p: MilpParams, v: Variables) -> None:
-    """``spread`` rows: at most one search assignment among the blocks within ``spread_px`` of
-    any candidate block (searchers do not crowd; an agent's two slots go to blocks apart)."""
-    srch = np.flatnonzero(v.vkind == SEARCH)
-    if not (p.spread_px > 0 and srch.size):
-        return
-    blocks, bidx = np.unique(v.vk[srch], return_inverse=True)
-    near = graph.task_distance[np.ix_(blocks, blocks)] <= p.spread_px  # (U, U)
-    # drop rows whose neighbourhood is contained in another's (they are implied)
-    inter = near.astype(np.int64) @ near.T.astype(np.int64)
-    cnt = near.sum(axis=1)
-    sub = (inter == cnt[:, None]) & (
-        (cnt[None, :] > cnt[:, None])
-        | (
-            (cnt[None, :] == cnt[:, None])
-            & (np.arange(blocks.size)[None, :] < np.arange(blocks.size)[:, None])
-        )
-    )
-    np.fill_diagonal(sub, False)
-    rows_u = np.flatnonzero(~sub.any(axis=1))
-    ru, rv = np.nonzero(near[np.ix_(rows_u, bidx)])
-    rows.add(ru, srch[rv], np.ones(ru.size), _ones, "spread")
-
-
-def _resource_rows(rows: _Rows, graph: TaskGraph, p: MilpParams, v: Variables) -> None:
-    """``tank`` and ``battery`` rows, only where they can bind."""
-    va, vk, vs, vkind, n_slots = v.va, v.vk, v.vs, v.vkind, p.slots
-    xi = np.arange(v.n_x)
-    ones = np.ones(v.n_x)
-    tank, rng_px = v.tank, v.rng_px
-    # tank (only where it binds: fewer dumps left than slots)
-    tank_rows = (vkind == DUMP) & (tank[va] < n_slots)
-    rows.add(va[tank_rows], xi[tank_rows], ones[tank_rows], lambda lab: tank[lab], "tank")
-    # battery (only where the worst case exceeds the range)
-    coef = np.where(vs == 0, v.first_leg[va, vk], v.later_leg[va, vk])
-    worst = np.zeros((graph.n_agents, n_slots))
-    np.maximum.at(worst, (va, vs), coef)
-    bat_rows = worst.sum(axis=1)[va] > rng_px[va]
-    rows.add(va[bat_rows], xi[bat_rows], coef[bat_rows], lambda lab: rng_px[lab], "battery")
-
-
-def _coupling_rows(rows: _Rows, graph: TaskGraph, v: Variables) -> None:
-    """``couple_dump`` and ``couple_watch`` rows of the auxiliary ``z``."""
-    va, vk, vs, vkind, zk, zs = v.va, v.vk, v.vs, v.vkind, v.zk, v.zs
-    # z[k,s] <= sum_a dump[a,k,s]
-    dump = np.flatnonzero(vkind == DUMP)
-    match = (vk[dump][None, :] == zk[:, None]) & (vs[dump][None, :] == zs[:, None])
-    _couple(rows, v, dump, match, "couple_dump")
-    # z[k,s] <= sum of sensors on the same cluster in slots <= s
-    sensor = np.flatnonzero((vkind == WATCH) | ((vkind == DUMP) & graph.agent_can_sense[va]))
-    cl = graph.task_cluster
-    match = (cl[vk[sensor]][None, :] == cl[zk][:, None]) & (vs[sensor][None, :] <= zs[:, None])
-    _couple(rows, v, sensor, match, "couple_watch")
-
-
-def _couple(rows: _Rows, v: Variables, cols: np.ndarray, match: np.ndarray, name: str) -> None:
-    """One row per ``z[k, s]``: ``z[k, s] - sum of the x in cols matching it <= 0`` (``match``:
-    (n_z, len(cols)) bool)."""
-    n_z = v.n_z
-    zr, j = np.nonzero(match)
+    r_idx = np.arange(n_r)
+    # one route per agent
+    rows.add(agent, r_idx, np.ones(n_r), 1, "agent", min_terms=2)
+    # each fire task dumped on by at most one route
+    rr, jj = np.nonzero(dump)
+    rows.add(tasks[rr, jj], rr, np.ones(rr.size), 1, "dump_once", min_terms=2)
+    # each connected fire watched by at most one watch route
+    watch_only = sees & ~dump
+    rr, jj = np.nonzero(watch_only)
+    rows.add(cluster[rr, jj], rr, np.ones(rr.size), 1, "watch_once", min_terms=2)
+    # each search block the first task of at most one search route
+    lead = np.flatnonzero(search)
+    rows.add(tasks[lead, 0], lead, np.ones(lead.size), 1, "search_once", min_terms=2)
+    # cover[b] <= sum_r share[r, b] y_r
+    cov = sp.coo_array(cover)
+    rb, bb = cov.row.astype(np.int64), cov.col.astype(np.int64)
     rows.add(
-        np.r_[np.arange(n_z), zr],
-        np.r_[v.n_x + np.arange(n_z), cols[j]],
-        np.r_[np.ones(n_z), -np.ones(zr.size)],
-        _zeros,
-        name,
+        np.r_[np.arange(n_b), bb],
+        np.r_[n_r + np.arange(n_b), rb],
+        np.r_[np.ones(n_b), -cov.data.astype(np.float64)],
+        0,
+        "cover",
     )
+    if n_z:
+        z_col = n_r + n_b + np.arange(n_z)
+        for name, entries in (("freeze_dump", dump), ("freeze_watch", sees)):
+            rr, jj = np.nonzero(entries)
+            cl = cluster[rr, jj]
+            mine = np.isin(cl, labels)
+            pair = np.unique(np.c_[np.searchsorted(labels, cl[mine]), rr[mine]], axis=0)
+            rows.add(
+                np.r_[np.arange(n_z), pair[:, 0]],
+                np.r_[z_col, pair[:, 1]],
+                np.r_[np.ones(n_z), -np.ones(len(pair))],
+                0,
+                name,
+            )
+    mat, b = rows.matrix(n_r + n_b + n_z)
+    return mat, b, tuple(rows.fam)

@@ -1,0 +1,200 @@
+"""Tests for the MILP schedulers' settings, limits, determinism and warm start (milp, milp-cvxpy)."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import fcplan
+from fcplan.plan import validate_plan
+from fcplan.scheduling import SettingError, make_scheduler, solve
+from fcplan.taskgraph import TaskGraph
+from solvers.milp import MilpScheduler
+from solvers.milp_cvxpy import MilpCvxpyScheduler
+from solvers.milp_model import IncompletePlanError
+from solvers.milp_model import scheduler as scheduler_module
+from tests.solvers.graphs import episode_graphs as _episode_graphs
+
+NAMES = ("milp", "milp-cvxpy")
+
+
+def episode_graphs(name) -> tuple[TaskGraph, ...]:
+    return _episode_graphs(name, (0, 100, 300, 600))
+
+
+# ---------------------------------------------------------------------------------------- settings
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize(
+    ("settings", "match"),
+    [
+        ({"slots": 0}, r"bad setting slots=0: must be an integer in 1\.\.4$"),
+        ({"slots": 2.5}, r"bad setting slots=2\.5: must be an integer in 1\.\.4$"),
+        ({"time_limit": math.nan}, r"bad setting time_limit=nan: must be a finite number > 0 s$"),
+        ({"time_limit": -1}, r"bad setting time_limit=-1: must be a finite number > 0 s$"),
+        ({"time_limit": "1"}, r"bad setting time_limit=1: must be a finite number > 0 s$"),
+        ({"work_limit": 0}, r"bad setting work_limit=0: must be "),
+        ({"seed": -1}, r"bad setting seed=-1: must be an integer in 0\.\.2147483647$"),
+        ({"deterministic": "yes"}, r"bad setting deterministic=yes: must be true or false$"),
+        ({"horizon_s": math.inf}, r"bad setting horizon_s=inf: must be a finite number > 0 s$"),
+        ({"prune_confidence": 1.5}, r"prune_confidence=1\.5: must be a number in \[0, 1\]$"),
+        (
+            {"search_weight": -0.1},
+            r"bad setting search_weight=-0\.1: must be a finite number >= 0$",
+        ),
+        ({"search_altitude": math.nan}, r"search_altitude=nan: must be a finite number >= 0 m$"),
+        ({"slot": 2}, r"bad setting slot=2: unknown setting; milp(-cvxpy)? takes: deterministic, "),
+    ],
+)
+def test_bad_settings_raise_one_line_errors(name, settings, match):
+    """Settings are checked at construction: a wrong type, a value out of range or NaN raises a
+    one-line SettingError (a ValueError) naming the scheduler, the setting, its value and the
+    allowed range (unknown names too)."""
+    with pytest.raises(SettingError, match=match) as info:
+        make_scheduler(name, **settings)
+    assert "\n" not in str(info.value)
+    assert str(info.value).startswith(f"scheduler {name!r}: bad setting ")
+    assert isinstance(info.value, ValueError)
+
+
+@pytest.mark.parametrize("limit", [math.nan, -1.0])
+def test_bad_time_limit_argument_falls_back(limit):
+    """A bad ``time_limit`` passed to plan() raises, so solve() falls back to greedy and says
+    why."""
+    g = episode_graphs(1)[1]
+    with pytest.raises(ValueError, match="time_limit"):
+        MilpScheduler().plan(g, time_limit=limit)
+    plan = solve(MilpScheduler(), g, time_limit=limit, rng=np.random.default_rng(0))
+    assert plan.stats.status == "fallback" and "time_limit" in plan.stats.message
+
+
+# ---------------------------------------------------------------------------------------- determinism
+@pytest.mark.parametrize("cls", [MilpScheduler, MilpCvxpyScheduler])
+def test_deterministic_mode_gives_the_same_plans(cls):
+    """Without a time limit, two schedulers give the same plans on the same graphs (routes,
+    altitudes, objective), whatever the generator: the search stops on a work limit."""
+    for name in (1, 12, 24, "open_world_example"):
+        for g in episode_graphs(name):
+            a = cls().plan(g, time_limit=None, rng=np.random.default_rng(1))
+            b = cls().plan(g, time_limit=None, rng=np.random.default_rng(2))
+            assert dict(a.routes) == dict(b.routes)
+            assert dict(a.altitudes) == dict(b.altitudes)
+            assert a.stats.objective == b.stats.objective
+
+
+_CHILD = """
+import json, sys
+from solvers.milp import MilpScheduler
+from tests.solvers.graphs import episode_graphs
+s = MilpScheduler()
+out = [dict(s.plan(g).routes) for g in episode_graphs(24, (0, 100, 300, 600))]
+print(json.dumps(out))
+"""
+
+
+def test_deterministic_mode_is_the_same_in_another_process():
+    """A fresh process under whatever load the machine has gives the very same sequence of
+    plans (the warm start included) as this one."""
+    s = MilpScheduler()
+    here = [dict(s.plan(g).routes) for g in episode_graphs(24)]
+    here = json.loads(json.dumps(here))
+    out = subprocess.run(
+        [sys.executable, "-c", _CHILD], capture_output=True, text=True, check=True
+    ).stdout
+    assert json.loads(out) == here
+
+
+def test_warm_start_does_not_change_the_optimum():
+    """Planning a graph after its predecessors (warm start from the previous plan) reaches the
+    same objective as a fresh scheduler: the hint only speeds the search up; the previous plan
+    is forgotten when a graph from an earlier time comes (a new episode)."""
+    graphs = episode_graphs(12)
+    s = MilpScheduler()
+    for g in graphs:
+        warm = s.plan(g)
+        cold = MilpScheduler().plan(g)
+        assert warm.stats.objective == pytest.approx(cold.stats.objective, rel=1e-9)
+    assert s._previous
+    s.plan(graphs[0])
+    assert s._previous_time == graphs[0].time_s
+
+
+# ---------------------------------------------------------------------------------------- limits
+@pytest.mark.parametrize("name", NAMES)
+def test_tiny_time_limit_team_still_acts(name):
+    """With a 1e-6 s limit the scheduler has no plan; solve() falls back to greedy (status
+    'fallback', reason recorded) and the team still acts: its plan has routes whenever greedy's
+    has."""
+    sched = make_scheduler(name)
+    greedy = make_scheduler("greedy")
+    for g in episode_graphs(24) + episode_graphs("open_world_example"):
+        plan = solve(sched, g, time_limit=1e-6, rng=np.random.default_rng(0))
+        validate_plan(plan, g)
+        assert plan.stats.status == "fallback" and plan.stats.message
+        assert plan.n_assignments == greedy.plan(g, time_limit=None, rng=None).n_assignments
+        assert plan.n_assignments > 0
+
+
+@pytest.mark.parametrize("cls", [MilpScheduler, MilpCvxpyScheduler])
+def test_a_plan_cut_short_with_idle_agents_raises(cls, monkeypatch):
+    """A backend result that a limit stopped (status time_limit) and that leaves agents idle
+    with routes to fly raises IncompletePlanError; the same empty result proven optimal is a
+    decision and is returned."""
+    from fcplan.scheduling import SolveStats
+
+    g = episode_graphs(12)[1]
+    for status, raises in (("time_limit", True), ("optimal", False)):
+
+        def empty(self, model, *, limits, seed, hint, status=status):
+            return np.zeros(model.n_vars), SolveStats(status=status, objective=0.0)
+
+        monkeypatch.setattr(cls, "_solve", empty)
+        if raises:
+            with pytest.raises(IncompletePlanError, match="idle"):
+                cls().plan(g)
+        else:
+            assert cls().plan(g).routes == {}
+
+
+def test_model_building_past_the_limit_raises(monkeypatch):
+    """In wall-clock mode, when building the model uses up the limit plan() raises TimeoutError
+    (solve() then falls back) instead of overrunning."""
+    real = scheduler_module.build_milp_model
+
+    def slow(graph, params, **kw):
+        time.sleep(0.05)
+        return real(graph, params, **kw)
+
+    monkeypatch.setattr(scheduler_module, "build_milp_model", slow)
+    with pytest.raises(TimeoutError):
+        MilpScheduler().plan(episode_graphs(12)[1], time_limit=0.02)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_wall_clock_limit_is_kept(name):
+    """With a 50 ms wall-clock limit every call on real graphs returns a plan or a fallback, and
+    the scheduler's own call stays within the limit plus 10 % and 5 ms, or raised (timings
+    are checked loosely here; bench/bench_milp.py measures them)."""
+    sched = make_scheduler(name)
+    for g in episode_graphs(24) + episode_graphs(12):
+        t0 = time.perf_counter()
+        with contextlib.suppress(IncompletePlanError, TimeoutError):
+            sched.plan(g, time_limit=0.05)
+        assert time.perf_counter() - t0 < 5.0  # generous: the machine may be loaded
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_episode_completes_and_prunes_fire(name):
+    """A whole episode of scenario #1 runs with the scheduler, and the team puts fire out."""
+    result = fcplan.run_episode(1, name, seed=0)
+    assert result.ticks == fcplan.load_scenario(1).n_ticks
+    assert len(result.solves) > 0
+    assert result.trace.pruned[-1] > 0
+    assert result.metrics["manual"].overall_firefighting > 0
+    assert any(s.status == "optimal" for s in result.solves)
