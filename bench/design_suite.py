@@ -6,10 +6,11 @@ the knobs changed from it and the generator seeds of the tier's scenarios. Three
 ``screen``
     Plays candidate scenarios (generator seeds ``--candidates``) with screening episode seeds
     (``--seeds``, kept apart from the seeds the tier is measured on) and rejects the degenerate
-    ones, by a rule that looks at no scheduler's rank: *saturated* (every policy ends every
-    screening episode with OFS 100 %) or *futile* (even the oracle keeps the negative reward ratio
-    at 95 % or more on every seed: nothing can be done). It prints the first ``--keep`` seeds
-    that pass, to copy into the design file.
+    ones, by a rule that looks at no scheduler's rank: *saturated* (every policy played ends
+    every screening episode with OFS 100 %) or *futile* (even the oracle keeps the negative
+    reward ratio at 95 % or more on every seed: nothing can be done). By default the policy
+    played is greedy alone (the cheapest; a scenario greedy clears is one a benchmark does not
+    need). It prints the first ``--keep`` seeds that pass, to copy into the design file.
 ``freeze``
     Writes the design file's tiers into ``fcplan/data/suites/<suite>/`` (the TOML files and
     ``manifest.json``, :func:`fcplan.scenario.suite.write_suite`).
@@ -27,11 +28,11 @@ machine's load; the load average is printed beside every timing.
 
 Usage::
 
-    python bench/design_suite.py screen bench/suite_v1.toml --tier hard --candidates 0-29 \\
-        --seeds 100-101 --results results/screen-hard --jobs 2
+    python bench/design_suite.py screen bench/suite_v1.toml --tier hard --candidates 0-15 \\
+        --seeds 100-101 --results bench/results/screen-hard --jobs 2
     python bench/design_suite.py freeze bench/suite_v1.toml
-    python bench/design_suite.py measure --tier hard --seeds 0-9 --results results/bench-v1 \\
-        --jobs 2 --json results/hard.json --csv results/hard.csv
+    python bench/design_suite.py measure --tier hard --seeds 0-9 --results bench/results/bench-v1 \\
+        --jobs 2 --json bench/results/hard.json --csv bench/results/hard.csv
 """
 
 from __future__ import annotations
@@ -217,6 +218,7 @@ def main(argv: list[str] | None = None) -> None:
     common.add_argument("--json", help="also write the numbers as JSON")
     common.add_argument("--quiet", action="store_true", help="no progress lines")
     s = sub.add_parser("screen", parents=[common], help="reject degenerate candidates")
+    s.set_defaults(schedulers="greedy,oracle,idle")
     s.add_argument("design")
     s.add_argument("--tier", required=True)
     s.add_argument("--candidates", type=parse_range, required=True, help="generator seeds")

@@ -29,6 +29,7 @@ from types import FrameType
 
 import fcplan.cli.compare as compare
 import fcplan.cli.import_legacy as import_legacy
+import fcplan.cli.leaderboard as leaderboard
 import fcplan.cli.play as play
 import fcplan.cli.replay as replay
 import fcplan.cli.report as report
@@ -47,7 +48,9 @@ MAX_MESSAGE = 1000
 #: The command modules, in the order ``fcplan --help`` lists them. Each defines
 #: ``add_parser(sub)``, which adds its parser to the sub-parsers ``sub`` (built with
 #: ``parser_class=fcplan.cli.util.Parser``) and sets ``run=<function(args) -> int>`` as a default.
-COMMANDS = (scenarios, scenario, run, compare, play, sweep, report, replay, import_legacy)
+COMMANDS = (
+    scenarios, scenario, run, compare, play, sweep, report, leaderboard, replay, import_legacy,
+)  # fmt: skip
 
 #: The names of the :data:`COMMANDS` modules.
 COMMAND_MODULES: tuple[str, ...] = tuple(m.__name__ for m in COMMANDS)

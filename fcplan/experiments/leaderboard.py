@@ -76,6 +76,7 @@ __all__ = [
     "fraction_of_oracle",
     "is_policy",
     "leaderboard",
+    "metric_direction",
     "read_episodes",
     "tier_of",
 ]
@@ -91,6 +92,27 @@ BOOTSTRAP_DRAWS = 2000
 _OFS = "manual.overall_firefighting"
 _TTC = "outcome.time_to_containment_s"
 _BURNED = "outcome.burned_area_cells"
+
+
+def metric_direction(metric: str) -> tuple[str, int, bool]:
+    """Label, decimals and whether higher is better for a result column: a metric
+    (``manual.final_score``), an outcome (``outcome.burned_area_cells``) or another column.
+
+    Examples
+    --------
+    >>> metric_direction("outcome.burned_area_cells"), metric_direction("manual.final_score")
+    (('burned area', 0, False), ('final score', 1, True))
+    """
+    from fcplan.metrics import metric_spec
+
+    prefix, _, name = metric.partition(".")
+    if prefix in ("outcome", "manual", "reference2020"):
+        try:
+            spec = metric_spec(name)
+            return spec.label, spec.decimals, spec.higher_is_better
+        except FcplanError:
+            pass
+    return metric, 2, higher_is_better(metric)
 
 
 def is_policy(label: str) -> bool:
@@ -295,7 +317,7 @@ def fraction_of_oracle(
     Examples
     --------
     >>> f, (lo, hi), med = fraction_of_oracle([5, 6, 7, 8], [10, 10, 10, 10], [0, 0, 0, 0])
-    >>> f, lo <= f <= hi, med
+    >>> f, lo <= f <= hi, round(med, 3)
     (0.65, True, 0.65)
     """
     s, o, z = (np.asarray(x, np.float64) for x in (score, oracle, idle))
@@ -352,7 +374,7 @@ def _cleared(rows: list[dict[str, Any]], scenarios: list[str]) -> int:
     n = 0
     for sc in scenarios:
         ofs = [r.get(_OFS) for r in rows if r["scenario"] == sc]
-        n += bool(ofs) and all(finite(v) and float(v) >= 100.0 for v in ofs)
+        n += bool(ofs) and all(finite(v) and float(v or 0.0) >= 100.0 for v in ofs)
     return n
 
 
@@ -436,7 +458,7 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
                             metric, scenarios, refs)
         for k in labels if by[k]
     }  # fmt: skip
-    sign = 1.0 if higher_is_better(metric) else -1.0
+    sign = 1.0 if metric_direction(metric)[2] else -1.0
     policies = sorted((k for k in stats if is_policy(k)), key=lambda k: -sign * stats[k].mean.mean)
     others = [k for k in stats if not is_policy(k)]
     order = policies + sorted(others, key=lambda k: (k != ORACLE, not k.startswith(ORACLE), k))

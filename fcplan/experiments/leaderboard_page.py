@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import datetime as _dt
 
-from fcplan.errors import FcplanError
 from fcplan.experiments.leaderboard import (
     HOLM_LEVEL,
     IDLE,
@@ -32,8 +31,8 @@ from fcplan.experiments.leaderboard import (
     TierResult,
     finite,
     is_policy,
+    metric_direction,
 )
-from fcplan.experiments.tables import higher_is_better
 
 __all__ = ["markdown"]
 
@@ -133,16 +132,9 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
 
 def markdown(board: Leaderboard, command: str = "") -> str:
     """The leaderboard page (``docs/leaderboard.md``); ``command`` is how it was made."""
-    from fcplan.metrics import metric_spec
-
     m = board.meta
-    definition, _, name = board.metric.partition(".")
-    try:
-        spec = metric_spec(name)
-        label, digits = spec.label, spec.decimals
-    except FcplanError:
-        label, digits = board.metric, 2
-    direction = "higher" if higher_is_better(board.metric) else "lower"
+    label, digits, higher = metric_direction(board.metric)
+    direction = "higher" if higher else "lower"
     libs = "; ".join(", ".join(f"{k} {v}" for k, v in sorted(d.items())) for d in m["libraries"])
     modes = {s.deterministic for t in board.tiers for s in t.stats.values()}
     made = _dt.date.today().isoformat()

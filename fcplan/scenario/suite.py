@@ -23,8 +23,8 @@ manifest field         meaning
 ``scenarios``          one record per file, in order: ``name`` (``"hard-01"``), ``tier``,
                        ``file``, ``seed``, ``preset`` (the preset the call started from),
                        ``overrides`` (knobs changed from that preset), ``knobs`` (every knob's
-                       value: the exact call), ``wind_model`` (stated in the file too, so that
-                       a change of the format's default cannot change the suite) and
+                       value: the exact call), ``wind_model`` (recorded, so that a change of the
+                       format's default cannot change the suite) and
                        ``sha256`` of the file's bytes
 =====================  ==========================================================================
 
@@ -80,6 +80,7 @@ __all__ = [
     "SuiteEntry",
     "freeze_entry",
     "load_suite",
+    "read_suite",
     "suite_of",
     "suite_scenario_path",
     "suite_versions",
@@ -113,14 +114,14 @@ class SuiteEntry:
     preset : str
         The preset the call started from (informative; ``knobs`` is what counts).
     overrides : dict
-        The knobs changed from that preset when the suite was frozen.
+        The knobs changed from that preset when the suite was frozen (normalised values).
     file : str
         File name inside the suite's folder.
     sha256 : str
         Hex digest of the file's bytes.
     wind_model : str
-        The fire's wind model, written in the file even when it is the format's default (a
-        default that changes must not change a frozen scenario).
+        The fire's wind model (recorded, so that a change of the format's default cannot change
+        how the suite's scenarios are drawn again).
     """
 
     suite: str
@@ -155,14 +156,8 @@ class SuiteEntry:
         )
 
     def text(self) -> str:
-        """The TOML text of :meth:`build` (what the frozen file holds), the wind model stated."""
-        s = self.build()
-        text = dump_scenario(s)
-        if "\nwind_model = " not in text:  # dump_scenario leaves the default out
-            head = "\n[fire]\nmode = "
-            end = text.index("\n", text.index(head) + len(head)) + 1
-            text = f'{text[:end]}wind_model = "{s.wind_model}"\n{text[end:]}'
-        return text
+        """The TOML text of :meth:`build` (what the frozen file holds)."""
+        return dump_scenario(self.build())
 
     def to_dict(self) -> dict[str, Any]:
         """The manifest record (JSON-ready; tuples become lists)."""
@@ -247,7 +242,16 @@ def _manifest_error(folder: Path, problem: str) -> ScenarioError:
     return ScenarioError("manifest", problem, source=str(folder / MANIFEST))
 
 
-def _read_manifest(folder: Path) -> Suite:
+def read_suite(folder: str | os.PathLike[str]) -> Suite:
+    """The suite stored in ``folder`` (named after its version), e.g. one :func:`write_suite`
+    wrote.
+
+    Raises
+    ------
+    ScenarioError
+        A missing or malformed manifest (one line naming it).
+    """
+    folder = Path(folder)
     try:
         doc = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
@@ -258,22 +262,23 @@ def _read_manifest(folder: Path) -> Suite:
     entries = []
     for i, rec in enumerate(doc.get("scenarios", [])):
         try:
+            knobs = GeneratorConfig(**rec["knobs"]).as_dict()  # normalised: ranges as tuples
             entries.append(
                 SuiteEntry(
                     suite=version,
                     name=rec["name"],
                     tier=rec["tier"],
                     seed=int(rec["seed"]),
-                    knobs=dict(rec["knobs"]),
+                    knobs=knobs,
                     preset=rec.get("preset", "default"),
-                    overrides=dict(rec.get("overrides", {})),
+                    overrides={k: knobs[k] for k in rec.get("overrides", {})},
                     file=rec["file"],
                     sha256=rec.get("sha256", ""),
                     wind_model=rec["wind_model"],
                 )
             )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise _manifest_error(folder, f"scenarios[{i}]: bad record ({exc!r})") from None
+        except (KeyError, TypeError, ValueError) as exc:  # ScenarioError is a ValueError
+            raise _manifest_error(folder, f"scenarios[{i}]: bad record ({exc})") from None
     return Suite(
         version=version,
         folder=folder,
@@ -308,7 +313,7 @@ def load_suite(version: str = SUITE_VERSION) -> Suite:
     if version not in suite_versions():
         known = ", ".join(suite_versions()) or "none"
         raise UnknownNameError(f"unknown benchmark suite {version!r}; shipped suites: {known}")
-    return _read_manifest(_DATA / version)
+    return read_suite(_DATA / version)
 
 
 def suite_of(scenario_name: str) -> str | None:
@@ -348,15 +353,16 @@ def freeze_entry(
     Examples
     --------
     >>> e = freeze_entry("my-bench-v1", "tiny-01", "tiny", 4, n_regions=1, duration_s=60)
-    >>> e.file, e.overrides, e.knobs["n_regions"], e.build().name
-    ('tiny-01.toml', {'n_regions': 1, 'duration_s': 60}, (1, 1), 'my-bench-v1/tiny-01')
+    >>> e.file, e.overrides, e.build().name
+    ('tiny-01.toml', {'n_regions': (1, 1), 'duration_s': 60.0}, 'my-bench-v1/tiny-01')
     """
     if not _VERSION.match(suite) or not _NAME.match(name):
         raise ValueError(f"suite must look like 'name-v1' and name like 'tier-01': {suite}, {name}")
     if preset not in PRESETS:
         raise ValueError(f"unknown preset {preset!r}")
     knobs = GeneratorConfig.preset(preset, **overrides).as_dict()
-    entry = SuiteEntry(suite, name, tier, int(seed), knobs, preset, dict(overrides), f"{name}.toml")
+    changed = {k: knobs[k] for k in overrides}
+    entry = SuiteEntry(suite, name, tier, int(seed), knobs, preset, changed, f"{name}.toml")
     digest = hashlib.sha256(entry.text().encode("utf-8")).hexdigest()
     return dataclasses.replace(entry, sha256=digest)
 
