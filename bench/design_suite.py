@@ -31,8 +31,11 @@ Usage::
     python bench/design_suite.py screen bench/suite_v1.toml --tier hard --candidates 0-15 \\
         --seeds 100-101 --results bench/results/screen-hard --jobs 2
     python bench/design_suite.py freeze bench/suite_v1.toml
-    python bench/design_suite.py measure --tier hard --seeds 0-9 --results bench/results/bench-v1 \\
-        --jobs 2 --json bench/results/hard.json --csv bench/results/hard.csv
+    python bench/design_suite.py measure --tier hard --sweep bench/suite_v1_hard.toml \\
+        --results bench/results/bench-v1 --jobs 2 --json bench/results/hard.json
+
+(``--sweep bench/suite_v1_hard.toml`` plays the leaderboard's own sweep: the same episodes as
+``fcplan sweep bench/suite_v1_hard.toml``, stored under the same keys.)
 """
 
 from __future__ import annotations
@@ -49,11 +52,11 @@ from typing import Any
 
 import numpy as np
 
-from fcplan.experiments import sweep
+from fcplan.experiments import load_sweep_config, sweep
 from fcplan.experiments.leaderboard import finite, is_policy, leaderboard
 from fcplan.experiments.leaderboard_page import markdown
 from fcplan.experiments.ranges import parse_range
-from fcplan.scenario import GeneratorConfig, Scenario
+from fcplan.scenario import GeneratorConfig, Scenario, load_scenario
 from fcplan.scenario.suite import freeze_entry, load_suite, write_suite
 
 SCHEDULERS = "greedy,routing,milp,cbba,oracle,idle"
@@ -79,15 +82,20 @@ def candidates(tier: dict[str, Any], seeds: list[int]) -> list[Scenario]:
 
 
 def play(scenarios: list[Any], args: argparse.Namespace) -> list[dict[str, Any]]:
-    """Every (scenario, scheduler, seed) episode, stored in (and resumed from) ``args.results``."""
+    """Every (scenario, scheduler, seed) episode, stored in (and resumed from) ``args.results``:
+    the sweep file ``args.sweep`` if given, else ``scenarios`` x ``args.schedulers`` x
+    ``args.seeds``."""
+    config: Any = {
+        "scenarios": scenarios,
+        "schedulers": args.schedulers.split(","),
+        "seeds": args.seeds,
+    }
+    if getattr(args, "sweep", None):
+        config = load_sweep_config(args.sweep)
+        scenarios, args.seeds = list(config.scenarios), list(config.seeds)
     load0 = os.getloadavg()[0]
     t0 = time.perf_counter()
-    summary = sweep(
-        {"scenarios": scenarios, "schedulers": args.schedulers.split(","), "seeds": args.seeds},
-        args.results,
-        jobs=args.jobs,
-        progress=not args.quiet,
-    )
+    summary = sweep(config, args.results, jobs=args.jobs, progress=not args.quiet)
     wall = time.perf_counter() - t0
     print(
         f"# {summary.total} episodes ({summary.skipped} stored before, {summary.ran} now, "
@@ -95,7 +103,7 @@ def play(scenarios: list[Any], args: argparse.Namespace) -> list[dict[str, Any]]
         f"workers; load average {load0:.1f} at the start, {os.getloadavg()[0]:.1f} at the end",
         flush=True,
     )
-    names = {s.name if isinstance(s, Scenario) else s for s in scenarios}
+    names = {s.name if isinstance(s, Scenario) else load_scenario(s).name for s in scenarios}
     rows = summary.load().to_dict("records")
     return [r for r in rows if r["scenario"] in names and r["seed"] in set(args.seeds)]
 
@@ -230,6 +238,7 @@ def main(argv: list[str] | None = None) -> None:
     m.add_argument("--design", help="measure the design's candidates instead of the frozen tier")
     m.add_argument("--candidates", type=parse_range, default=None, help="generator seeds")
     m.add_argument("--csv", help="also write the tables as CSV")
+    m.add_argument("--sweep", help="play this sweep file (its scenarios, schedulers and seeds)")
     args = ap.parse_args(argv)
     if args.command == "measure":
         args.tier_of_design = args.design is not None

@@ -200,6 +200,8 @@ class TierResult:
     order: list[str]
     pairs: list[PairedComparison]
     check: TierCheck
+    settings: dict[str, str] = field(default_factory=dict)
+    """Scheduler label -> its settings as recorded in the results (``key=value, ...``)."""
 
 
 @dataclass
@@ -223,6 +225,7 @@ class Leaderboard:
                         "scenarios": t.scenarios,
                         "seeds": t.seeds,
                         "order": t.order,
+                        "settings": t.settings,
                         "stats": {k: _stats_dict(v) for k, v in t.stats.items()},
                         "pairs": [_pair_dict(c) for c in t.pairs],
                         "check": {
@@ -480,7 +483,18 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
         order=order,
         pairs=pairs,
         check=_check(stats, pairs, scenarios),
+        settings={k: _settings(by[k]) for k in order if _settings(by[k])},
     )
+
+
+def _settings(rows: list[dict[str, Any]]) -> str:
+    """The scheduler settings the rows recorded (JSON text in sweep results), as text."""
+    texts = {r.get("settings") for r in rows if isinstance(r.get("settings"), str)}
+    out = []
+    for text in sorted(t for t in texts if t):
+        doc = json.loads(text)
+        out.append(", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(doc.items())))
+    return "; ".join(o for o in out if o)
 
 
 def _meta(rows: list[dict[str, Any]], wall: float | None) -> dict[str, Any]:

@@ -100,6 +100,9 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
         rank += is_policy(k)
         r = str(rank) if is_policy(k) else "ref" if k.startswith(ORACLE) else "base"
         out.append(_row(r, k, t.stats[k], len(t.scenarios), digits))
+    if t.settings:
+        text = "; ".join(f"{k}: {v}" for k, v in t.settings.items())
+        out += ["", f"Scheduler settings: {text}."]
     if t.pairs:
         n = t.pairs[0].diff.n
         out += [
