@@ -52,6 +52,10 @@ def _span(seeds: list[int]) -> str:
     return ",".join(map(str, seeds))
 
 
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
 def _num(v: float, digits: int) -> str:
     return "n/a" if not finite(v) else f"{v:,.{digits}f}"
 
@@ -89,7 +93,8 @@ def _row(rank: str, name: str, s: SchedulerStats, n_scen: int, digits: int) -> s
 def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
     name = f"{t.suite}/{t.tier}" if t.suite else "other scenarios"
     out = [
-        f"## Tier `{name}`: {len(t.scenarios)} scenarios x {len(t.seeds)} seeds ({_span(t.seeds)})",
+        f"## Tier `{name}`: {_count(len(t.scenarios), 'scenario')} x "
+        f"{_count(len(t.seeds), 'seed')} ({_span(t.seeds)})",
         "",
         f"| # | scheduler | {label} (mean ± 95 % CI) | fraction of oracle [95 % CI] | OFS % "
         "| cleared | containment s | burned cells | solve p50 / p95 ms | fallbacks / replans |",
@@ -123,9 +128,14 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
     top = {None: "no oracle episodes", True: "yes", False: "**no**"}[c.oracle_top]
     out += [
         "",
-        f"Tier check (issue 12): policies {'separated' if c.separated else '**not separated**'} "
-        f"(not all within each other's 95 % intervals); OFS 100 % on every scenario: "
-        f"{', '.join(c.cleared_all) or 'none'}; pairs with Holm p < 0.01: {c.resolved} of "
+        "Tier check (issue 12): policies "
+        + (
+            "separated (not all within each other's 95 % intervals)"
+            if c.separated
+            else "**not separated** (every mean inside every other's 95 % interval)"
+        )
+        + "; OFS 100 % on every scenario: "
+        + f"{', '.join(c.cleared_all) or 'none'}; pairs with Holm p < 0.01: {c.resolved} of "
         f"{c.pairs}; oracle mean at least every policy's: {top}. "
         f"**{'Accepted' if c.accepted else 'Kept' if c.keep else 'Not kept'}.**",
         "",

@@ -198,11 +198,11 @@ def knob_table(cls: Any) -> str:
     ... class Settings:
     ...     size: int | tuple[int, int] = knob((4, 4), "irange", 1, 10, doc="cells (range)")
     >>> print(knob_table(Settings))
-    ======  =======  =======  =============
-    knob    default  allowed  meaning
-    ======  =======  =======  =============
-    size    4        1..10    cells (range)
-    ======  =======  =======  =============
+    ====  =======  =======  =============
+    knob  default  allowed  meaning
+    ====  =======  =======  =============
+    size  4        1..10    cells (range)
+    ====  =======  =======  =============
     """
     rows = [("knob", "default", "allowed", "meaning")]
     rows += [(n, _cell(d), k.short(), k.doc) for n, (k, d) in knobs_of(cls).items()]

@@ -34,7 +34,7 @@ def test_prints_the_page(results, capsys):
     assert main(["leaderboard", str(results)]) == 0
     out = capsys.readouterr().out
     assert out.startswith("# Leaderboard") and f"`fcplan leaderboard {results}`" in out
-    assert "## Tier `fcplan-bench-v1/hard`: 1 scenarios x 2 seeds" in out
+    assert "## Tier `fcplan-bench-v1/hard`: 1 scenario x 2 seeds" in out
 
 
 def test_writes_the_page_and_the_numbers(results, tmp_path, capsys):
