@@ -174,7 +174,7 @@ class TierCheck:
     """Policy pairs with Holm-adjusted p < 0.01."""
     pairs: int
     oracle_top: bool | None
-    """The oracle's mean is at least every policy's (None without oracle episodes)."""
+    """The oracle's mean is at least as good as every policy's (None without oracle episodes)."""
 
     @property
     def keep(self) -> bool:
@@ -398,10 +398,11 @@ def _scheduler_stats(
             and (r["scenario"], int(r["seed"])) in refs[IDLE]
         ]
         mine = {(r["scenario"], int(r["seed"])): float(r[metric]) for r in rows}
+        sign = 1.0 if metric_direction(metric)[2] else -1.0  # lower is better: negate
         frac = fraction_of_oracle(
-            [mine[k] for k in keys],
-            [refs[ORACLE][k] for k in keys],
-            [refs[IDLE][k] for k in keys],
+            [sign * mine[k] for k in keys],
+            [sign * refs[ORACLE][k] for k in keys],
+            [sign * refs[IDLE][k] for k in keys],
             strata=[k[0] for k in keys],
         )
     flags = {bool(r["deterministic"]) for r in rows if isinstance(r.get("deterministic"), bool)}
@@ -425,7 +426,10 @@ def _scheduler_stats(
 
 
 def _check(
-    stats: dict[str, SchedulerStats], pairs: list[PairedComparison], scenarios: list[str]
+    stats: dict[str, SchedulerStats],
+    pairs: list[PairedComparison],
+    scenarios: list[str],
+    sign: float,
 ) -> TierCheck:
     policies = tuple(k for k in stats if is_policy(k))
     cis = {k: stats[k].mean for k in policies}
@@ -435,7 +439,7 @@ def _check(
     oracles = [k for k in stats if k == ORACLE]
     top = None
     if oracles and policies:
-        top = all(stats[ORACLE].mean.mean >= cis[k].mean for k in policies)
+        top = all(sign * (stats[ORACLE].mean.mean - cis[k].mean) >= 0 for k in policies)
     return TierCheck(
         policies=policies,
         separated=len(policies) > 1 and not inside,
@@ -482,7 +486,7 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
         stats=stats,
         order=order,
         pairs=pairs,
-        check=_check(stats, pairs, scenarios),
+        check=_check(stats, pairs, scenarios, sign),
         settings={k: _settings(by[k]) for k in order if _settings(by[k])},
     )
 

@@ -208,3 +208,17 @@ def test_compare_json_gives_the_same_tier(tmp_path):
     t = board.tiers[0]
     assert (t.suite, t.tier, t.order) == ("fcplan-bench-v1", "hard", ["greedy", "idle"])
     assert board.meta["wall_time_s"] == pytest.approx(result.wall_time_s)
+
+
+def test_lower_is_better_metrics_rank_and_normalise_the_other_way():
+    """On a lower-is-better metric (burned area) the smallest mean ranks first, the fraction of
+    the oracle is still 1 for the oracle's values and 0 for idle's, and the oracle on top means
+    lowest."""
+    rows = _rows({"a": [300.0] * 4, "b": [200.0] * 4, "oracle": [100.0] * 4, "idle": [500.0] * 4})
+    for r in rows:
+        r["outcome.burned_area_cells"] = r["manual.final_score"]
+    t = leaderboard(rows, metric="outcome.burned_area_cells").tiers[0]
+    assert t.order[:2] == ["b", "a"]
+    assert t.stats["b"].fraction == pytest.approx(0.75)
+    assert t.stats["oracle"].fraction == pytest.approx(1.0)
+    assert t.check.oracle_top is True
