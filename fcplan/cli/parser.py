@@ -36,6 +36,7 @@ from types import FrameType
 
 import fcplan.cli.compare as compare
 import fcplan.cli.import_legacy as import_legacy
+import fcplan.cli.leaderboard as leaderboard
 import fcplan.cli.play as play
 import fcplan.cli.replay as replay
 import fcplan.cli.report as report
@@ -64,6 +65,7 @@ COMMANDS = (
     play,
     sweep,
     report,
+    leaderboard,
     replay,
     import_legacy,
 )

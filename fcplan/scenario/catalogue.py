@@ -3,8 +3,10 @@
 Scenarios ship in the ``scenarios/`` folder, installed as the ``fcplan.scenarios`` package data:
 ``practice.toml``, ``01.toml``..``24.toml`` (the manual's pre-designed scenarios #1..#24) and
 open-world examples. A scenario is named by its number (``12``, ``"12"``, ``"#12"``, ``"01"``; 0
-is practice) or by its file's stem (``"practice"``, ``"scale_example"``); anything that looks like
-a path (ending in ``.toml`` or holding a path separator) is a file of the user's own.
+is practice) or by its file's stem (``"practice"``, ``"scale_example"``). The benchmark suites'
+scenarios (:mod:`fcplan.scenario.suite`) are named ``"hard-01"`` (in the current suite) or
+``"fcplan-bench-v1/hard-01"`` (fully qualified). Anything else that looks like a path (ending in
+``.toml`` or holding a path separator) is a file of the user's own.
 
 Examples
 --------
@@ -12,6 +14,10 @@ Examples
 ['practice', '1', '2']
 >>> scenario_path("#7") == scenario_path(7) == scenario_path("07")
 True
+>>> scenario_path("hard-01") == scenario_path("fcplan-bench-v1/hard-01")
+True
+>>> list_scenarios(suites=True)[-1]
+'fcplan-bench-v1/scale-06'
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from fcplan.errors import UnknownNameError
+from fcplan.scenario.suite import load_suite, suite_scenario_path, suite_versions
 from fcplan.scenario.validate import is_integer
 
 __all__ = ["list_scenarios", "scenario_path"]
@@ -54,22 +61,29 @@ def _shipped() -> dict[str, Path]:
     return out
 
 
-def list_scenarios() -> list[str]:
-    """Names of the shipped scenarios, in order: practice, 1..24, then the examples.
+def list_scenarios(*, suites: bool = False) -> list[str]:
+    """Names of the shipped scenarios, in order: practice, 1..24, then the examples; with
+    ``suites``, then every benchmark suite's scenarios (fully qualified, oldest suite first).
 
     Examples
     --------
     >>> names = list_scenarios()
     >>> names[0], names[1], names[24], names[25:]
     ('practice', '1', '24', ['open_world_example', 'scale_example'])
+    >>> list_scenarios(suites=True)[27]
+    'fcplan-bench-v1/hard-01'
     """
-    return list(_shipped())
+    names = list(_shipped())
+    if suites:
+        for version in suite_versions():
+            names += load_suite(version).names()
+    return names
 
 
 def scenario_path(name: str | int | os.PathLike[str]) -> Path:
     """File of a scenario given by name (``"12"``, ``12``, ``"#12"``, ``"01"``, ``"practice"``,
-    ``"scale_example"``) or by path (anything path-like, ending in ``.toml`` or containing a
-    path separator).
+    ``"scale_example"``, ``"hard-01"``, ``"fcplan-bench-v1/hard-01"``) or by path (anything
+    path-like, ending in ``.toml`` or containing a path separator).
 
     Raises
     ------
@@ -83,6 +97,10 @@ def scenario_path(name: str | int | os.PathLike[str]) -> Path:
     """
     if isinstance(name, os.PathLike):
         return Path(name)
+    if isinstance(name, str) and not name.endswith(".toml"):
+        in_suite = suite_scenario_path(name)
+        if in_suite is not None:
+            return in_suite
     if isinstance(name, str) and (name.endswith(".toml") or "/" in name or os.sep in name):
         return Path(name)
     key: Any = name
@@ -96,6 +114,9 @@ def scenario_path(name: str | int | os.PathLike[str]) -> Path:
     if isinstance(key, str) and key in shipped:
         return shipped[key]
     known = ", ".join(shipped)
+    for version in suite_versions():
+        for entries in load_suite(version).tiers().values():
+            known += f", {version}/{entries[0].name}..{entries[-1].name}"
     raise UnknownNameError(
         f"unknown scenario {name!r}; known scenarios: {known} (or the path of a .toml file)"
     )

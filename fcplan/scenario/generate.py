@@ -113,47 +113,47 @@ class GeneratorConfig:
     speeds px per tick at 10 ticks/s and batteries the manual's units, as in
     :class:`~fcplan.scenario.model.AgentSpec`.
 
-    ==========================  ================  ===================  ===========================
-    knob                        default           allowed              meaning
-    ==========================  ================  ===================  ===========================
-    world_size                  1200              800..10000 (x100)    map side (range)
-    duration_s                  180               1..36000             episode length
-    ticks_per_second            10                1..100               simulation rate
-    n_regions                   (1, 4)            1..500               fire regions (range)
-    region_placement            "uniform"         PLACEMENTS           where regions go
-    n_clusters                  (1, 2)            1..100               clusters (range)
-    cluster_radius_px           300               50..10000            cluster radius
-    min_depot_distance_px       300               0..10000             regions this far from depot
-    far_fraction                0.5               0..0.95              share of the farthest distance
-    late_share                  0                 0..1                 share of regions igniting late
-    late_delay_s                (60, 120)         0..36000             late ignition delay (range)
-    fronts                      (3, 8)            1..1000              fronts per region (range)
-    fuel                        (3, 15)           (0, 100]             fuel coefficient (range)
-    wind_speed                  (2, 8)            0..50                m/s (range)
-    wind_dir_deg                (0, 360)          0..360               degrees (range)
-    fire_mode                   "specific"        specific, uniform    per-region or shared values
-    depot_orientation           "any"             any, vertical, ...   depot shape
-    n_houses                    (1, 3)            0..500               houses (range)
-    n_hospitals                 (0, 1)            0..500               hospitals (range)
-    n_power_stations            (0, 1)            0..500               power stations (range)
-    facility_fire_distance_px   (150, 500)        0..20000             facility to nearest region
-    house_penalty               1                 0..1000              penalty coefficient
-    hospital_penalty            2                 0..1000              penalty coefficient
-    power_station_penalty       5                 0..1000              penalty coefficient
-    depot_penalty               5                 0..1000              penalty coefficient
-    n_lakes                     (0, 1)            0..100               decorative lakes (range)
-    n_perception                (2, 3)            0..500               perception agents (range)
-    n_action                    (2, 3)            0..500               action agents (range)
-    n_hybrid                    (0, 0)            0..500               hybrid agents (range)
-    speed                       (20, 20)          (0, 500]             per agent (range)
-    battery                     (500, 500)        (0, 1e6]             per agent (range)
-    tank                        (10, 10)          1..1000              dumps per sortie (range)
-    perception_altitude         (10, 100)         (0, 1000]            altitude bounds [lo, hi]
-    hybrid_altitude             (10, 100)         (0, 1000]            bounds, lo <= 20 <= hi
-    action_prune_confidence     (0.9, 0.9)        (0, 1]               per agent (range)
-    hybrid_prune_confidence     (0.8, 0.8)        (0, 1]               per agent (range)
-    comm_range                  None              (0, 1e6] or None     communication range
-    ==========================  ================  ===================  ===========================
+    =========================  ==========  =========================  ==============================
+    knob                       default     allowed                    meaning
+    =========================  ==========  =========================  ==============================
+    world_size                 1200        800..10000 (x100)          map side, px (range)
+    duration_s                 180         1..36000                   episode length, s
+    ticks_per_second           10          1..100                     simulation rate, Hz
+    n_regions                  (1, 4)      1..500                     fire regions (range)
+    region_placement           'uniform'   uniform, clustered, far    where regions go
+    n_clusters                 (1, 2)      1..100                     region clusters (range)
+    cluster_radius_px          300         50..10000                  cluster radius, px
+    min_depot_distance_px      300         0..10000                   min region-depot distance, px
+    far_fraction               0.5         0..0.95                    far: share of max distance
+    late_share                 0           0..1                       share of regions igniting late
+    late_delay_s               (60, 120)   0..36000                   late ignition delay, s (range)
+    fronts                     (3, 8)      1..1000                    fronts per region (range)
+    fuel                       (3, 15)     (0, 100]                   fuel coefficient (range)
+    wind_speed                 (2, 8)      0..50                      wind speed, m/s (range)
+    wind_dir_deg               (0, 360)    0..360                     wind direction, deg (range)
+    fire_mode                  'specific'  uniform, specific          per-region or shared values
+    depot_orientation          'any'       any, vertical, horizontal  depot shape
+    n_houses                   (1, 3)      0..500                     houses (range)
+    n_hospitals                (0, 1)      0..500                     hospitals (range)
+    n_power_stations           (0, 1)      0..500                     power stations (range)
+    facility_fire_distance_px  (150, 500)  0..20000                   facility to nearest region, px
+    house_penalty              1           0..1000                    penalty of a house
+    hospital_penalty           2           0..1000                    penalty of a hospital
+    power_station_penalty      5           0..1000                    penalty of a power station
+    depot_penalty              5           0..1000                    penalty of the depot
+    n_lakes                    (0, 1)      0..100                     decorative lakes (range)
+    n_perception               (2, 3)      0..500                     perception agents (range)
+    n_action                   (2, 3)      0..500                     action agents (range)
+    n_hybrid                   0           0..500                     hybrid agents (range)
+    speed                      20          (0, 500]                   speed, px per tick (range)
+    battery                    500         (0, 1e6]                   battery (range)
+    tank                       10          1..1000                    dumps per sortie (range)
+    perception_altitude        (10, 100)   (0, 1000]                  perception altitude bounds, m
+    hybrid_altitude            (10, 100)   (0, 1000]                  hybrid altitude bounds, m
+    action_prune_confidence    0.9         (0, 1]                     action confidence (range)
+    hybrid_prune_confidence    0.8         (0, 1]                     hybrid confidence (range)
+    comm_range                 None        (0, 1e6] or None           communication range, px
+    =========================  ==========  =========================  ==============================
 
     Knobs are also checked together: the team must always be able to sense (``n_perception[0] +
     n_hybrid[0] >= 1``) and act (``n_action[0] + n_hybrid[0] >= 1``), and hybrids prune at exactly
@@ -170,43 +170,73 @@ class GeneratorConfig:
     (8, 40)
     """
 
-    world_size: IntRange = knob((1200, 1200), "irange", 800, 10_000, step=100)
-    duration_s: float = knob(180.0, "float", 1, 36_000)
-    ticks_per_second: int = knob(10, "int", 1, 100)
-    n_regions: IntRange = knob((1, 4), "irange", 1, 500)
-    region_placement: str = knob("uniform", "choice", choices=PLACEMENTS)
-    n_clusters: IntRange = knob((1, 2), "irange", 1, 100)
-    cluster_radius_px: float = knob(300.0, "float", 50, 10_000)
-    min_depot_distance_px: float = knob(300.0, "float", 0, 10_000)
-    far_fraction: float = knob(0.5, "float", 0, 0.95)
-    late_share: float = knob(0.0, "float", 0, 1)
-    late_delay_s: FloatRange = knob((60.0, 120.0), "frange", 0, 36_000)
-    fronts: IntRange = knob((3, 8), "irange", 1, 1000)
-    fuel: FloatRange = knob((3.0, 15.0), "frange", 0, 100, open_lo=True)
-    wind_speed: FloatRange = knob((2.0, 8.0), "frange", 0, 50)
-    wind_dir_deg: FloatRange = knob((0.0, 360.0), "frange", 0, 360)
-    fire_mode: str = knob("specific", "choice", choices=FIRE_MODES)
-    depot_orientation: str = knob("any", "choice", choices=("any", "vertical", "horizontal"))
-    n_houses: IntRange = knob((1, 3), "irange", 0, 500)
-    n_hospitals: IntRange = knob((0, 1), "irange", 0, 500)
-    n_power_stations: IntRange = knob((0, 1), "irange", 0, 500)
-    facility_fire_distance_px: FloatRange = knob((150.0, 500.0), "frange", 0, 20_000)
-    house_penalty: float = knob(1.0, "float", 0, 1000)
-    hospital_penalty: float = knob(2.0, "float", 0, 1000)
-    power_station_penalty: float = knob(5.0, "float", 0, 1000)
-    depot_penalty: float = knob(5.0, "float", 0, 1000)
-    n_lakes: IntRange = knob((0, 1), "irange", 0, 100)
-    n_perception: IntRange = knob((2, 3), "irange", 0, 500)
-    n_action: IntRange = knob((2, 3), "irange", 0, 500)
-    n_hybrid: IntRange = knob((0, 0), "irange", 0, 500)
-    speed: FloatRange = knob((20.0, 20.0), "frange", 0, 500, open_lo=True)
-    battery: FloatRange = knob((500.0, 500.0), "frange", 0, 1e6, open_lo=True)
-    tank: IntRange = knob((10, 10), "irange", 1, 1000)
-    perception_altitude: tuple[float, float] = knob((10.0, 100.0), "pair", 0, 1000, open_lo=True)
-    hybrid_altitude: tuple[float, float] = knob((10.0, 100.0), "pair", 0, 1000, open_lo=True)
-    action_prune_confidence: FloatRange = knob((0.9, 0.9), "frange", 0, 1, open_lo=True)
-    hybrid_prune_confidence: FloatRange = knob((0.8, 0.8), "frange", 0, 1, open_lo=True)
-    comm_range: float | None = knob(None, "optional", 0, 1e6, open_lo=True)
+    world_size: IntRange = knob(
+        (1200, 1200), "irange", 800, 10_000, step=100, doc="map side, px (range)"
+    )
+    duration_s: float = knob(180.0, "float", 1, 36_000, doc="episode length, s")
+    ticks_per_second: int = knob(10, "int", 1, 100, doc="simulation rate, Hz")
+    n_regions: IntRange = knob((1, 4), "irange", 1, 500, doc="fire regions (range)")
+    region_placement: str = knob("uniform", "choice", choices=PLACEMENTS, doc="where regions go")
+    n_clusters: IntRange = knob((1, 2), "irange", 1, 100, doc="region clusters (range)")
+    cluster_radius_px: float = knob(300.0, "float", 50, 10_000, doc="cluster radius, px")
+    min_depot_distance_px: float = knob(
+        300.0, "float", 0, 10_000, doc="min region-depot distance, px"
+    )
+    far_fraction: float = knob(0.5, "float", 0, 0.95, doc="far: share of max distance")
+    late_share: float = knob(0.0, "float", 0, 1, doc="share of regions igniting late")
+    late_delay_s: FloatRange = knob(
+        (60.0, 120.0), "frange", 0, 36_000, doc="late ignition delay, s (range)"
+    )
+    fronts: IntRange = knob((3, 8), "irange", 1, 1000, doc="fronts per region (range)")
+    fuel: FloatRange = knob(
+        (3.0, 15.0), "frange", 0, 100, open_lo=True, doc="fuel coefficient (range)"
+    )
+    wind_speed: FloatRange = knob((2.0, 8.0), "frange", 0, 50, doc="wind speed, m/s (range)")
+    wind_dir_deg: FloatRange = knob(
+        (0.0, 360.0), "frange", 0, 360, doc="wind direction, deg (range)"
+    )
+    fire_mode: str = knob(
+        "specific", "choice", choices=FIRE_MODES, doc="per-region or shared values"
+    )
+    depot_orientation: str = knob(
+        "any", "choice", choices=("any", "vertical", "horizontal"), doc="depot shape"
+    )
+    n_houses: IntRange = knob((1, 3), "irange", 0, 500, doc="houses (range)")
+    n_hospitals: IntRange = knob((0, 1), "irange", 0, 500, doc="hospitals (range)")
+    n_power_stations: IntRange = knob((0, 1), "irange", 0, 500, doc="power stations (range)")
+    facility_fire_distance_px: FloatRange = knob(
+        (150.0, 500.0), "frange", 0, 20_000, doc="facility to nearest region, px"
+    )
+    house_penalty: float = knob(1.0, "float", 0, 1000, doc="penalty of a house")
+    hospital_penalty: float = knob(2.0, "float", 0, 1000, doc="penalty of a hospital")
+    power_station_penalty: float = knob(5.0, "float", 0, 1000, doc="penalty of a power station")
+    depot_penalty: float = knob(5.0, "float", 0, 1000, doc="penalty of the depot")
+    n_lakes: IntRange = knob((0, 1), "irange", 0, 100, doc="decorative lakes (range)")
+    n_perception: IntRange = knob((2, 3), "irange", 0, 500, doc="perception agents (range)")
+    n_action: IntRange = knob((2, 3), "irange", 0, 500, doc="action agents (range)")
+    n_hybrid: IntRange = knob((0, 0), "irange", 0, 500, doc="hybrid agents (range)")
+    speed: FloatRange = knob(
+        (20.0, 20.0), "frange", 0, 500, open_lo=True, doc="speed, px per tick (range)"
+    )
+    battery: FloatRange = knob(
+        (500.0, 500.0), "frange", 0, 1e6, open_lo=True, doc="battery (range)"
+    )
+    tank: IntRange = knob((10, 10), "irange", 1, 1000, doc="dumps per sortie (range)")
+    perception_altitude: tuple[float, float] = knob(
+        (10.0, 100.0), "pair", 0, 1000, open_lo=True, doc="perception altitude bounds, m"
+    )
+    hybrid_altitude: tuple[float, float] = knob(
+        (10.0, 100.0), "pair", 0, 1000, open_lo=True, doc="hybrid altitude bounds, m"
+    )
+    action_prune_confidence: FloatRange = knob(
+        (0.9, 0.9), "frange", 0, 1, open_lo=True, doc="action confidence (range)"
+    )
+    hybrid_prune_confidence: FloatRange = knob(
+        (0.8, 0.8), "frange", 0, 1, open_lo=True, doc="hybrid confidence (range)"
+    )
+    comm_range: float | None = knob(
+        None, "optional", 0, 1e6, open_lo=True, doc="communication range, px"
+    )
 
     KNOB_NAMES: ClassVar[tuple[str, ...]]
 
@@ -265,12 +295,16 @@ class GeneratorConfig:
     def hard(cls, **knobs: Any) -> GeneratorConfig:
         """Hard tier: manual-sized maps (800-1200 px) and teams (4-9 agents, at most 2 action
         agents), but fast fires, scarce tanks and batteries, late far ignitions, threatened
-        facilities and 300-s episodes (a starting point, to be tuned by measurement)."""
+        facilities and 300-s episodes. The ``hard`` tier of the ``fcplan-bench-v1`` suite was
+        drawn from it (:mod:`fcplan.scenario.suite`); about half of its draws are cleared by
+        greedy and were screened out."""
         return cls.preset("hard", **knobs)
 
     @classmethod
     def scale(cls, **knobs: Any) -> GeneratorConfig:
-        """Scale tier: 3,000-10,000 px maps, 20-100 agents and 10-40 clustered regions."""
+        """Scale tier: 3,000-10,000 px maps, 20-100 agents and 10-40 clustered regions. (The
+        suite's ``scale`` tier shrinks it to 3,000-5,000 px, 18-30 agents, 10-16 regions and
+        180-s episodes, so that every built-in scheduler can be measured on it.)"""
         return cls.preset("scale", **knobs)
 
 
@@ -294,7 +328,8 @@ PRESETS: dict[str, dict[str, Any]] = {
         battery=(2000.0, 4000.0),
     ),
 }  # fmt: skip
-"""Named knob sets: ``"hard"`` and ``"scale"`` are the planned benchmark tiers (starting points)."""
+"""Named knob sets: ``"hard"`` and ``"scale"`` are the benchmark suite's tiers' starting points
+(the suite's manifest records every knob of every frozen scenario)."""
 
 
 # ------------------------------------------------------------------------------------- drawing

@@ -48,7 +48,7 @@ from typing import Any
 from fcplan.errors import ScenarioError
 from fcplan.scenario.validate import is_integer, is_number
 
-__all__ = ["KINDS", "Knob", "check_knobs", "knob", "span"]
+__all__ = ["KINDS", "Knob", "check_knobs", "knob", "knob_table", "knobs_of", "span"]
 
 KINDS = ("int", "float", "optional", "choice", "irange", "frange", "pair")
 """The kinds of knob (see the module docstring)."""
@@ -57,7 +57,8 @@ KINDS = ("int", "float", "optional", "choice", "irange", "frange", "pair")
 @dataclass(frozen=True)
 class Knob:
     """What one knob accepts: its ``kind`` (one of :data:`KINDS`), the range ``lo..hi``
-    (``(lo, hi]`` when ``open_lo``), a ``step`` integers must be multiples of, the ``choices``.
+    (``(lo, hi]`` when ``open_lo``), a ``step`` integers must be multiples of, the ``choices``;
+    ``doc`` says what it means (a few words, with the unit).
 
     Examples
     --------
@@ -73,6 +74,7 @@ class Knob:
     open_lo: bool = False
     step: int = 1
     choices: tuple[str, ...] = ()
+    doc: str = ""
 
     def allowed(self) -> str:
         """What the knob accepts, as the end of a "must be ..." sentence."""
@@ -88,6 +90,22 @@ class Knob:
             "frange": f"a number or a pair [lo, hi], lo <= hi, in {within}",
             "pair": f"a pair [lo, hi], lo <= hi, in {within}",
         }[self.kind]
+
+    def short(self) -> str:
+        """The allowed values in a few characters (a table cell).
+
+        Examples
+        --------
+        >>> Knob("irange", 800, 10_000, step=100).short(), Knob("optional", 0, 1, open_lo=True).short()
+        ('800..10000 (x100)', '(0, 1] or None')
+        """
+        if self.kind == "choice":
+            return ", ".join(self.choices)
+        lo, hi = _number(self.lo), _number(self.hi)
+        text = f"({lo}, {hi}]" if self.open_lo else f"{lo}..{hi}"
+        if self.step > 1:
+            text += f" (x{self.step})"
+        return text + (" or None" if self.kind == "optional" else "")
 
     def _one(self, v: Any, integer: bool) -> int | float | None:
         ok = is_integer(v) if integer else is_number(v) and math.isfinite(v)
@@ -146,3 +164,52 @@ def span(value: Any) -> tuple[Any, Any]:
     ((1, 4), (3, 3))
     """
     return (value[0], value[1]) if isinstance(value, tuple) else (value, value)
+
+
+def _number(v: float) -> str:
+    """``v`` in few characters: ``1e6`` rather than ``1e+06``."""
+    return f"{v:g}".replace("e+0", "e").replace("e+", "e")
+
+
+def knobs_of(cls: Any) -> dict[str, tuple[Knob, Any]]:
+    """``{name: (Knob, default)}`` of every knob field of the dataclass ``cls``, in order."""
+    return {f.name: (f.metadata["knob"], f.default) for f in fields(cls) if "knob" in f.metadata}
+
+
+def _cell(value: Any) -> str:
+    if isinstance(value, tuple) and len(value) == 2 and value[0] == value[1]:
+        value = value[0]
+    if isinstance(value, tuple):
+        return "(" + ", ".join(_cell(v) for v in value) + ")"
+    if isinstance(value, float):
+        return _number(value)
+    return repr(value) if isinstance(value, str) else str(value)
+
+
+def knob_table(cls: Any) -> str:
+    """The reStructuredText table of the knobs of ``cls``: name, default, allowed values, meaning.
+
+    A settings class's docstring holds this table; a test checks that it is up to date.
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True)
+    ... class Settings:
+    ...     size: int | tuple[int, int] = knob((4, 4), "irange", 1, 10, doc="cells (range)")
+    >>> print(knob_table(Settings))
+    ====  =======  =======  =============
+    knob  default  allowed  meaning
+    ====  =======  =======  =============
+    size  4        1..10    cells (range)
+    ====  =======  =======  =============
+    """
+    rows = [("knob", "default", "allowed", "meaning")]
+    rows += [(n, _cell(d), k.short(), k.doc) for n, (k, d) in knobs_of(cls).items()]
+    widths = [max(len(r[i]) for r in rows) for i in range(4)]
+    rule = "  ".join("=" * w for w in widths)
+
+    def line(row: tuple[str, ...]) -> str:
+        return "  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip()
+
+    return "\n".join([rule, line(rows[0]), rule, *map(line, rows[1:]), rule])

@@ -1,0 +1,552 @@
+"""The benchmark leaderboard: every scheduler on every tier of a suite, from a results folder.
+
+:func:`leaderboard` reads episodes (a results folder written by ``fcplan sweep``, or the JSON of
+``fcplan compare --json``), groups them by suite and tier from the scenario names
+(``"fcplan-bench-v1/hard-01"`` is tier ``hard`` of suite ``fcplan-bench-v1``; other scenarios form
+the tier ``other``) and computes, per tier and scheduler:
+
+* the **headline metric** (default the manual's final score, ``manual.final_score``): mean and
+  95 % Student-t interval over the tier's completed (scenario, seed) episodes, the same numbers
+  ``fcplan report`` prints (the interval includes the spread between scenarios, so it is wide;
+  compare schedulers with the paired table instead);
+* the **fraction of the oracle**: ``F = sum_i (s_i - idle_i) / sum_i (oracle_i - idle_i)`` over
+  the (scenario, seed) pairs ``i`` where the scheduler, the clairvoyant ``oracle`` and the
+  ``idle`` team all completed: the share of the oracle's improvement over doing nothing that the
+  scheduler achieved on the same pairs (1 = as good as the oracle, 0 = no better than idle). A
+  ratio of raw scores would mean nothing (final scores are often negative). It is a **ratio of
+  means**, not a mean of per-pair ratios: a pair where the oracle barely beats idle (nothing was
+  at stake) would give a huge or undefined per-pair ratio, while the ratio of means weights each
+  pair by what was achievable there. Its 95 % interval is a percentile bootstrap (2,000 draws,
+  seed 0) that resamples seeds within each scenario: the suite's scenarios are fixed, seeds are
+  the random part;
+* OFS, time to containment and burned area (means), the scenarios *cleared* (OFS 100 % on every
+  seed), the solve time per replan (p50 and p95 over every replan of the tier), and the replans
+  that fell back to greedy;
+* **paired comparisons** of the policies (every scheduler except the oracle references and the
+  ``idle`` and ``random`` baselines) on the pairs they all completed: mean difference and its
+  interval, Wilcoxon p-value, Holm-adjusted over the tier's pairs of policies, Cohen's d_z
+  (:func:`~fcplan.experiments.stats.paired_comparisons`);
+* the **tier check** of issue 12: a tier separates the schedulers when the policies are not all
+  within each other's 95 % intervals and no scheduler clears every scenario; its acceptance
+  asks that at least half of the policy pairs differ with Holm p < 0.01 and that the oracle's mean
+  be at least every policy's.
+
+:func:`fcplan.experiments.leaderboard_page.markdown` writes the page (``docs/leaderboard.md``):
+the suite version, seeds, library versions, date and wall time of producing the results, then one
+section per tier.
+
+Examples
+--------
+>>> rows = [{"scenario": "fcplan-bench-v1/hard-01", "scheduler": name, "seed": seed,
+...          "status": "ok", "manual.final_score": score + seed,
+...          "manual.overall_firefighting": 50.0, "fallbacks": 0, "replans": 10}
+...         for seed in range(3)
+...         for name, score in (("greedy", 10.0), ("oracle", 20.0), ("idle", -100.0))]
+>>> board = leaderboard(rows)
+>>> tier = board.tiers[0]
+>>> tier.suite, tier.tier, tier.stats["greedy"].mean.mean, round(tier.stats["greedy"].fraction, 3)
+('fcplan-bench-v1', 'hard', 11.0, 0.917)
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import math
+import os
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fcplan.errors import FcplanError
+from fcplan.experiments.stats import MeanCI, PairedComparison, mean_ci, paired_comparisons
+from fcplan.experiments.tables import higher_is_better
+from fcplan.scenario.suite import suite_of
+
+__all__ = [
+    "HEADLINE",
+    "Leaderboard",
+    "SchedulerStats",
+    "TierCheck",
+    "TierResult",
+    "finite",
+    "fraction_of_oracle",
+    "is_policy",
+    "leaderboard",
+    "metric_direction",
+    "read_episodes",
+    "tier_of",
+]
+
+HEADLINE = "manual.final_score"
+"""The suite's headline metric (the manual's final score, Eq. 6)."""
+
+ORACLE, IDLE = "oracle", "idle"
+BASELINES = ("idle", "random")
+HOLM_LEVEL = 0.01
+BOOTSTRAP_DRAWS = 2000
+
+_OFS = "manual.overall_firefighting"
+_TTC = "outcome.time_to_containment_s"
+_BURNED = "outcome.burned_area_cells"
+
+
+def metric_direction(metric: str) -> tuple[str, int, bool]:
+    """Label, decimals and whether higher is better for a result column: a metric
+    (``manual.final_score``), an outcome (``outcome.burned_area_cells``) or another column.
+
+    Examples
+    --------
+    >>> metric_direction("outcome.burned_area_cells"), metric_direction("manual.final_score")
+    (('burned area', 0, False), ('final score', 1, True))
+    """
+    from fcplan.metrics import metric_spec
+
+    prefix, _, name = metric.partition(".")
+    if prefix in ("outcome", "manual", "reference2020"):
+        try:
+            spec = metric_spec(name)
+            return spec.label, spec.decimals, spec.higher_is_better
+        except FcplanError:
+            pass
+    return metric, 2, higher_is_better(metric)
+
+
+def is_policy(label: str) -> bool:
+    """Whether a scheduler label is a policy to rank (not an oracle reference or a baseline).
+
+    Examples
+    --------
+    >>> is_policy("cbba"), is_policy("oracle[routing]"), is_policy("idle")
+    (True, False, False)
+    """
+    return not label.startswith(ORACLE) and label not in BASELINES
+
+
+def tier_of(scenario: str) -> tuple[str, str]:
+    """``(suite, tier)`` of a scenario name; ``("", "other")`` outside the suites.
+
+    Examples
+    --------
+    >>> tier_of("fcplan-bench-v1/scale-03"), tier_of("#12")
+    (('fcplan-bench-v1', 'scale'), ('', 'other'))
+    """
+    suite = suite_of(scenario)
+    if suite is None:
+        return "", "other"
+    return suite, scenario.split("/", 1)[1].rsplit("-", 1)[0]
+
+
+@dataclass(frozen=True)
+class SchedulerStats:
+    """One scheduler on one tier (see the module docstring for each number)."""
+
+    episodes: int
+    failed: int
+    mean: MeanCI
+    fraction: float = math.nan
+    fraction_ci: tuple[float, float] = (math.nan, math.nan)
+    fraction_median_pair: float = math.nan
+    ofs: float = math.nan
+    containment_s: float = math.nan
+    burned: float = math.nan
+    cleared: int = 0
+    solve_p50_ms: float = math.nan
+    solve_p95_ms: float = math.nan
+    fallbacks: int = 0
+    replans: int = 0
+    deterministic: bool | None = None
+
+
+@dataclass(frozen=True)
+class TierCheck:
+    """Issue 12's rule for keeping a tier, and its acceptance test, on the tier's policies."""
+
+    policies: tuple[str, ...]
+    separated: bool
+    """Not every policy's mean lies inside every other policy's 95 % interval."""
+    cleared_all: tuple[str, ...]
+    """Schedulers with OFS 100 % on every seed of every scenario."""
+    resolved: int
+    """Policy pairs with Holm-adjusted p < 0.01."""
+    pairs: int
+    oracle_top: bool | None
+    """The oracle's mean is at least as good as every policy's (None without oracle episodes)."""
+
+    @property
+    def keep(self) -> bool:
+        """The tier separates (the issue's rule for keeping it)."""
+        return self.separated and not self.cleared_all
+
+    @property
+    def accepted(self) -> bool:
+        """The issue's acceptance: kept, half the pairs resolved at Holm p < 0.01, oracle on top."""
+        return self.keep and 2 * self.resolved >= self.pairs > 0 and self.oracle_top is True
+
+
+@dataclass
+class TierResult:
+    """Every scheduler on one tier."""
+
+    suite: str
+    tier: str
+    scenarios: list[str]
+    seeds: list[int]
+    metric: str
+    stats: dict[str, SchedulerStats]
+    order: list[str]
+    pairs: list[PairedComparison]
+    check: TierCheck
+    settings: dict[str, str] = field(default_factory=dict)
+    """Scheduler label -> its settings as recorded in the results (``key=value, ...``)."""
+
+
+@dataclass
+class Leaderboard:
+    """Tier results and where they came from (see :func:`leaderboard`)."""
+
+    metric: str
+    tiers: list[TierResult]
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Every number, JSON-ready (NaN as None)."""
+        return _plain(
+            {
+                "metric": self.metric,
+                "meta": self.meta,
+                "tiers": [
+                    {
+                        "suite": t.suite,
+                        "tier": t.tier,
+                        "scenarios": t.scenarios,
+                        "seeds": t.seeds,
+                        "order": t.order,
+                        "settings": t.settings,
+                        "stats": {k: _stats_dict(v) for k, v in t.stats.items()},
+                        "pairs": [_pair_dict(c) for c in t.pairs],
+                        "check": {
+                            **_fields(t.check),
+                            "keep": t.check.keep,
+                            "accepted": t.check.accepted,
+                        },
+                    }
+                    for t in self.tiers
+                ],
+            }
+        )
+
+
+def _fields(obj: Any) -> dict[str, Any]:
+    return {k: getattr(obj, k) for k in obj.__dataclass_fields__}
+
+
+def _stats_dict(s: SchedulerStats) -> dict[str, Any]:
+    d = _fields(s)
+    d["mean"] = {"mean": s.mean.mean, "ci": s.mean.half_width, "n": s.mean.n}
+    return d
+
+
+def _pair_dict(c: PairedComparison) -> dict[str, Any]:
+    return {"a": c.a, "b": c.b, "diff": c.diff.mean, "ci": c.diff.half_width, "n": c.diff.n,
+            "p": c.p, "p_holm": c.p_holm, "d_z": c.effect}  # fmt: skip
+
+
+def _plain(v: Any) -> Any:
+    if isinstance(v, dict):
+        return {str(k): _plain(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_plain(x) for x in v]
+    if isinstance(v, (float, np.floating)):
+        return None if math.isnan(v) else float(v)
+    if isinstance(v, np.integer):
+        return int(v)
+    return v
+
+
+# ------------------------------------------------------------------------------------- reading
+def read_episodes(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """Episode rows of a results folder (``fcplan sweep``) or a comparison's JSON file
+    (``fcplan compare --json``).
+
+    Raises
+    ------
+    FcplanError
+        The path is neither (one line naming it).
+    """
+    p = Path(path)
+    if p.is_dir():
+        from fcplan.experiments.results import load_results
+
+        return list(load_results(p).to_dict("records"))
+    if p.is_file() and p.suffix == ".json":
+        doc = json.loads(p.read_text(encoding="utf-8"))
+        episodes = doc.get("episodes")
+        if not isinstance(episodes, list):
+            raise FcplanError(f"{p}: not a comparison file of fcplan compare --json (no episodes)")
+        times = doc.get("solve_times_ms") or [[] for _ in episodes]
+        out = []
+        for e, t in zip(episodes, times, strict=False):
+            row = {k: (math.nan if v is None else v) for k, v in e.items()}
+            row.update(status="failed" if e.get("error") else "ok", replan_solve_ms=list(t))
+            out.append(row)
+        if doc.get("wall_time_s"):
+            out.append({"__wall_time_s": float(doc["wall_time_s"])})
+        return out
+    raise FcplanError(
+        f"{p}: expected a results folder of fcplan sweep or a .json file of fcplan compare --json"
+    )
+
+
+# ------------------------------------------------------------------------------------- numbers
+def fraction_of_oracle(
+    score: Sequence[float],
+    oracle: Sequence[float],
+    idle: Sequence[float],
+    strata: Sequence[Any] | None = None,
+    *,
+    draws: int = BOOTSTRAP_DRAWS,
+    seed: int = 0,
+) -> tuple[float, tuple[float, float], float]:
+    """Fraction of the oracle's improvement over idle, its bootstrap interval, and the median of
+    the per-pair ratios (see the module docstring).
+
+    The arrays hold one value per (scenario, seed) pair, in the same order; ``strata`` (the
+    scenario of each pair) makes the bootstrap resample within each scenario.
+
+    Examples
+    --------
+    >>> f, (lo, hi), med = fraction_of_oracle([5, 6, 7, 8], [10, 10, 10, 10], [0, 0, 0, 0])
+    >>> f, lo <= f <= hi, round(med, 3)
+    (0.65, True, 0.65)
+    """
+    s, o, z = (np.asarray(x, np.float64) for x in (score, oracle, idle))
+    gain, best = s - z, o - z
+    if s.size == 0 or not np.isfinite(gain).all() or not np.isfinite(best).all():
+        return math.nan, (math.nan, math.nan), math.nan
+    total = best.sum()
+    frac = float(gain.sum() / total) if total > 0 else math.nan
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = np.where(best > 0, gain / best, np.nan)
+    median = float(np.nanmedian(ratios)) if np.isfinite(ratios).any() else math.nan
+    groups = [np.arange(s.size)]
+    if strata is not None:
+        labels = np.asarray([str(x) for x in strata])
+        groups = [np.flatnonzero(labels == u) for u in dict.fromkeys(labels.tolist())]
+    rng = np.random.default_rng(seed)
+    picks = np.concatenate(
+        [g[rng.integers(0, g.size, size=(draws, g.size))] for g in groups], axis=1
+    )
+    num, den = gain[picks].sum(axis=1), best[picks].sum(axis=1)
+    boot = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+    boot = boot[np.isfinite(boot)]
+    if boot.size < draws // 2:
+        return frac, (math.nan, math.nan), median
+    lo, hi = np.percentile(boot, [2.5, 97.5])
+    return frac, (float(lo), float(hi)), median
+
+
+def _pooled_percentiles(rows: list[dict[str, Any]]) -> tuple[float, float]:
+    times: list[float] = []
+    for r in rows:
+        t = r.get("replan_solve_ms")
+        if t is not None and len(t):
+            times.extend(float(x) for x in t)
+    if not times:
+        p50 = [float(r["solve_p50_ms"]) for r in rows if finite(r.get("solve_p50_ms"))]
+        return (float(np.median(p50)), math.nan) if p50 else (math.nan, math.nan)
+    a = np.asarray(times)
+    return float(np.percentile(a, 50)), float(np.percentile(a, 95))
+
+
+def finite(v: Any) -> bool:
+    """Whether ``v`` is a finite number (not None, NaN or text)."""
+    return isinstance(v, (int, float, np.integer, np.floating)) and math.isfinite(float(v))
+
+
+def _mean_of(rows: list[dict[str, Any]], key: str) -> float:
+    vals = [float(r[key]) for r in rows if finite(r.get(key))]
+    return float(np.mean(vals)) if vals else math.nan
+
+
+def _cleared(rows: list[dict[str, Any]], scenarios: list[str]) -> int:
+    """Scenarios where every episode of ``rows`` on it has OFS 100 %."""
+    n = 0
+    for sc in scenarios:
+        ofs = [r.get(_OFS) for r in rows if r["scenario"] == sc]
+        n += bool(ofs) and all(finite(v) and float(v or 0.0) >= 100.0 for v in ofs)
+    return n
+
+
+def _scheduler_stats(
+    rows: list[dict[str, Any]],
+    failed: int,
+    metric: str,
+    scenarios: list[str],
+    refs: dict[str, dict[tuple[str, int], float]],
+) -> SchedulerStats:
+    p50, p95 = _pooled_percentiles(rows)
+    frac: tuple[float, tuple[float, float], float] = (math.nan, (math.nan, math.nan), math.nan)
+    if ORACLE in refs and IDLE in refs:
+        keys = [
+            (r["scenario"], int(r["seed"]))
+            for r in rows
+            if (r["scenario"], int(r["seed"])) in refs[ORACLE]
+            and (r["scenario"], int(r["seed"])) in refs[IDLE]
+        ]
+        mine = {(r["scenario"], int(r["seed"])): float(r[metric]) for r in rows}
+        sign = 1.0 if metric_direction(metric)[2] else -1.0  # lower is better: negate
+        frac = fraction_of_oracle(
+            [sign * mine[k] for k in keys],
+            [sign * refs[ORACLE][k] for k in keys],
+            [sign * refs[IDLE][k] for k in keys],
+            strata=[k[0] for k in keys],
+        )
+    flags = {bool(r["deterministic"]) for r in rows if isinstance(r.get("deterministic"), bool)}
+    return SchedulerStats(
+        episodes=len(rows),
+        failed=failed,
+        mean=mean_ci([float(r[metric]) for r in rows]),
+        fraction=frac[0],
+        fraction_ci=frac[1],
+        fraction_median_pair=frac[2],
+        ofs=_mean_of(rows, _OFS),
+        containment_s=_mean_of(rows, _TTC),
+        burned=_mean_of(rows, _BURNED),
+        cleared=_cleared(rows, scenarios),
+        solve_p50_ms=p50,
+        solve_p95_ms=p95,
+        fallbacks=int(sum(int(r.get("fallbacks") or 0) for r in rows)),
+        replans=int(sum(int(r.get("replans") or 0) for r in rows)),
+        deterministic=flags.pop() if len(flags) == 1 else None,
+    )
+
+
+def _check(
+    stats: dict[str, SchedulerStats],
+    pairs: list[PairedComparison],
+    scenarios: list[str],
+    sign: float,
+) -> TierCheck:
+    policies = tuple(k for k in stats if is_policy(k))
+    cis = {k: stats[k].mean for k in policies}
+    inside = all(
+        cis[b].low <= cis[a].mean <= cis[b].high for a in policies for b in policies if a != b
+    )
+    oracles = [k for k in stats if k == ORACLE]
+    top = None
+    if oracles and policies:
+        top = all(sign * (stats[ORACLE].mean.mean - cis[k].mean) >= 0 for k in policies)
+    return TierCheck(
+        policies=policies,
+        separated=len(policies) > 1 and not inside,
+        cleared_all=tuple(k for k, s in stats.items() if s.cleared == len(scenarios) > 0),
+        resolved=sum(c.p_holm < HOLM_LEVEL for c in pairs),
+        pairs=len(pairs),
+        oracle_top=top,
+    )
+
+
+def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> TierResult:
+    ok = [r for r in rows if r.get("status", "ok") == "ok" and finite(r.get(metric))]
+    labels = list(dict.fromkeys(str(r["scheduler"]) for r in rows))
+    scenarios = sorted({str(r["scenario"]) for r in rows})
+    by = {k: [r for r in ok if r["scheduler"] == k] for k in labels}
+    refs = {
+        k: {(r["scenario"], int(r["seed"])): float(r[metric]) for r in by[k]}
+        for k in (ORACLE, IDLE)
+        if by.get(k)
+    }
+    stats = {
+        k: _scheduler_stats(by[k], sum(r["scheduler"] == k for r in rows) - len(by[k]),
+                            metric, scenarios, refs)
+        for k in labels if by[k]
+    }  # fmt: skip
+    sign = 1.0 if metric_direction(metric)[2] else -1.0
+    policies = sorted((k for k in stats if is_policy(k)), key=lambda k: -sign * stats[k].mean.mean)
+    others = [k for k in stats if not is_policy(k)]
+    order = policies + sorted(others, key=lambda k: (k != ORACLE, not k.startswith(ORACLE), k))
+    common = set.intersection(
+        *({(r["scenario"], int(r["seed"])) for r in by[k]} for k in policies)
+    ) if policies else set()  # fmt: skip
+    keys = sorted(common)
+    values = {
+        k: {(r["scenario"], int(r["seed"])): float(r[metric]) for r in by[k]} for k in policies
+    }
+    pairs = paired_comparisons({k: [values[k][x] for x in keys] for k in policies}) if keys else []
+    return TierResult(
+        suite=suite,
+        tier=tier,
+        scenarios=scenarios,
+        seeds=sorted({int(r["seed"]) for r in rows}),
+        metric=metric,
+        stats=stats,
+        order=order,
+        pairs=pairs,
+        check=_check(stats, pairs, scenarios, sign),
+        settings={k: _settings(by[k]) for k in order if _settings(by[k])},
+    )
+
+
+def _settings(rows: list[dict[str, Any]]) -> str:
+    """The scheduler settings the rows recorded (JSON text in sweep results), as text."""
+    texts = {r.get("settings") for r in rows if isinstance(r.get("settings"), str)}
+    out = []
+    for text in sorted(t for t in texts if t):
+        doc = json.loads(text)
+        out.append(", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(doc.items())))
+    return "; ".join(o for o in out if o)
+
+
+def _meta(rows: list[dict[str, Any]], wall: float | None) -> dict[str, Any]:
+    versions = sorted({str(r["versions"]) for r in rows if isinstance(r.get("versions"), str)})
+    done = [str(r["finished_at"]) for r in rows if isinstance(r.get("finished_at"), str)]
+    span = math.nan
+    if done and all(finite(r.get("episode_wall_s")) for r in rows):
+        ends = [_dt.datetime.fromisoformat(str(r["finished_at"])) for r in rows]
+        starts = [e - _dt.timedelta(seconds=float(r["episode_wall_s"])) for e, r in zip(ends, rows, strict=True)]  # fmt: skip
+        span = (max(ends) - min(starts)).total_seconds()
+    return {
+        "episodes": len(rows),
+        "failed": sum(r.get("status", "ok") != "ok" for r in rows),
+        "libraries": [json.loads(v) for v in versions],
+        "finished": max(done) if done else "",
+        "wall_time_s": wall if wall is not None else span,
+        "episode_time_s": float(sum(float(r.get("episode_wall_s") or 0.0) for r in rows)),
+        "hosts": sorted({str(r["host"]) for r in rows if r.get("host")}),
+        "suites": sorted({tier_of(str(r["scenario"]))[0] for r in rows} - {""}),
+    }
+
+
+def leaderboard(
+    source: str | os.PathLike[str] | Iterable[dict[str, Any]] | Sequence[Any],
+    *,
+    metric: str = HEADLINE,
+) -> Leaderboard:
+    """The leaderboard of episodes: a results folder, a ``compare --json`` file, a list of those,
+    or episode rows (dicts with ``scenario``, ``scheduler``, ``seed``, ``status`` and the metric).
+
+    Raises
+    ------
+    FcplanError
+        No episodes, or an unknown metric column (one line).
+    """
+    paths = [source] if isinstance(source, (str, os.PathLike)) else list(source)
+    rows: list[dict[str, Any]] = []
+    for item in paths:
+        rows.extend(read_episodes(item) if isinstance(item, (str, os.PathLike)) else [dict(item)])
+    walls = [float(r["__wall_time_s"]) for r in rows if "__wall_time_s" in r]
+    rows = [r for r in rows if "__wall_time_s" not in r]
+    if not rows:
+        raise FcplanError("leaderboard: no episodes in the results")
+    if not any(metric in r for r in rows):
+        raise FcplanError(f"leaderboard: no column {metric!r} in the results")
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    for r in rows:
+        groups.setdefault(tier_of(str(r["scenario"])), []).append(r)
+    order = sorted(groups, key=lambda k: (k[0] == "", k))
+    tiers = [_tier(suite, tier, groups[(suite, tier)], metric) for suite, tier in order]
+    return Leaderboard(metric, tiers, _meta(rows, sum(walls) if walls else None))

@@ -1,0 +1,195 @@
+"""The leaderboard page: :class:`~fcplan.experiments.leaderboard.Leaderboard` as Markdown.
+
+:func:`markdown` writes ``docs/leaderboard.md`` (``fcplan leaderboard RESULTS -o FILE``): a header
+with the suite version, the headline metric, the date, the command, how many episodes, the wall
+time of producing them and the library versions; one section per tier with a table of every
+scheduler (ranked policies, then the oracle reference and the baselines), the paired comparisons
+of the policies and the tier check; and a short guide to the numbers. The numbers are those of
+:mod:`fcplan.experiments.leaderboard`.
+
+Examples
+--------
+>>> from fcplan.experiments.leaderboard import leaderboard
+>>> rows = [{"scenario": "fcplan-bench-v1/hard-01", "scheduler": name, "seed": seed,
+...          "status": "ok", "manual.final_score": score + seed}
+...         for seed in range(3) for name, score in (("greedy", 1.0), ("cbba", 2.0))]
+>>> page = markdown(leaderboard(rows), "fcplan leaderboard results")
+>>> page.splitlines()[0], "| 1 | cbba | 3.0 ± 2.5 |" in page
+('# Leaderboard', True)
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+
+from fcplan.experiments.leaderboard import (
+    HOLM_LEVEL,
+    IDLE,
+    ORACLE,
+    Leaderboard,
+    SchedulerStats,
+    TierResult,
+    finite,
+    is_policy,
+    metric_direction,
+)
+
+__all__ = ["markdown"]
+
+
+# ---------------------------------------------------------------------------------------- page
+_NOTES = {
+    ORACLE: "reference: sees the true fire, not a legal policy",
+    IDLE: "baseline: does nothing",
+    "random": "baseline: random plans",
+}
+
+
+def _span(seeds: list[int]) -> str:
+    """``0-9`` for a contiguous run, else the list."""
+    if seeds and seeds == list(range(seeds[0], seeds[-1] + 1)) and len(seeds) > 2:
+        return f"{seeds[0]}-{seeds[-1]}"
+    return ",".join(map(str, seeds))
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
+def _num(v: float, digits: int) -> str:
+    return "n/a" if not finite(v) else f"{v:,.{digits}f}"
+
+
+def _duration(seconds: float) -> str:
+    if not finite(seconds):
+        return "unknown"
+    h, rest = divmod(int(round(seconds)), 3600)
+    return f"{h} h {rest // 60:02d} min" if h else f"{rest // 60} min {rest % 60:02d} s"
+
+
+def _row(rank: str, name: str, s: SchedulerStats, n_scen: int, digits: int) -> str:
+    lo, hi = s.fraction_ci
+    frac = "n/a" if not finite(s.fraction) else f"{s.fraction:.3f}"
+    if finite(lo):
+        frac += f" [{lo:.3f}, {hi:.3f}]"
+    note = _NOTES.get(name, _NOTES[ORACLE] if name.startswith(ORACLE) else "")
+    label = f"{name} ({note})" if note else name
+    failed = f" ({s.failed} failed)" if s.failed else ""
+    cells = [
+        rank,
+        label + failed,
+        f"{s.mean.mean:.{digits}f} ± {_num(s.mean.half_width, digits)}",
+        frac,
+        _num(s.ofs, 1),
+        f"{s.cleared}/{n_scen}",
+        _num(s.containment_s, 1),
+        _num(s.burned, 0),
+        f"{_num(s.solve_p50_ms, 1)} / {_num(s.solve_p95_ms, 1)}",
+        f"{s.fallbacks}/{s.replans}",
+    ]
+    return "| " + " | ".join(cells) + " |"
+
+
+def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
+    name = f"{t.suite}/{t.tier}" if t.suite else "other scenarios"
+    out = [
+        f"## Tier `{name}`: {_count(len(t.scenarios), 'scenario')} x "
+        f"{_count(len(t.seeds), 'seed')} ({_span(t.seeds)})",
+        "",
+        f"| # | scheduler | {label} (mean ± 95 % CI) | fraction of oracle [95 % CI] | OFS % "
+        "| cleared | containment s | burned cells | solve p50 / p95 ms | fallbacks / replans |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    rank = 0
+    for k in t.order:
+        rank += is_policy(k)
+        r = str(rank) if is_policy(k) else "ref" if k.startswith(ORACLE) else "base"
+        out.append(_row(r, k, t.stats[k], len(t.scenarios), digits))
+    if t.settings:
+        text = "; ".join(f"{k}: {v}" for k, v in t.settings.items())
+        out += ["", f"Scheduler settings: {text}."]
+    if t.pairs:
+        n = t.pairs[0].diff.n
+        out += [
+            "",
+            f"Paired differences of the {label} on the {n} (scenario, seed) pairs that every "
+            f"policy completed (Wilcoxon signed-rank p, Holm-adjusted over the {len(t.pairs)} "
+            "pairs; d_z = mean / sd of the differences):",
+            "",
+            "| a - b | mean ± 95 % CI | p | p Holm | d_z | Holm p < 0.01 |",
+            "|---|---|---|---|---|---|",
+        ]
+        out += [
+            f"| {c.a} - {c.b} | {c.diff.format(digits)} | {c.p:.2g} | {c.p_holm:.2g} "
+            f"| {c.effect:+.2f} | {'yes' if c.p_holm < HOLM_LEVEL else 'no'} |"
+            for c in t.pairs
+        ]
+    c = t.check
+    top = {None: "no oracle episodes", True: "yes", False: "**no**"}[c.oracle_top]
+    out += [
+        "",
+        "Tier check (issue 12): policies "
+        + (
+            "separated (not all within each other's 95 % intervals)"
+            if c.separated
+            else "**not separated** (every mean inside every other's 95 % interval)"
+        )
+        + "; OFS 100 % on every scenario: "
+        + f"{', '.join(c.cleared_all) or 'none'}; pairs with Holm p < 0.01: {c.resolved} of "
+        f"{c.pairs}; oracle mean at least every policy's: {top}. "
+        f"**{'Accepted' if c.accepted else 'Kept' if c.keep else 'Not kept'}.**",
+        "",
+    ]
+    return out
+
+
+def markdown(board: Leaderboard, command: str = "") -> str:
+    """The leaderboard page (``docs/leaderboard.md``); ``command`` is how it was made."""
+    m = board.meta
+    label, digits, higher = metric_direction(board.metric)
+    direction = "higher" if higher else "lower"
+    libs = "; ".join(", ".join(f"{k} {v}" for k, v in sorted(d.items())) for d in m["libraries"])
+    modes = {s.deterministic for t in board.tiers for s in t.stats.values()}
+    made = _dt.date.today().isoformat()
+    out = [
+        "# Leaderboard",
+        "",
+        f"<!-- generated by `{command or 'fcplan leaderboard'}`; do not edit by hand -->",
+        "",
+        f"Suite **{', '.join(m['suites']) or 'none'}**; headline metric **{label}** "
+        f"(`{board.metric}`, {direction} is better). Made on {made}"
+        + (f" with `{command}`" if command else "")
+        + f" from {m['episodes']} episodes ({m['failed']} failed)"
+        + (f", the last finished {m['finished']}" if m["finished"] else "")
+        + (f" on {', '.join(m['hosts'])}" if m["hosts"] else "")
+        + f". Producing the results took {_duration(m['wall_time_s'])} of wall-clock time "
+        f"({_duration(m['episode_time_s'])} of episode time).",
+        "",
+        "Schedulers ran in their deterministic modes where they have one, so their scores do not "
+        "depend on machine load; solve times do."
+        if False not in modes
+        else "Some schedulers ran with wall-clock time limits: their scores depend on load.",
+        "",
+        f"Libraries: {libs or 'not recorded'}.",
+        "",
+    ]
+    for t in board.tiers:
+        out += _tier_section(t, label, digits)
+    out += [
+        "## How to read this page",
+        "",
+        "* **fraction of oracle**: `sum (s - idle) / sum (oracle - idle)` over the (scenario, "
+        "seed) pairs where the scheduler, the clairvoyant `oracle` and the `idle` team all "
+        "completed: the share of the oracle's improvement over doing nothing. A ratio of means, "
+        "so that pairs where little was at stake do not dominate; 95 % interval by a bootstrap "
+        "of seeds within each scenario. Above 1: better than the oracle on these pairs (the "
+        "oracle is a reference, not a bound).",
+        "* **mean ± 95 % CI**: Student t over every episode of the tier (it includes the spread "
+        "between scenarios); the paired table is the comparison to quote.",
+        "* **cleared**: scenarios where every seed ended with OFS 100 %. **fallbacks**: replans "
+        "where the scheduler failed or ran out of time and greedy planned instead.",
+        "* **solve p50 / p95**: milliseconds per scheduler call over every replan of the tier, "
+        "measured on the machine above (they vary with its load).",
+        "",
+    ]
+    return "\n".join(out)

@@ -1,0 +1,224 @@
+"""fcplan.experiments.leaderboard and leaderboard_page: tiers from scenario names, the fraction of
+the oracle, paired comparisons, the tier check, and a page built from real results."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fcplan.errors import FcplanError
+from fcplan.experiments import compare, sweep
+from fcplan.experiments.leaderboard import (
+    fraction_of_oracle,
+    is_policy,
+    leaderboard,
+    read_episodes,
+    tier_of,
+)
+from fcplan.experiments.leaderboard_page import markdown
+from fcplan.scenario import load_scenario
+
+HARD = "fcplan-bench-v1/hard-{:02d}"
+
+
+def _rows(scores: dict[str, list[float]], scenarios: int = 2, ofs: float = 50.0) -> list[dict]:
+    """Episode rows: scheduler -> one score per (scenario, seed) pair, scenarios outermost."""
+    rows = []
+    for name, values in scores.items():
+        per = len(values) // scenarios
+        for i, v in enumerate(values):
+            rows.append(
+                {
+                    "scenario": HARD.format(i // per + 1),
+                    "scheduler": name,
+                    "seed": i % per,
+                    "status": "ok",
+                    "manual.final_score": float(v),
+                    "manual.overall_firefighting": ofs,
+                    "fallbacks": 1,
+                    "replans": 10,
+                    "replan_solve_ms": [1.0, 2.0, 3.0, 100.0],
+                }  # fmt: skip
+            )
+    return rows
+
+
+def test_fraction_is_one_for_the_oracle_and_zero_for_idle():
+    """A scheduler scoring the oracle's scores has fraction 1, one scoring idle's has 0."""
+    oracle, idle = [10.0, 20.0, 5.0, 8.0], [-100.0, -90.0, -120.0, -80.0]
+    assert fraction_of_oracle(oracle, oracle, idle)[0] == pytest.approx(1.0)
+    assert fraction_of_oracle(idle, oracle, idle)[0] == pytest.approx(0.0)
+
+
+def test_fraction_is_a_ratio_of_means_not_a_mean_of_ratios():
+    """F = sum(s - idle) / sum(oracle - idle); a pair where little was at stake does not
+    dominate (its per-pair ratio is 10, the fraction stays near the other pair's)."""
+    f, _, median = fraction_of_oracle([10.0, 50.0], [1.0, 100.0], [0.0, 0.0])
+    assert f == pytest.approx(60.0 / 101.0)
+    assert median == pytest.approx((10.0 + 0.5) / 2)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    data=st.lists(
+        st.tuples(st.floats(-300, 300), st.floats(1, 300), st.floats(-300, -1)),
+        min_size=2,
+        max_size=12,
+    ),
+    scale=st.floats(0.1, 10),
+    shift=st.floats(-500, 500),
+)
+def test_fraction_is_invariant_under_affine_changes_of_the_score(data, scale, shift):
+    """Rescaling and shifting every score (a * s + b, a > 0) leaves the fraction and its
+    interval unchanged: it does not depend on the score's units or zero."""
+    s = np.array([d[0] for d in data])
+    idle = np.array([d[2] for d in data])
+    oracle = idle + np.array([d[1] for d in data])
+    f, ci, _ = fraction_of_oracle(s, oracle, idle)
+    g, cj, _ = fraction_of_oracle(scale * s + shift, scale * oracle + shift, scale * idle + shift)
+    assert g == pytest.approx(f, rel=1e-9, abs=1e-9)
+    assert np.allclose(ci, cj, rtol=1e-6, atol=1e-9, equal_nan=True)
+
+
+def test_fraction_interval_contains_the_estimate_and_is_reproducible():
+    """The bootstrap interval (within scenarios) holds the estimate and is the same every call."""
+    rng = np.random.default_rng(3)
+    idle = rng.normal(-200, 10, 40)
+    oracle = idle + rng.uniform(100, 300, 40)
+    s = idle + 0.7 * (oracle - idle) + rng.normal(0, 20, 40)
+    strata = np.repeat(np.arange(4), 10)
+    a = fraction_of_oracle(s, oracle, idle, strata)
+    assert a == fraction_of_oracle(s, oracle, idle, strata)
+    f, (lo, hi), _ = a
+    assert lo < f < hi and hi - lo < 0.3
+
+
+def test_tiers_come_from_scenario_names():
+    """Suite scenarios group by (suite, tier); anything else is the tier 'other'."""
+    assert tier_of("fcplan-bench-v1/hard-07") == ("fcplan-bench-v1", "hard")
+    assert tier_of("gen-3-abcdef12") == ("", "other")
+    assert is_policy("routing") and not is_policy("oracle") and not is_policy("random")
+
+
+def test_policies_ranked_references_apart_and_stats_computed():
+    """Policies are ranked by mean; the oracle and idle follow unranked; solve percentiles pool
+    every replan; fallbacks and replans are summed; fractions use the same pairs."""
+    n = 8
+    rows = _rows(
+        {"greedy": [10.0] * n, "cbba": [20.0] * n, "oracle": [30.0] * n, "idle": [-70.0] * n}
+    )
+    t = leaderboard(rows).tiers[0]
+    assert t.order == ["cbba", "greedy", "oracle", "idle"]
+    assert t.stats["cbba"].fraction == pytest.approx(0.9)
+    assert t.stats["greedy"].fraction == pytest.approx(0.8)
+    assert t.stats["greedy"].solve_p50_ms == pytest.approx(2.5)
+    assert (t.stats["greedy"].fallbacks, t.stats["greedy"].replans) == (n, 10 * n)
+    assert t.scenarios == [HARD.format(1), HARD.format(2)] and t.seeds == [0, 1, 2, 3]
+
+
+def test_tier_check_counts_resolved_pairs_and_cleared_scenarios():
+    """Clearly different policies are separated with every pair resolved at Holm p < 0.01 and
+    the tier accepted; identical ones are not separated; OFS 100 everywhere is reported."""
+    rng = np.random.default_rng(0)
+    base = rng.normal(0, 30, 40)
+    rows = _rows(
+        {
+            "a": base + 50,
+            "b": base + 25 + rng.normal(0, 1, 40),
+            "c": base + rng.normal(0, 1, 40),
+            "oracle": base + 80,
+            "idle": base - 200,
+        }  # fmt: skip
+    )
+    check = leaderboard(rows).tiers[0].check
+    assert check.separated and check.resolved == check.pairs == 3
+    assert check.oracle_top and check.accepted and check.cleared_all == ()
+    same = _rows({"a": base, "b": base + rng.normal(0, 1, 40)}, ofs=100.0)
+    check = leaderboard(same).tiers[0].check
+    assert not check.separated and not check.keep and not check.accepted
+    assert check.cleared_all == ("a", "b") and check.oracle_top is None
+
+
+def test_failed_episodes_are_counted_not_averaged():
+    """A failed episode counts in `failed` and is left out of the means and pairs."""
+    rows = _rows({"greedy": [1.0, 2.0, 3.0, 4.0], "cbba": [2.0, 3.0, 4.0, 5.0]})
+    rows[0].update(status="failed", **{"manual.final_score": math.nan})
+    t = leaderboard(rows).tiers[0]
+    assert (t.stats["greedy"].episodes, t.stats["greedy"].failed) == (3, 1)
+    assert t.pairs[0].diff.n == 3
+
+
+def test_no_episodes_or_unknown_metric_fail_in_one_line(tmp_path):
+    """Empty results and a metric column the results lack are one-line FcplanErrors."""
+    with pytest.raises(FcplanError, match="no episodes"):
+        leaderboard(str(tmp_path))
+    with pytest.raises(FcplanError, match="no column 'manual.nope'"):
+        leaderboard(_rows({"greedy": [1.0, 2.0]}), metric="manual.nope")
+    with pytest.raises(FcplanError, match="expected a results folder"):
+        read_episodes(tmp_path / "x.csv")
+
+
+@pytest.fixture(scope="module")
+def real_results(tmp_path_factory):
+    """A small real sweep on two suite scenarios, shortened to 8 s."""
+    out = tmp_path_factory.mktemp("results")
+    sweep(
+        {
+            "scenarios": ["hard-01", "hard-02"],
+            "schedulers": ["greedy", "cbba", "oracle", "idle"],
+            "seeds": "0-1",
+            "overrides": {"duration_s": 8},
+        },  # fmt: skip
+        out,
+        jobs=1,
+        progress=False,
+    )
+    return out
+
+
+def test_page_from_a_real_sweep_names_suite_versions_and_wall_time(real_results):
+    """The page of a real results folder names the suite, the libraries, the command, the
+    wall time of producing the results and every scheduler of the tier."""
+    board = leaderboard(real_results)
+    assert [(t.suite, t.tier) for t in board.tiers] == [("fcplan-bench-v1", "hard")]
+    page = markdown(board, "fcplan leaderboard results")
+    assert "Suite **fcplan-bench-v1**" in page and "numpy" in page
+    assert "`fcplan leaderboard results`" in page and "wall-clock time" in page
+    for name in ("greedy", "cbba", "oracle (reference", "idle (baseline"):
+        assert f"| {name}" in page
+    assert board.meta["wall_time_s"] > 0 and board.meta["hosts"]
+    doc = board.to_dict()
+    json.dumps(doc, allow_nan=False)  # plain JSON, NaN written as null
+    assert doc["tiers"][0]["stats"]["greedy"]["episodes"] == 4
+
+
+def test_compare_json_gives_the_same_tier(tmp_path):
+    """A `fcplan compare --json` file is read like a results folder (its wall time is the
+    comparison's)."""
+    short = load_scenario("hard-03").replace(duration_s=5)
+    result = compare([short], ["greedy", "idle"], [0, 1], jobs=1)
+    path = tmp_path / "c.json"
+    result.to_json(path)
+    board = leaderboard(path)
+    t = board.tiers[0]
+    assert (t.suite, t.tier, t.order) == ("fcplan-bench-v1", "hard", ["greedy", "idle"])
+    assert board.meta["wall_time_s"] == pytest.approx(result.wall_time_s)
+
+
+def test_lower_is_better_metrics_rank_and_normalise_the_other_way():
+    """On a lower-is-better metric (burned area) the smallest mean ranks first, the fraction of
+    the oracle is still 1 for the oracle's values and 0 for idle's, and the oracle on top means
+    lowest."""
+    rows = _rows({"a": [300.0] * 4, "b": [200.0] * 4, "oracle": [100.0] * 4, "idle": [500.0] * 4})
+    for r in rows:
+        r["outcome.burned_area_cells"] = r["manual.final_score"]
+    t = leaderboard(rows, metric="outcome.burned_area_cells").tiers[0]
+    assert t.order[:2] == ["b", "a"]
+    assert t.stats["b"].fraction == pytest.approx(0.75)
+    assert t.stats["oracle"].fraction == pytest.approx(1.0)
+    assert t.check.oracle_top is True
