@@ -67,9 +67,9 @@ entry                      shape        dtype    meaning
 ``inputs``                 ()           str      JSON list of the raw input events (dicts), in order
 =========================  ===========  =======  ===========================================================
 
-The header is a JSON object: ``format`` (``"fcplan-recording"``), ``format_version`` (1),
-``scenario`` (:meth:`fcplan.scenario.Scenario.to_dict`), ``seed`` (int, or null when the episode
-was not seeded: then it cannot be re-simulated), ``source`` (scheduler name, ``"human"`` or
+The header is a JSON object: ``format`` (``"fcplan-recording"``), ``format_version`` (2; version
+1 reads too), ``scenario`` (:meth:`fcplan.scenario.Scenario.to_dict`), ``seed`` (int, or null
+when the episode was not seeded: then it cannot be re-simulated), ``source`` (scheduler name, ``"human"`` or
 ``"legacy"``), ``settings`` (replan period, time limit, scheduler settings, ...), ``ticks`` (T) and
 ``versions`` (fcplan, numpy, python).
 

@@ -65,8 +65,8 @@ from fcplan.errors import FcplanError
 from fcplan.recording.schema import (
     EVENTS,
     FORMAT,
-    FORMAT_VERSION,
     JSON_ENTRIES,
+    READ_VERSIONS,
     SCHEMA,
     RecordingError,
 )
@@ -373,16 +373,21 @@ def _nonneg_sum(a: np.ndarray, name: str, path: str) -> int:
 
 # ------------------------------------------------------------------------------- the checks
 def _check_header(header: Any, path: str) -> None:
-    """The header's format, version and the types of the fields the reader and replay use."""
+    """The header's format, version and the types of the fields the reader and replay use; a
+    version-1 header's scenario gets the wind model it was played with ("fresh") if it names none."""
     if not isinstance(header, dict) or header.get("format") != FORMAT:
         raise RecordingError(f"{path}: not an fcplan recording (header.format is not {FORMAT!r})")
-    if header.get("format_version") != FORMAT_VERSION:
+    version = header.get("format_version")
+    if type(version) is not int or version not in READ_VERSIONS:
         raise RecordingError(
-            f"{path}: header.format_version {header.get('format_version')!r:.40} is not "
-            f"supported (this fcplan reads version {FORMAT_VERSION})"
+            f"{path}: header.format_version {version!r:.40} is not supported (this fcplan "
+            f"reads versions {', '.join(map(str, READ_VERSIONS))})"
         )
     if not isinstance(header.get("scenario"), dict):
         raise RecordingError(f"{path}: header.scenario is missing or not a JSON object")
+    fire = header["scenario"].get("fire")
+    if version == 1 and isinstance(fire, dict):  # version 1's default wind model, said out loud
+        fire.setdefault("wind_model", "fresh")
     checks = (
         ("seed", lambda v: v is None or (type(v) is int and v >= 0), "an integer >= 0 or null"),
         ("ticks", lambda v: v is None or (type(v) is int and v >= 0), "an integer >= 0"),

@@ -31,6 +31,7 @@ from fcplan.trace import TRACE_FIELDS, TraceField
 __all__ = [
     "FORMAT",
     "FORMAT_VERSION",
+    "READ_VERSIONS",
     "RECORDING_FIELDS",
     "SCHEMA",
     "WORLD_ENTRIES",
@@ -40,7 +41,10 @@ __all__ = [
 ]
 
 FORMAT = "fcplan-recording"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+"""Version this fcplan writes. Version 1 (before the default wind model became ``"tables"``)
+reads too: its scenarios that name no wind model used ``"fresh"``."""
+READ_VERSIONS = (1, 2)
 
 #: bits of ``command_flags``: route given, patrol, home, altitude given
 ROUTE, PATROL, HOME, ALTITUDE = 1, 2, 4, 8

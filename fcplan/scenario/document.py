@@ -19,8 +19,8 @@ A scenario file is a TOML document::
     [fire]
     mode = "specific"           # uniform | specific (default specific)
     # action_gate = "sensed"    # sensed (manual rule) | reference (2020 code's looser gate)
-    # wind_model = "fresh"      # fresh (new draws every fire step) | tables (the original's
-    #                           #   per-episode sample tables); see fcplan.fire
+    # wind_model = "tables"     # tables (the original's per-episode sample tables, default) |
+    #                           #   fresh (new draws every fire step); see fcplan.fire
     # fronts, delay_s, fuel, wind_speed, wind_dir_deg, half_width here are defaults for every
     # region (in uniform mode, write them here only)
 
@@ -438,8 +438,7 @@ def scenario_to_dict(s: Scenario) -> dict[str, Any]:
     fire: dict[str, Any] = {"mode": s.fire_mode}
     if s.action_gate != "sensed":
         fire["action_gate"] = s.action_gate
-    if s.wind_model != DEFAULT_WIND_MODEL:
-        fire["wind_model"] = s.wind_model
+    fire["wind_model"] = s.wind_model  # (always: the default changed once, from "fresh")
     shared = _UNIFORM_PARAMS if s.fire_mode == "uniform" else ()
     fire.update({key: getattr(s.regions[0], key) for key in shared})
     regions = []

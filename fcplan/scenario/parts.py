@@ -104,8 +104,10 @@ ACTION_GATES = ("sensed", "reference")
 WIND_MODELS = ("tables", "fresh")
 """Wind models of the fire (:mod:`fcplan.fire`): the original's per-episode sample tables, or
 fresh draws every fire step."""
-DEFAULT_WIND_MODEL = "fresh"
-"""Wind model of scenarios that do not name one (``[fire] wind_model``)."""
+DEFAULT_WIND_MODEL = "tables"
+"""Wind model of scenarios that do not name one (``[fire] wind_model``): the original's, so that
+fcplan's fire is statistically the original's (:mod:`fcplan.fire`, "Wind"). It was ``"fresh"``
+before recording format 2; documents written since always name their wind model."""
 
 
 def _is_real(v: Any) -> bool:

@@ -21,9 +21,11 @@ OLD_FILE = Path(__file__).parent.parent / "data" / "recording_v1_practice.npz"
 
 
 def test_recording_written_before_still_loads_and_resimulates():
-    """A file written by an earlier fcplan loads, re-simulates to identical world and command
-    arrays, and scores the same from its arrays as from the re-simulation."""
+    """A file written by an earlier fcplan (format version 1, whose scenarios name no wind model:
+    they used "fresh", the default then) loads with that wind model, re-simulates to identical
+    world and command arrays, and scores the same from its arrays as from the re-simulation."""
     rec = load_recording(OLD_FILE)
+    assert rec.header["format_version"] == 1 and rec.scenario.wind_model == "fresh"
     assert rec.source == "greedy" and rec.seed == 7 and rec.n_ticks == 250
     assert (
         rec.arrays["pruned_cells"].size > 0 and len(rec.replans) == rec.arrays["replan_tick"].size

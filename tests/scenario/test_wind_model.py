@@ -11,9 +11,10 @@ from tests.scenario.designs import edit, load_error, write
 
 
 def test_wind_model_defaults_to_the_default_and_is_read_from_the_fire_table(tmp_path):
-    """Without ``wind_model`` a scenario has DEFAULT_WIND_MODEL; ``[fire] wind_model`` sets it."""
+    """Without ``wind_model`` a scenario has DEFAULT_WIND_MODEL, the original's "tables" model
+    (issue 15: statistically the original's fire); ``[fire] wind_model`` sets it."""
     assert load_scenario(write(tmp_path, edit("[fire]", "[fire]"))).wind_model == DEFAULT_WIND_MODEL
-    assert load_scenario(12).wind_model == DEFAULT_WIND_MODEL
+    assert load_scenario(12).wind_model == DEFAULT_WIND_MODEL == "tables"
     for model in WIND_MODELS:
         s = load_scenario(write(tmp_path, edit("[fire]", f'[fire]\nwind_model = "{model}"')))
         assert s.wind_model == model
@@ -21,11 +22,12 @@ def test_wind_model_defaults_to_the_default_and_is_read_from_the_fire_table(tmp_
 
 @pytest.mark.parametrize("model", WIND_MODELS)
 def test_wind_model_survives_a_write_and_read(tmp_path, model):
-    """dump_scenario writes a non-default wind model (and omits the default); loading the text
-    gives an equal scenario."""
+    """dump_scenario always writes the wind model, the default too (the default changed once,
+    from "fresh" to "tables": a file must not depend on it); loading the text gives an equal
+    scenario."""
     s = load_scenario(1).replace(wind_model=model)
     text = dump_scenario(s)
-    assert ("wind_model" in text) == (model != DEFAULT_WIND_MODEL)
+    assert f'wind_model = "{model}"' in text
     path = tmp_path / "copy.toml"
     path.write_text(text, encoding="utf-8")
     assert load_scenario(path) == s
