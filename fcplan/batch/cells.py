@@ -32,7 +32,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["CellGrid", "scan_boxes", "SENSED", "BLOCK", "STATE_BITS"]
+__all__ = ["CellGrid", "scan_boxes", "runs", "SENSED", "BLOCK", "STATE_BITS"]
 
 #: side of a block (px); equal to :data:`fcplan.fire.BLOCK`
 BLOCK = 16
@@ -84,13 +84,14 @@ class CellGrid:
         """Indices into :attr:`flat_blocks` of the blocks of cells ``(x, y)`` of ``world``."""
         return world * (self.nb * self.nb) + (x >> _SHIFT) * self.nb + (y >> _SHIFT)
 
-    def touch(self, world: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
-        """Note that cells ``(x, y)`` of ``world`` were written (see :attr:`used`)."""
-        bx, by = x >> _SHIFT, y >> _SHIFT
-        np.minimum.at(self.used[:, 0], world, bx)
-        np.maximum.at(self.used[:, 1], world, bx)
-        np.minimum.at(self.used[:, 2], world, by)
-        np.maximum.at(self.used[:, 3], world, by)
+    def touch(self, worlds: np.ndarray, lo: tuple, hi: tuple) -> None:
+        """Note that cells of ``worlds`` (distinct) within ``[lo[0], hi[0]] x [lo[1], hi[1]]``
+        were written (see :attr:`used`)."""
+        used = self.used
+        used[worlds, 0] = np.minimum(used[worlds, 0], lo[0] >> _SHIFT)
+        used[worlds, 1] = np.maximum(used[worlds, 1], hi[0] >> _SHIFT)
+        used[worlds, 2] = np.minimum(used[worlds, 2], lo[1] >> _SHIFT)
+        used[worlds, 3] = np.maximum(used[worlds, 3], hi[1] >> _SHIFT)
 
     def clear(self, b: int) -> None:
         """Zero world ``b``'s cells and block counts (only the blocks it touched)."""
@@ -165,6 +166,22 @@ def scan_boxes(
     pair, rem = np.divmod(key, ww)
     x, y = np.divmod(rem, w)
     return pair, x, y
+
+
+def runs(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and lengths of the runs of equal values of a sorted 1-D array (its distinct
+    values are ``a[starts]``: ``np.unique(a, return_counts=True)`` of sorted input, cheaper).
+
+    Examples
+    --------
+    >>> starts, counts = runs(np.array([2, 2, 5, 7, 7, 7]))
+    >>> starts.tolist(), counts.tolist()
+    ([0, 2, 3], [2, 1, 3])
+    """
+    if a.size == 0:
+        return _EMPTY, _EMPTY
+    starts = np.flatnonzero(np.concatenate(([True], a[1:] != a[:-1])))
+    return starts, np.diff(np.append(starts, a.size))
 
 
 _EMPTY = np.zeros(0, dtype=np.int64)

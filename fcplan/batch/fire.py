@@ -45,8 +45,8 @@ import math
 
 import numpy as np
 
-from fcplan._fast.fire import draw_ahead, draw_ahead_tables
-from fcplan.batch.cells import SENSED, STATE_BITS, CellGrid
+from fcplan._fast.fire import draw_ahead, draw_ahead_tables, unique
+from fcplan.batch.cells import SENSED, STATE_BITS, CellGrid, runs
 from fcplan.batch.streams import TerrainJump
 from fcplan.farsite import (
     INTERP_MAX,
@@ -277,24 +277,30 @@ class BatchFire:
         grid, w = self.grid, self.world_size
         if wb.size == 0:
             return _EMPTY, _EMPTY, _EMPTY
-        key = np.unique((wb * w + x) * w + y)
+        key = unique((wb * w + x) * w + y)
         wb, rem = np.divmod(key, w * w)
         x, y = np.divmod(rem, w)
         g = grid.index(wb, x, y)
         fresh = grid.flat_state[g] & STATE_BITS == UNBURNT
         if not fresh.all():
             wb, x, y, g = wb[fresh], x[fresh], y[fresh], g[fresh]
+            if wb.size == 0:
+                return _EMPTY, _EMPTY, _EMPTY
         grid.flat_state[g] = BURNING
         np.add.at(grid.flat_blocks, grid.block_index(wb, x, y), 1)
-        grid.touch(wb, x, y)
-        counts = np.bincount(wb, minlength=self.num)
-        self.n_burning += counts
-        self.n_ignited += counts
+        # per world (the cells are sorted by world, then x): counts and the box of the new cells
+        start, counts = runs(wb)
+        worlds = wb[start]
+        self.n_burning[worlds] += counts
+        self.n_ignited[worlds] += counts
+        lo = (x[start], np.minimum.reduceat(y, start))
+        hi = (x[np.append(start[1:], wb.size) - 1], np.maximum.reduceat(y, start))
         box = self.burn_box
-        np.minimum.at(box[:, 0], wb, x)
-        np.maximum.at(box[:, 1], wb, x)
-        np.minimum.at(box[:, 2], wb, y)
-        np.maximum.at(box[:, 3], wb, y)
+        box[worlds, 0] = np.minimum(box[worlds, 0], lo[0])
+        box[worlds, 1] = np.maximum(box[worlds, 1], hi[0])
+        box[worlds, 2] = np.minimum(box[worlds, 2], lo[1])
+        box[worlds, 3] = np.maximum(box[worlds, 3], hi[1])
+        grid.touch(worlds, lo, hi)
         return wb, x, y
 
     def prune(self, wb: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:

@@ -43,7 +43,8 @@ from typing import Any
 
 import numpy as np
 
-from fcplan.batch.cells import SENSED, STATE_BITS, CellGrid, scan_boxes
+from fcplan._fast.fire import unique
+from fcplan.batch.cells import SENSED, STATE_BITS, CellGrid, runs, scan_boxes
 from fcplan.batch.fire import BatchFire
 from fcplan.batch.streams import UniformBlocks, seed_list, spawn_streams
 from fcplan.batch.team import BatchTeam
@@ -266,14 +267,14 @@ class BatchWorld:
         if pair.size == 0:
             return (_EMPTY, _EMPTY), (_EMPTY, _EMPTY)
         wb = pw[pair]
-        worlds, per_world = np.unique(wb, return_counts=True)
-        u = self._sense_streams.take(worlds, per_world)
+        start, per_world = runs(wb)
+        u = self._sense_streams.take(wb[start], per_world)
         conf = self.team.sensing_confidence()[pw, s[pa]]
         if self.tps != 10:  # (Python floats: the single world's own power function)
             conf = np.array([per_tick_probability(float(c), self.tps) for c in conf.tolist()])
         keep = u < conf[pair]
         wb, flat = wb[keep], x[keep] * self.world_size + y[keep]
-        key = np.unique(wb * self.world_size**2 + flat)
+        key = unique(wb * self.world_size**2 + flat)
         wb, flat = np.divmod(key, self.world_size**2)
         g = self.grid.index(wb, *np.divmod(flat, self.world_size))
         new = (self.grid.flat_state[g] & SENSED) == 0
@@ -323,8 +324,9 @@ class BatchWorld:
             pair, x, y, g = pair[sel], x[sel], y[sel], g[sel]
             if pair.size == 0:
                 return _EMPTY, _EMPTY
-        ones = np.unique(pair)
-        u = self._prune_streams.take(pw[ones], np.bincount(pair)[ones])
+        ones, per_pair = runs(pair)
+        ones = pair[ones]
+        u = self._prune_streams.take(pw[ones], per_pair)
         keep = u < self.team.prune_confidence[pa[pair]]
         hit_w, hx, hy, hg = pw[pair][keep], x[keep], y[keep], g[keep]
         if hit_w.size:
