@@ -195,16 +195,17 @@ class BatchWorld:
         self._started[b] = True
 
     # ------------------------------------------------------------------ step
-    def step(self, *, autoreset: bool = False) -> BatchStepInfo:
+    def step(self, *, autoreset: bool = False, mask: np.ndarray | None = None) -> BatchStepInfo:
         """Advance every running world one tick (held worlds stay; with ``autoreset`` they are
-        reset instead and not stepped); return what happened."""
+        reset instead and not stepped; ``mask``, (B,) bool, holds the others too); return what
+        happened."""
         if not self._started.all():
             raise ValueError("BatchWorld.step before reset() of every world")
         done = self.done
         reset = done if autoreset else np.zeros(self.num, dtype=bool)
         if autoreset and np.count_nonzero(done):
             self.reset(mask=done)
-        run = ~done
+        run = ~done if mask is None else ~done & mask
         team = self.team
         arrived = team.move(run)
         self.tick += run
@@ -376,6 +377,17 @@ class BatchWorld:
         for name, arr in self._agents.items():
             rows[name] = arr[b, :t].copy()
         return rows
+
+    def trace_sum(self, b: int, name: str, start: int, stop: int) -> np.ndarray:
+        """Sum over trace rows ``start:stop`` of world ``b``'s count array ``name`` (one of
+        ``active``, ``pruned``, ``sensed_active``, ``sensed_ever``, ``facility_burning``,
+        ``facility_pruned``), as int64: :meth:`fcplan.World.trace_sum`."""
+        names = ("active", "pruned", "sensed_active", "sensed_ever")
+        if name in names:
+            rows = self._counts[names.index(name), b, start:stop]
+        else:
+            rows = self._fac[("facility_burning", "facility_pruned").index(name), b, start:stop]
+        return rows.astype(np.int64).sum(axis=0)
 
     def trace(self, b: int) -> Trace:
         """World ``b``'s :class:`fcplan.trace.Trace` (needs ``record_agents=True``)."""

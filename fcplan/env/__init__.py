@@ -71,6 +71,7 @@ __all__ = [
     "VERSIONED",
     "vector_env",
     "VectorMotionEnv",
+    "VectorTaskEnv",
 ]
 
 #: Environment levels accepted by :func:`parallel_env`.
@@ -88,6 +89,7 @@ _LAZY = {
     "PlanFollower": "fcplan.env.motion_expert",
     "vector_env": "fcplan.env.vector",
     "VectorMotionEnv": "fcplan.env.vector_motion",
+    "VectorTaskEnv": "fcplan.env.vector_task",
 }
 
 

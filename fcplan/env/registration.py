@@ -59,6 +59,7 @@ ENV_IDS: dict[str, tuple[str, dict[str, Any]]] = {
 #: Gymnasium id -> the batched env ``gymnasium.make_vec`` makes (:mod:`fcplan.env.vector`).
 VECTOR_ENTRY_POINTS: dict[str, str] = {
     "fcplan/Motion-v0": "fcplan.env.vector_motion:VectorMotionEnv",
+    "fcplan/Task-v0": "fcplan.env.vector_task:VectorTaskEnv",
 }
 
 

@@ -9,9 +9,15 @@ over worlds on the per-tick path):
     action masks. World ``i`` is bit for bit ``fcplan/Motion-v0`` (the centralised view of
     :class:`fcplan.env.motion.MotionEnv`) with seed ``s + i``.
 
-``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` returns the same class
-(the id's ``vector_entry_point``); ``vectorization_mode="sync"`` still gives Gymnasium's
-``SyncVectorEnv`` of single envs, which the batched one matches step for step.
+``mode="task"`` (:class:`fcplan.env.vector_task.VectorTaskEnv`)
+    One step is one replan period of every world; actions ``(B, A)`` candidate slots,
+    observations ``(B, A, ...)``; world ``i`` is ``fcplan/Task-v0`` with seed ``s + i``. The
+    ticks are batched; the belief, task graph, candidates and features stay per world (that
+    module says why and ``bench/README.md`` measures it).
+
+``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` (and ``"fcplan/Task-v0"``)
+return the same classes (the ids' ``vector_entry_point``); ``vectorization_mode="sync"`` still
+gives Gymnasium's ``SyncVectorEnv`` of single envs, which the batched ones match step for step.
 
 Examples
 --------
@@ -34,7 +40,7 @@ from fcplan.errors import EnvError
 __all__ = ["vector_env", "VECTOR_MODES"]
 
 #: levels :func:`vector_env` batches
-VECTOR_MODES = ("motion",)
+VECTOR_MODES = ("motion", "task")
 
 
 def vector_env(scenario: Any, mode: str = "motion", num_envs: int = 1, **kwargs: Any) -> Any:
@@ -44,12 +50,13 @@ def vector_env(scenario: Any, mode: str = "motion", num_envs: int = 1, **kwargs:
     ----------
     scenario : Scenario, str or int
         A scenario or a name/path for :func:`fcplan.load_scenario`.
-    mode : {"motion"}
+    mode : {"motion", "task"}
         The level (module docstring).
     num_envs : int
         Worlds ``B``.
     **kwargs
-        The level's options (``autoreset_mode``, ``cell_px``, ``view``, ...).
+        The level's options (``autoreset_mode``; ``cell_px``, ``view``, ... at the motion level;
+        ``k``, ``replan_period``, ... at the task level).
 
     Raises
     ------
@@ -60,4 +67,8 @@ def vector_env(scenario: Any, mode: str = "motion", num_envs: int = 1, **kwargs:
         from fcplan.env.vector_motion import VectorMotionEnv
 
         return VectorMotionEnv(scenario, num_envs, **kwargs)
+    if mode == "task":
+        from fcplan.env.vector_task import VectorTaskEnv
+
+        return VectorTaskEnv(scenario, num_envs, **kwargs)
     raise EnvError(f"mode: must be one of {', '.join(VECTOR_MODES)} (got {mode!r})")

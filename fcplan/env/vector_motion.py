@@ -49,21 +49,20 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
-from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from fcplan.batch import BatchStepInfo, BatchWorld
 from fcplan.env.motion_obs import N_AGENT_FEATURES, N_FOV
+from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows
 from fcplan.env.vector_obs import BatchMotionObs
 from fcplan.errors import EnvError
 from fcplan.metrics import facility_penalty
 from fcplan.mission import ScenarioLike, as_scenario
 from fcplan.team import CLIMB_PER_TICK
 
-__all__ = ["VectorMotionEnv", "AUTORESET_MODES"]
+__all__ = ["VectorMotionEnv"]
 
-#: accepted ``autoreset_mode`` values
-AUTORESET_MODES = ("next_step", "same_step", "disabled")
 _STAY, _MOVE, _ALTITUDE, _DUMP = range(4)
 _ACTIVE = 1
 _GOAL_REACH = 1.5  # (fcplan.env.motion: a move sets a goal 1.5 steps away)
@@ -75,22 +74,8 @@ _NAMES = {
 _DIRS = {"west": (-1.0, 0.0), "east": (1.0, 0.0), "north": (0.0, -1.0), "south": (0.0, 1.0)}
 
 
-def autoreset_from(mode: str | AutoresetMode) -> AutoresetMode:
-    """The :class:`gymnasium.vector.AutoresetMode` named ``mode`` (``"next_step"``,
-    ``"same_step"``, ``"disabled"``, or Gymnasium's own values)."""
-    if isinstance(mode, AutoresetMode):
-        return mode
-    names = dict(zip(AUTORESET_MODES, AutoresetMode, strict=True))
-    names.update({m.value: m for m in AutoresetMode})
-    if mode not in names:
-        raise EnvError(f"autoreset_mode: must be one of {', '.join(AUTORESET_MODES)} (got {mode!r})")
-    return names[mode]
-
-
-class VectorMotionEnv(VectorEnv):
+class VectorMotionEnv(BatchedEnv):
     """``num_envs`` motion-level worlds of ``scenario`` stepped together (module docstring)."""
-
-    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
     def __init__(
         self,
@@ -108,9 +93,7 @@ class VectorMotionEnv(VectorEnv):
         reward_fn: Any = None,
     ) -> None:
         sc = as_scenario(scenario)
-        self.autoreset_mode = autoreset_from(autoreset_mode)
-        if int(num_envs) < 1:
-            raise EnvError(f"num_envs: must be >= 1 (got {num_envs})")
+        self._setup(num_envs, autoreset_mode)
         if int(cell_px) < 1:
             raise EnvError(f"cell_px: must be >= 1 (got {cell_px})")
         if int(view) < 1 or int(view) % 2 == 0:
@@ -120,8 +103,7 @@ class VectorMotionEnv(VectorEnv):
         if reward_fn is not None:
             raise EnvError("reward_fn: a custom reward works on one World and is not batched")
         self.scenario = sc
-        self.metadata = {**self.metadata, "autoreset_mode": self.autoreset_mode}
-        self.num_envs = b = int(num_envs)
+        b = self.num_envs
         self.idle_rule = bool(idle_rule)
         self.shaping = (float(sense_bonus), float(prune_bonus), float(dump_cost))
         self.batch = BatchWorld(sc, b)
@@ -140,11 +122,9 @@ class VectorMotionEnv(VectorEnv):
         self.single_action_space = spaces.MultiDiscrete(self.views.n_actions.copy())
         self.observation_space = batch_space(self.single_observation_space, b)
         self.action_space = batch_space(self.single_action_space, b)
-        self._pending = np.zeros(b, dtype=bool)  # next-step autoreset due
         self._weight = sc.scoring.propagation_weight
         self._fb_last = np.full((b, self.batch.n_facilities), -1, dtype=np.int64)
         self._fb_pen = np.zeros(b)
-        self._started = False
 
     def _actions_table(self) -> None:
         """Per agent and action: kind, goal offset (dx, dy) and altitude change."""
@@ -172,13 +152,12 @@ class VectorMotionEnv(VectorEnv):
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         """Start episodes: every world (``seed``: an int ``s`` for ``s, s + 1, ...``, a list of
         seeds, or None to continue each world's seeds), or only ``options["reset_mask"]``."""
-        mask = None if not options else options.get("reset_mask")
-        if mask is not None:
-            mask = np.asarray(mask, dtype=bool).reshape(self.num_envs)
-        elif not isinstance(seed, (int, np.integer)) and seed is not None:
+        rows = reset_rows(self.num_envs, seed, options)
+        mask = np.zeros(self.num_envs, dtype=bool)
+        mask[rows] = True
+        if seed is not None and not isinstance(seed, (int, np.integer)):
             seed = list(seed)
         self.batch.reset(seeds=seed, mask=mask)
-        rows = np.arange(self.num_envs) if mask is None else np.flatnonzero(mask)
         self._reset_views(rows)
         self._started = True
         return self.views.observe(self.batch), {}
@@ -191,12 +170,10 @@ class VectorMotionEnv(VectorEnv):
     # ------------------------------------------------------------------ step
     def step(self, actions: Any) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """Advance every world one tick with ``actions`` ((B, N) ints); see the module docstring."""
-        if not self._started:
-            raise EnvError("step: call reset() first")
-        act = self._check(actions)
         batch = self.batch
+        run = self._stepping(batch.done)
+        act = self._check(actions)
         next_step = self.autoreset_mode is AutoresetMode.NEXT_STEP
-        run = ~(self._pending if next_step else batch.done)
         self._decode(act, run)
         info = batch.step(autoreset=next_step)
         batch.team.armed.fill(False)
@@ -211,7 +188,7 @@ class VectorMotionEnv(VectorEnv):
         obs = self.views.observe(batch)
         if self.autoreset_mode is AutoresetMode.SAME_STEP and np.count_nonzero(truncs):
             obs = self._same_step_reset(truncs, obs, infos)
-        self._pending = truncs.copy()
+        self._ended(truncs)
         terms = np.zeros(self.num_envs, dtype=bool)
         return obs, rewards, terms, truncs, infos
 
@@ -278,22 +255,19 @@ class VectorMotionEnv(VectorEnv):
         return np.where(info.ran, r, 0.0)
 
     def _final_metrics(self, truncs: np.ndarray, infos: dict[str, Any]) -> None:
-        out = np.empty(self.num_envs, dtype=object)
-        for b in np.flatnonzero(truncs).tolist():
-            out[b] = {k: m.as_dict() for k, m in self.batch.metrics(b).items()}
-        infos["metrics"], infos["_metrics"] = out, truncs.copy()
+        def metrics(b: int) -> dict[str, Any]:
+            return {k: m.as_dict() for k, m in self.batch.metrics(b).items()}
+
+        infos["metrics"], infos["_metrics"] = per_world_info(truncs, metrics)
 
     def _same_step_reset(
         self, truncs: np.ndarray, obs: dict[str, np.ndarray], infos: dict[str, Any]
     ) -> dict[str, np.ndarray]:
         """Reset the worlds that just ended; their final observations go into the infos."""
-        final = np.empty(self.num_envs, dtype=object)
-        final_info = np.empty(self.num_envs, dtype=object)
-        for b in np.flatnonzero(truncs).tolist():
-            final[b] = {k: v[b].copy() for k, v in obs.items()}
-            final_info[b] = {"metrics": infos["metrics"][b]}
-        infos.update(final_obs=final, _final_obs=truncs.copy())
-        infos.update(final_info=final_info, _final_info=truncs.copy())
+        final, mask = per_world_info(truncs, lambda b: {k: v[b].copy() for k, v in obs.items()})
+        infos.update(final_obs=final, _final_obs=mask)
+        final_info, mask = per_world_info(truncs, lambda b: {"metrics": infos["metrics"][b]})
+        infos.update(final_info=final_info, _final_info=mask)
         self.batch.reset(mask=truncs)
         self._reset_views(np.flatnonzero(truncs))
         return self.views.observe(self.batch)
@@ -301,6 +275,3 @@ class VectorMotionEnv(VectorEnv):
     def state(self) -> np.ndarray:
         """Global state of every world, ``(B, 8, nc, nc)`` float32 (``MotionEnv.state``)."""
         return self.views.state(self.batch)
-
-    def close_extras(self, **kwargs: Any) -> None:
-        """Nothing to release."""

@@ -1,0 +1,223 @@
+"""Benchmark the batched motion level: world-steps per second against the single env, same run.
+
+For scenarios #1 and #24 it plays, with random legal actions (drawn from the action masks; the
+draw is not timed):
+
+* the single env (:class:`fcplan.env.motion.MotionEnv`), ``--episodes`` whole episodes, timing
+  ``env.step`` only (resets excluded), and inside it the simulator (``Mission.step``);
+* :class:`fcplan.env.vector_motion.VectorMotionEnv` with ``B`` worlds for every ``B`` of
+  ``--sizes`` (default 1, 16, 64, 256, 1024), one whole episode of every world (the worlds start
+  together: ``n_ticks`` steps, next-step autoreset of all of them at the end included), timing
+  ``env.step`` and inside it the batched simulator (``BatchWorld.step``).
+
+It prints world-steps per second (``B`` x steps / time) on the thread's CPU clock and on the wall
+clock with the load average (the machine may be shared: compare the CPU-time ratios), the ratio
+to the single env of the same scenario measured in the same run, the simulator alone (its ratio
+too), where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
+action decoding, rewards), and the memory per world (``tracemalloc``: the growth from the
+smallest to the largest ``B``, per added world; the tables every world shares are the rest).
+
+Usage::
+
+    python bench/bench_vector.py                       # about 4 minutes on a quiet 2-core machine
+    python bench/bench_vector.py --quick               # 30-s episodes, sizes 1, 16, 256
+    python bench/bench_vector.py --plot vector.png     # also plot throughput against B
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import gc
+import os
+import platform
+import time
+import tracemalloc
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+import fcplan.batch.fire as bfire
+import fcplan.batch.world as bworld
+import fcplan.env.vector_motion as vmotion
+import fcplan.env.vector_obs as vobs
+from fcplan.env.motion import MotionEnv
+from fcplan.env.vector_motion import VectorMotionEnv
+from fcplan.scenario import load_scenario
+
+_CPU, _WALL = time.thread_time, time.perf_counter
+
+
+class Clock:
+    """CPU and wall seconds of timed sections."""
+
+    def __init__(self) -> None:
+        self.cpu: collections.Counter = collections.Counter()
+        self.wall: collections.Counter = collections.Counter()
+
+    def wrap(self, owner: Any, name: str, label: str) -> Callable[[], None]:
+        """Time every call of ``owner.name`` under ``label``; return the undo function."""
+        inner = getattr(owner, name)
+
+        def timed(*a: Any, **k: Any) -> Any:
+            c, w = _CPU(), _WALL()
+            out = inner(*a, **k)
+            self.cpu[label] += _CPU() - c
+            self.wall[label] += _WALL() - w
+            return out
+
+        setattr(owner, name, timed)
+        return lambda: setattr(owner, name, inner)
+
+
+def single_env(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
+    """Steps of ``episodes`` episodes of the single env with random legal actions, timed."""
+    env = MotionEnv(sc)
+    rng = np.random.default_rng(seed)
+    clock, steps = Clock(), 0
+    for ep in range(episodes):
+        obs, _ = env.reset(seed=seed + ep)
+        undo = clock.wrap(env.mission, "step", "sim")
+        while env.agents:
+            act = {a: int(rng.choice(np.flatnonzero(obs[a]["action_mask"]))) for a in env.agents}
+            c, w = _CPU(), _WALL()
+            obs, *_ = env.step(act)
+            clock.cpu["step"] += _CPU() - c
+            clock.wall["step"] += _WALL() - w
+            steps += 1
+        undo()
+    return steps, clock
+
+
+_PARTS = [
+    (bworld.BatchWorld, "step", "sim"),
+    (bworld.BatchWorld, "_fire_steps", "sim: fire"),
+    (bfire.BatchFire, "_refill", "sim: fire: wind blocks"),
+    (bfire.BatchFire, "_terrain", "sim: fire: terrain"),
+    (bfire.BatchFire, "ignite", "sim: fire: ignition"),
+    (bworld.BatchWorld, "_sense", "sim: sensing"),
+    (bworld.BatchWorld, "_prune", "sim: dumps"),
+    (bworld.BatchWorld, "_record", "sim: trace rows"),
+    (vobs.BatchMotionObs, "update", "obs: map updates"),
+    (vobs.BatchMotionObs, "observe", "obs: observe"),
+    (vobs.BatchMotionObs, "agent_arrays", "obs: observe: agent vectors, masks"),
+    (vmotion.VectorMotionEnv, "_decode", "actions"),
+    (vmotion.VectorMotionEnv, "_rewards", "rewards"),
+]
+
+
+def batched_env(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int, Clock]:
+    """World-steps of one whole episode of ``num`` worlds (and the autoreset step), timed."""
+    env = VectorMotionEnv(sc, num)
+    rng = np.random.default_rng(seed)
+    clock = Clock()
+    undo = [clock.wrap(o, n, lab) for o, n, lab in _PARTS] if parts else []
+    if not parts:
+        undo.append(clock.wrap(bworld.BatchWorld, "step", "sim"))
+    obs, _ = env.reset(seed=seed)
+    for _ in range(sc.n_ticks + 1):
+        m = obs["action_mask"]
+        act = (rng.random(m.shape) * m).argmax(axis=2)
+        c, w = _CPU(), _WALL()
+        obs, *_ = env.step(act)
+        clock.cpu["step"] += _CPU() - c
+        clock.wall["step"] += _WALL() - w
+    for u in undo:
+        u()
+    return num * (sc.n_ticks + 1), clock
+
+
+def memory_per_world(sc: Any, small: int, large: int) -> tuple[float, float]:
+    """(bytes per added world, bytes of the rest) of a stepped batched env, by tracemalloc."""
+    sizes = []
+    for num in (small, large):
+        gc.collect()
+        tracemalloc.start()
+        env = VectorMotionEnv(sc, num)
+        obs, _ = env.reset(seed=0)
+        for _ in range(5):
+            obs, *_ = env.step(np.zeros((num, len(env.agent_ids)), dtype=np.int64))
+        sizes.append(tracemalloc.get_traced_memory()[0])
+        tracemalloc.stop()
+        del env, obs
+    per = (sizes[1] - sizes[0]) / (large - small)
+    return per, sizes[0] - small * per
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="30-s episodes, sizes 1, 16, 256")
+    ap.add_argument("--sizes", type=int, nargs="+", default=None, help="batch sizes B")
+    ap.add_argument("--episodes", type=int, default=2, help="single-env episodes")
+    ap.add_argument("--scenarios", nargs="+", default=["1", "24"])
+    ap.add_argument("--plot", default=None, help="write a plot of throughput against B here")
+    args = ap.parse_args(argv)
+    sizes = args.sizes or ([1, 16, 256] if args.quick else [1, 16, 64, 256, 1024])
+    print(f"# batched motion level, random legal actions; Python {platform.python_version()}, "
+          f"numpy {np.__version__}; load average at start {os.getloadavg()[0]:.2f}")  # fmt: skip
+    print("# world-steps/s on the thread CPU clock (wall clock); ratio = CPU-time world-steps/s "
+          "over the single env's in this run")  # fmt: skip
+    results: dict[str, list[tuple[int, float]]] = {}
+    for name in args.scenarios:
+        sc = load_scenario(name)
+        if args.quick:
+            sc = sc.replace(duration_s=30)
+        steps, clock = single_env(sc, args.episodes)
+        base = steps / clock.cpu["step"]
+        base_sim = steps / clock.cpu["sim"]
+        print(f"\n## #{name}  (load {os.getloadavg()[0]:.2f})")
+        print(f"{'env':14s} {'world-steps/s':>22s} {'ratio':>7s} {'sim world-steps/s':>19s} "
+              f"{'sim ratio':>9s} {'us/world-step':>13s}")  # fmt: skip
+        print(f"{'single':14s} {base:10.0f} ({steps / clock.wall['step']:9.0f}) {1.0:7.2f} "
+              f"{base_sim:19.0f} {1.0:9.2f} {1e6 / base:13.2f}")  # fmt: skip
+        results[name] = [(0, base)]
+        last = None
+        for num in sizes:
+            ws, clock = batched_env(sc, num, parts=num == sizes[-1])
+            rate, sim = ws / clock.cpu["step"], ws / clock.cpu["sim"]
+            print(f"{'B=' + str(num):14s} {rate:10.0f} ({ws / clock.wall['step']:9.0f}) "
+                  f"{rate / base:7.2f} {sim:19.0f} {sim / base_sim:9.2f} {1e6 / rate:13.2f}")  # fmt: skip
+            results[name].append((num, rate))
+            last = (num, ws, clock)
+        assert last is not None
+        num, ws, clock = last
+        total = clock.cpu["step"]
+        print(f"where a step goes at B={num} (CPU ms per step; % of env.step):")
+        for label in [lab for _, _, lab in _PARTS]:
+            ms = clock.cpu[label] / (sc.n_ticks + 1) * 1e3
+            print(f"  {label:38s} {ms:8.3f}  {100 * clock.cpu[label] / total:5.1f}%")
+    sc = load_scenario(args.scenarios[0])
+    per, rest = memory_per_world(sc, 16, 64 if args.quick else 256)
+    print(f"\nmemory (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
+          f"{rest / 1e6:.1f} MB shared (terrain jump tables, maps, team constants)")
+    if args.plot:
+        _plot(results, args.plot)
+        print(f"plot: {args.plot}")
+    return 0
+
+
+def _plot(results: dict[str, list[tuple[int, float]]], path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for k, (name, rows) in enumerate(results.items()):
+        xs = [b for b, _ in rows[1:]]
+        ax.plot(xs, [r for _, r in rows[1:]], "o-", color=f"C{k}", label=f"batched #{name}")
+        ax.axhline(rows[0][1], color=f"C{k}", ls="--", label=f"single env #{name}")
+    ax.set_xscale("log", base=2)
+    ax.set_yscale("log")
+    ax.set_xlabel("worlds per batch B")
+    ax.set_ylabel("world-steps per CPU second")
+    ax.set_title("fcplan motion level: batched vs single env")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
