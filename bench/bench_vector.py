@@ -42,8 +42,11 @@ import fcplan.batch.fire as bfire
 import fcplan.batch.world as bworld
 import fcplan.env.vector_motion as vmotion
 import fcplan.env.vector_obs as vobs
+import fcplan.env.vector_task as vtask
+from fcplan.env.gym_view import TaskGymEnv
 from fcplan.env.motion import MotionEnv
 from fcplan.env.vector_motion import VectorMotionEnv
+from fcplan.env.vector_task import VectorTaskEnv
 from fcplan.scenario import load_scenario
 
 _CPU, _WALL = time.thread_time, time.perf_counter
@@ -145,12 +148,65 @@ def memory_per_world(sc: Any, small: int, large: int) -> tuple[float, float]:
     return per, sizes[0] - small * per
 
 
+def single_task(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
+    """Steps of ``episodes`` episodes of ``fcplan/Task-v0`` with random legal actions, timed."""
+    env = TaskGymEnv(sc)
+    rng = np.random.default_rng(seed)
+    clock, steps = Clock(), 0
+    for ep in range(episodes):
+        obs, _ = env.reset(seed=seed + ep)
+        undo = clock.wrap(env.env.mission.world, "step", "sim")
+        done = False
+        while not done:
+            m = obs["action_mask"]
+            act = (rng.random(m.shape) * m).argmax(axis=1)
+            c, w = _CPU(), _WALL()
+            obs, _, _, done, _ = env.step(act)
+            clock.cpu["step"] += _CPU() - c
+            clock.wall["step"] += _WALL() - w
+            steps += 1
+        undo()
+    return steps, clock
+
+
+_TASK_PARTS = [
+    (bworld.BatchWorld, "step", "sim"),
+    (vtask.VectorTaskEnv, "_beliefs", "beliefs (per world)"),
+    (vtask.VectorTaskEnv, "_observe", "graph, candidates, features (per world)"),
+    (vtask.VectorTaskEnv, "_command", "actions to commands (per world)"),
+    (vtask.VectorTaskEnv, "_rewards", "rewards"),
+]
+
+
+def batched_task(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int, Clock]:
+    """World-steps of one whole task-level episode of ``num`` worlds (and the autoreset step)."""
+    env = VectorTaskEnv(sc, num)
+    rng = np.random.default_rng(seed)
+    clock = Clock()
+    chosen = _TASK_PARTS if parts else _TASK_PARTS[:1]
+    undo = [clock.wrap(o, n, lab) for o, n, lab in chosen]
+    obs, _ = env.reset(seed=seed)
+    n = env.one.max_steps + 1
+    for _ in range(n):
+        m = obs["action_mask"]
+        act = (rng.random(m.shape) * m).argmax(axis=2)
+        c, w = _CPU(), _WALL()
+        obs, *_ = env.step(act)
+        clock.cpu["step"] += _CPU() - c
+        clock.wall["step"] += _WALL() - w
+    for u in undo:
+        u()
+    return num * n, clock
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="30-s episodes, sizes 1, 16, 256")
     ap.add_argument("--sizes", type=int, nargs="+", default=None, help="batch sizes B")
     ap.add_argument("--episodes", type=int, default=2, help="single-env episodes")
     ap.add_argument("--scenarios", nargs="+", default=["1", "24"])
+    ap.add_argument("--levels", nargs="+", default=["motion", "task"], choices=["motion", "task"])
+    ap.add_argument("--task-max", type=int, default=256, help="largest B at the task level")
     ap.add_argument("--plot", default=None, help="write a plot of throughput against B here")
     args = ap.parse_args(argv)
     sizes = args.sizes or ([1, 16, 256] if args.quick else [1, 16, 64, 256, 1024])
@@ -159,34 +215,13 @@ def main(argv: list[str] | None = None) -> int:
     print("# world-steps/s on the thread CPU clock (wall clock); ratio = CPU-time world-steps/s "
           "over the single env's in this run")  # fmt: skip
     results: dict[str, list[tuple[int, float]]] = {}
-    for name in args.scenarios:
-        sc = load_scenario(name)
-        if args.quick:
-            sc = sc.replace(duration_s=30)
-        steps, clock = single_env(sc, args.episodes)
-        base = steps / clock.cpu["step"]
-        base_sim = steps / clock.cpu["sim"]
-        print(f"\n## #{name}  (load {os.getloadavg()[0]:.2f})")
-        print(f"{'env':14s} {'world-steps/s':>22s} {'ratio':>7s} {'sim world-steps/s':>19s} "
-              f"{'sim ratio':>9s} {'us/world-step':>13s}")  # fmt: skip
-        print(f"{'single':14s} {base:10.0f} ({steps / clock.wall['step']:9.0f}) {1.0:7.2f} "
-              f"{base_sim:19.0f} {1.0:9.2f} {1e6 / base:13.2f}")  # fmt: skip
-        results[name] = [(0, base)]
-        last = None
-        for num in sizes:
-            ws, clock = batched_env(sc, num, parts=num == sizes[-1])
-            rate, sim = ws / clock.cpu["step"], ws / clock.cpu["sim"]
-            print(f"{'B=' + str(num):14s} {rate:10.0f} ({ws / clock.wall['step']:9.0f}) "
-                  f"{rate / base:7.2f} {sim:19.0f} {sim / base_sim:9.2f} {1e6 / rate:13.2f}")  # fmt: skip
-            results[name].append((num, rate))
-            last = (num, ws, clock)
-        assert last is not None
-        num, ws, clock = last
-        total = clock.cpu["step"]
-        print(f"where a step goes at B={num} (CPU ms per step; % of env.step):")
-        for label in [lab for _, _, lab in _PARTS]:
-            ms = clock.cpu[label] / (sc.n_ticks + 1) * 1e3
-            print(f"  {label:38s} {ms:8.3f}  {100 * clock.cpu[label] / total:5.1f}%")
+    for level in args.levels:
+        for name in args.scenarios:
+            sc = load_scenario(name)
+            if args.quick:
+                sc = sc.replace(duration_s=30)
+            sizes_l = [n for n in sizes if level == "motion" or n <= args.task_max]
+            results[f"{level} #{name}"] = _level(level, sc, name, sizes_l, args.episodes)
     sc = load_scenario(args.scenarios[0])
     per, rest = memory_per_world(sc, 16, 64 if args.quick else 256)
     print(f"\nmemory (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
@@ -195,6 +230,35 @@ def main(argv: list[str] | None = None) -> int:
         _plot(results, args.plot)
         print(f"plot: {args.plot}")
     return 0
+
+
+def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int) -> list:
+    """Print one level's table on one scenario; return ``[(0, single rate), (B, rate), ...]``."""
+    single, batched, parts = (
+        (single_env, batched_env, _PARTS)
+        if level == "motion"
+        else (single_task, batched_task, _TASK_PARTS)
+    )
+    steps, clock = single(sc, episodes)
+    base, base_sim = steps / clock.cpu["step"], steps / clock.cpu["sim"]
+    print(f"\n## {level} level, #{name}  (load {os.getloadavg()[0]:.2f})")
+    print(f"{'env':14s} {'world-steps/s':>22s} {'ratio':>7s} {'sim world-steps/s':>19s} "
+          f"{'sim ratio':>9s} {'us/world-step':>13s}")  # fmt: skip
+    print(f"{'single':14s} {base:10.0f} ({steps / clock.wall['step']:9.0f}) {1.0:7.2f} "
+          f"{base_sim:19.0f} {1.0:9.2f} {1e6 / base:13.2f}")  # fmt: skip
+    rows = [(0, base)]
+    for num in sizes:
+        ws, clock = batched(sc, num, parts=num == sizes[-1])
+        rate, sim = ws / clock.cpu["step"], ws / clock.cpu["sim"]
+        print(f"{'B=' + str(num):14s} {rate:10.0f} ({ws / clock.wall['step']:9.0f}) "
+              f"{rate / base:7.2f} {sim:19.0f} {sim / base_sim:9.2f} {1e6 / rate:13.2f}")  # fmt: skip
+        rows.append((num, rate))
+    n_steps = ws // sizes[-1]
+    print(f"where a step goes at B={sizes[-1]} (CPU ms per step; % of env.step):")
+    for label in [lab for _, _, lab in parts]:
+        ms = clock.cpu[label] / n_steps * 1e3
+        print(f"  {label:40s} {ms:9.3f}  {100 * clock.cpu[label] / clock.cpu['step']:5.1f}%")
+    return rows
 
 
 def _plot(results: dict[str, list[tuple[int, float]]], path: str) -> None:
@@ -206,13 +270,13 @@ def _plot(results: dict[str, list[tuple[int, float]]], path: str) -> None:
     fig, ax = plt.subplots(figsize=(6, 4))
     for k, (name, rows) in enumerate(results.items()):
         xs = [b for b, _ in rows[1:]]
-        ax.plot(xs, [r for _, r in rows[1:]], "o-", color=f"C{k}", label=f"batched #{name}")
-        ax.axhline(rows[0][1], color=f"C{k}", ls="--", label=f"single env #{name}")
+        ax.plot(xs, [r for _, r in rows[1:]], "o-", color=f"C{k}", label=f"batched, {name}")
+        ax.axhline(rows[0][1], color=f"C{k}", ls="--", label=f"single env, {name}")
     ax.set_xscale("log", base=2)
     ax.set_yscale("log")
     ax.set_xlabel("worlds per batch B")
     ax.set_ylabel("world-steps per CPU second")
-    ax.set_title("fcplan motion level: batched vs single env")
+    ax.set_title("fcplan: batched vs single env (world-steps per CPU second)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
