@@ -33,6 +33,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -47,7 +48,7 @@ from fcplan.scheduling import Scheduler, solve
 from fcplan.taskgraph import TaskKind
 
 __all__ = ["EpisodeRecord", "rollout_episode", "recording_episode", "OBS_KEYS"]
-__all__ += ["scenario_from_metadata", "env_kwargs_from_metadata"]
+__all__ += ["batched_rollouts", "scenario_from_metadata", "env_kwargs_from_metadata"]
 
 #: the keys of a joint observation (``fcplan/Task-v0``'s)
 OBS_KEYS = ("agents", "tasks", "action_mask")
@@ -133,11 +134,61 @@ def rollout_episode(
         ticks.append(infos[ids[0]]["tick"])
         ill.append([infos[a]["illegal"] for a in ids])
         con.append([infos[a]["conflict"] for a in ids])
-    name = getattr(scheduler, "name", type(scheduler).__name__)
-    rec = _record(obs, acts, rews, ticks, ill, con, scenario_key, seed, str(name))
+    rec = _record(obs, acts, rews, ticks, ill, con, scenario_key, seed, _name(scheduler))
     rec.metrics = infos[ids[0]]["metrics"]
     rec.fallbacks = fallbacks
     return rec
+
+
+def batched_rollouts(
+    env: Any,
+    schedulers: Sequence[Scheduler],
+    scenario_key: str,
+    seeds: Sequence[int],
+    *,
+    time_limit: float | None = None,
+    counts: MappingCounts | None = None,
+) -> list[EpisodeRecord]:
+    """:func:`rollout_episode` of ``len(seeds)`` seeds at once in a
+    :class:`fcplan.env.vector_task.VectorTaskEnv` of as many worlds (``autoreset_mode=
+    "disabled"``): world ``b`` plays seed ``seeds[b]`` with ``schedulers[b]``
+    (:meth:`~fcplan.env.vector_task.VectorTaskEnv.expert_actions`). Each record equals the
+    sequential rollout of its seed (with a scheduler that keeps no state between episodes)."""
+    n = len(seeds)
+    obs, _ = env.reset(seed=[int(s) for s in seeds])
+    keep: list[dict[str, np.ndarray]] = [obs]
+    acts, rews, ticks, ill, con = [], [], [env.batch.tick.copy()], [], []
+    falls = np.zeros(n, dtype=np.int64)
+    done = np.zeros(n, dtype=bool)
+    finals: list[Any] = [None] * n
+    ends = np.zeros(n, dtype=np.int64)  # steps of each world's episode
+    while not done.all():
+        act, fb = env.expert_actions(schedulers, time_limit=time_limit, counts=counts)
+        falls += fb & ~done
+        obs, rew, _, trunc, info = env.step(act)
+        keep.append(obs)
+        acts.append(act)
+        rews.append(rew)
+        ticks.append(info["tick"])
+        ill.append(info["illegal"])
+        con.append(info["conflict"])
+        for b in np.flatnonzero(trunc).tolist():
+            finals[b], ends[b] = info["metrics"][b], len(acts)
+        done |= trunc
+    out = []
+    for b, seed in enumerate(seeds):
+        e = int(ends[b])
+        rec = _record([{k: o[k][b] for k in OBS_KEYS} for o in keep[: e + 1]],
+                      [x[b] for x in acts[:e]], [x[b] for x in rews[:e]],
+                      [x[b] for x in ticks[: e + 1]], [x[b] for x in ill[:e]],
+                      [x[b] for x in con[:e]], scenario_key, seed, _name(schedulers[b]))  # fmt: skip
+        rec.metrics, rec.fallbacks = finals[b], int(falls[b])
+        out.append(rec)
+    return out
+
+
+def _name(scheduler: Any) -> str:
+    return str(getattr(scheduler, "name", type(scheduler).__name__))
 
 
 def _record(obs: list, acts: list, rews: list, ticks: list, ill: list, con: list,

@@ -65,6 +65,7 @@ import numpy as np
 
 from fcplan.env.demo_episodes import (
     EpisodeRecord,
+    batched_rollouts,
     env_kwargs_from_metadata,
     recording_episode,
     rollout_episode,
@@ -214,6 +215,7 @@ def demonstrations(
     recordings: Iterable[Any] = (),
     format: str = "npz",
     dataset_id: str | None = None,
+    num_envs: int = 1,
 ) -> Any:
     """Roll ``scheduler`` out through the task-level env on every (scenario, seed).
 
@@ -238,6 +240,11 @@ def demonstrations(
         dataset (:mod:`fcplan.env.demo_minari`; needs ``pip install fcplan[minari]``).
     dataset_id : str, optional
         The Minari dataset id (``format="minari"``; default ``"fcplan/task/<scheduler>-v0"``).
+    num_envs : int
+        Roll up to this many seeds of a scenario out at once in a batched task env
+        (:func:`fcplan.env.demo_episodes.batched_rollouts`, one scheduler instance per world);
+        the dataset is the one ``num_envs=1`` gives, for schedulers that keep no state between
+        episodes.
 
     Returns
     -------
@@ -254,6 +261,9 @@ def demonstrations(
     for sc in scenarios:
         scenario = as_scenario(sc)
         key = _scenario_key(scen_docs, scenario)
+        if num_envs > 1:
+            rollouts.add_batched(scenario, scheduler, key, seeds, int(num_envs), env_kwargs)
+            continue
         env = TaskEnv(scenario, **env_kwargs)
         for seed in seeds:
             rollouts.add(rollout_episode(env, sched, key, seed, time_limit=time_limit,
@@ -337,6 +347,22 @@ class _Rollouts:
                 "source": rec.source,
             }
         )
+
+    def add_batched(self, scenario: Any, spec: Any, key: str, seeds: list[int], num: int,
+                    env_kwargs: dict[str, Any]) -> None:  # fmt: skip
+        """The episodes of ``seeds`` on ``scenario``, ``num`` at a time in a batched env."""
+        import copy
+
+        from fcplan.env.vector_task import VectorTaskEnv
+
+        for i in range(0, len(seeds), num):
+            chunk = seeds[i : i + num]
+            env = VectorTaskEnv(scenario, len(chunk), autoreset_mode="disabled", **env_kwargs)
+            scheds = [_scheduler(spec)[0] if isinstance(spec, str) else copy.deepcopy(spec)
+                      for _ in chunk]  # fmt: skip
+            for rec in batched_rollouts(env, scheds, key, chunk, time_limit=self.time_limit,
+                                        counts=self.counts):  # fmt: skip
+                self.add(rec)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The dataset's arrays (module docstring), rows of every episode in order."""

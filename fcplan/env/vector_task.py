@@ -49,6 +49,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -59,13 +60,20 @@ from gymnasium.vector.utils import batch_space
 from fcplan.batch import BatchStepInfo, BatchWorld
 from fcplan.belief import Belief
 from fcplan.env.task import TaskEnv
-from fcplan.env.task_actions import actions_plan, decode_actions, rows_commands
+from fcplan.env.task_actions import (
+    MappingCounts,
+    actions_plan,
+    decode_actions,
+    plan_to_actions,
+    rows_commands,
+)
 from fcplan.env.task_candidates import agent_features, rank_candidates, task_features
 from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows
 from fcplan.errors import EnvError
 from fcplan.metrics import facility_penalty, penalty_rate
 from fcplan.mission import ScenarioLike
 from fcplan.plan import validate_plan
+from fcplan.scheduling import Scheduler, solve
 from fcplan.taskgraph import TaskGraphBuilder
 from fcplan.team import Team
 from fcplan.world import StepInfo
@@ -300,6 +308,34 @@ class VectorTaskEnv(BatchedEnv):
             rate = penalty_rate(active, facility_penalty(in_fac, pen), w)
             out[b] = -rate / tps + self.one.prune_bonus * int(batch.fire.n_pruned[b] - pruned[b])
         return out
+
+    def expert_actions(
+        self,
+        schedulers: Sequence[Scheduler],
+        *,
+        time_limit: float | None = None,
+        counts: MappingCounts | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(B, A) actions of a scheduler's plans on every world's current graph, and (B,) bool:
+        the plan came from the greedy fallback.
+
+        ``schedulers[b]`` plans world ``b`` (one instance per world: a scheduler that keeps state
+        between calls sees only its own world), through :func:`fcplan.scheduling.solve` with
+        the world's controller generator, as :func:`fcplan.env.demonstrations.demonstrations`
+        does on one env; the plan becomes actions by
+        :func:`fcplan.env.task_actions.plan_to_actions`. A loop over the worlds: the schedulers
+        work on one graph each.
+        """
+        a, k = self.one.n_agents, self.one.k
+        out = np.full((self.num_envs, a), k, dtype=np.int64)
+        fallback = np.zeros(self.num_envs, dtype=bool)
+        for b in range(self.num_envs):
+            graph, cand = self.graphs[b], self.candidates[b]
+            rng = self.batch.controller_rngs[b]
+            plan = solve(schedulers[b], graph, time_limit=time_limit, rng=rng)
+            fallback[b] = getattr(plan.stats, "status", None) == "fallback"
+            out[b] = plan_to_actions(plan, graph, cand, counts)
+        return out, fallback
 
     def _finals(self, done: np.ndarray, infos: dict[str, Any]) -> None:
         def metrics(b: int) -> dict[str, Any]:
