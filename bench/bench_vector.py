@@ -199,6 +199,28 @@ def batched_task(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int,
     return num * n, clock
 
 
+def mpe_rate(steps: int = 5000, seed: int = 0) -> float | None:
+    """Steps per CPU second of PettingZoo MPE ``simple_spread`` (3 agents, random actions,
+    25-step episodes), or None when ``mpe2`` is not installed (``pip install --no-deps mpe2``)."""
+    try:
+        from mpe2 import simple_spread_v3
+    except ImportError:
+        return None
+    env = simple_spread_v3.parallel_env(N=3, max_cycles=25)
+    rng = np.random.default_rng(seed)
+    obs, _ = env.reset(seed=seed)
+    busy, n = 0.0, 0
+    while n < steps:
+        if not env.agents:
+            env.reset()
+        act = {a: int(rng.integers(env.action_space(a).n)) for a in env.agents}
+        c = _CPU()
+        env.step(act)
+        busy += _CPU() - c
+        n += 1
+    return n / busy
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="30-s episodes, sizes 1, 16, 256")
@@ -224,8 +246,17 @@ def main(argv: list[str] | None = None) -> int:
             results[f"{level} #{name}"] = _level(level, sc, name, sizes_l, args.episodes)
     sc = load_scenario(args.scenarios[0])
     per, rest = memory_per_world(sc, 16, 64 if args.quick else 256)
-    print(f"\nmemory (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
+    print(f"\nmemory, motion level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
           f"{rest / 1e6:.1f} MB shared (terrain jump tables, maps, team constants)")
+    mpe = mpe_rate()
+    if mpe is None:
+        print("MPE simple_spread: skipped (pip install --no-deps mpe2)")
+    else:
+        print(f"MPE simple_spread (PettingZoo, 3 agents, random actions): {mpe:.0f} steps per "
+              f"CPU second (load {os.getloadavg()[0]:.2f})")
+        for key, rows in results.items():
+            num, rate = rows[-1]
+            print(f"  {key}: single env {rows[0][1] / mpe:.2f}x MPE, B={num} {rate / mpe:.1f}x MPE")
     if args.plot:
         _plot(results, args.plot)
         print(f"plot: {args.plot}")

@@ -19,7 +19,7 @@ Examples
 >>> grid = CellGrid(num=2, world_size=40)
 >>> g = grid.index(np.array([1]), np.array([17]), np.array([5]))
 >>> grid.flat_state[g] = 1
->>> grid.blocks[1, 4] += 1  # block (1, 0) of world 1 holds one burning cell
+>>> grid.blocks[1, 3] += 1  # block (1, 0) of world 1 (nb = 3) holds one burning cell
 >>> pair, x, y = scan_boxes(grid, np.array([1]), np.array([0]), np.array([39]), np.array([0]),
 ...                         np.array([39]), lambda v: v == 1)
 >>> pair.tolist(), x.tolist(), y.tolist()

@@ -20,6 +20,7 @@ Examples
 >>> from fcplan import load_scenario
 >>> from fcplan.team import Command
 >>> team = BatchTeam(load_scenario("practice"), 2)
+>>> team.reset_worlds(np.arange(2))
 >>> team.apply(1, {"A1": Command(route=((400.0, 400.0),))})
 >>> arrived = team.move(np.ones(2, dtype=bool))
 >>> team.pos[:, team.ids.index("A1")].round(1).tolist()  # world 0 idles, world 1 flies

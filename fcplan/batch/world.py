@@ -31,8 +31,8 @@ Examples
 >>> batch.reset(seeds=[0, 1, 2, 3])
 >>> while not batch.done.all():
 ...     info = batch.step()
->>> batch.tick.tolist(), round(batch.metrics(2)["manual"].final_score, 1) > 0
-([20, 20, 20, 20], True)
+>>> batch.tick.tolist(), sorted(batch.metrics(2)), bool(batch.step().ran.any())  # all held
+([20, 20, 20, 20], ['manual', 'reference2020'], False)
 """
 
 from __future__ import annotations
