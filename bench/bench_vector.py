@@ -246,14 +246,18 @@ def main(argv: list[str] | None = None) -> int:
             results[f"{level} #{name}"] = _level(level, sc, name, sizes_l, args.episodes)
     sc = load_scenario(args.scenarios[0])
     per, rest = memory_per_world(sc, 16, 64 if args.quick else 256)
-    print(f"\nmemory, motion level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
-          f"{rest / 1e6:.1f} MB shared (terrain jump tables, maps, team constants)")
+    print(
+        f"\nmemory, motion level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
+        f"{rest / 1e6:.1f} MB shared (terrain jump tables, maps, team constants)"
+    )
     mpe = mpe_rate()
     if mpe is None:
         print("MPE simple_spread: skipped (pip install --no-deps mpe2)")
     else:
-        print(f"MPE simple_spread (PettingZoo, 3 agents, random actions): {mpe:.0f} steps per "
-              f"CPU second (load {os.getloadavg()[0]:.2f})")
+        print(
+            f"MPE simple_spread (PettingZoo, 3 agents, random actions): {mpe:.0f} steps per "
+            f"CPU second (load {os.getloadavg()[0]:.2f})"
+        )
         for key, rows in results.items():
             num, rate = rows[-1]
             print(f"  {key}: single env {rows[0][1] / mpe:.2f}x MPE, B={num} {rate / mpe:.1f}x MPE")

@@ -78,7 +78,9 @@ class CellGrid:
     def index(self, world: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Indices into :attr:`flat_state` of cells ``(x, y)`` of worlds ``world``."""
         blk = (x >> _SHIFT) * self.nb + (y >> _SHIFT)
-        return (world * (self.nb * self.nb) + blk) * (BLOCK * BLOCK) + ((x & _LOW) << 4) + (y & _LOW)
+        return (
+            (world * (self.nb * self.nb) + blk) * (BLOCK * BLOCK) + ((x & _LOW) << 4) + (y & _LOW)
+        )
 
     def block_index(self, world: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Indices into :attr:`flat_blocks` of the blocks of cells ``(x, y)`` of ``world``."""

@@ -64,6 +64,8 @@ __all__ = ["BatchFire"]
 
 _NEVER = 2**62
 _EMPTY = np.zeros(0, dtype=np.int64)
+#: cells as ``(world, x, y)`` int64 arrays
+Cells = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
 class BatchFire:
@@ -160,7 +162,7 @@ class BatchFire:
         :mod:`fcplan.fire`)."""
         return tick * STEPS_PER_SECOND // self.ticks_per_second - self.n_steps
 
-    def step(self, take: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def step(self, take: np.ndarray) -> Cells:
         """One fire step of the worlds ``take`` ((B,) bool); return the cells that started
         burning as ``(world, x, y)`` (sorted by world, unique)."""
         self.n_steps += take
@@ -181,9 +183,11 @@ class BatchFire:
             return _EMPTY, _EMPTY, _EMPTY
         if len(parts) == 1:
             return parts[0]
-        return tuple(np.concatenate(p) for p in zip(*parts, strict=True))  # type: ignore[return-value]
+        wb, x, y = (np.concatenate(p) for p in zip(*parts, strict=True))
+        order = np.argsort(wb, kind="stable")  # (per world: the woken regions' cells first)
+        return wb[order], x[order], y[order]
 
-    def _wake(self, waking: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _wake(self, waking: np.ndarray) -> Cells:
         """Activate the regions of worlds ``waking`` whose delay has passed and ignite the
         cells of their live fronts."""
         new = ~self.region_active & (self.start_step <= self.n_steps[:, None]) & waking[:, None]
@@ -243,7 +247,7 @@ class BatchFire:
             t_val[mi[new]] = v
         return val
 
-    def _advance(self, mi: np.ndarray, row: np.ndarray) -> tuple[np.ndarray, ...]:
+    def _advance(self, mi: np.ndarray, row: np.ndarray) -> Cells:
         """Move the fronts ``mi`` (flat ``b n + f``) one FARSITE step; kill, freeze and ignite
         as the rule does; return the ignited cells."""
         n, w = self.n, self.world_size
@@ -271,7 +275,7 @@ class BatchFire:
         return self.ignite(wb[fresh], xi[fresh], yi[fresh])
 
     # ------------------------------------------------------------------ cells
-    def ignite(self, wb: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, ...]:
+    def ignite(self, wb: np.ndarray, x: np.ndarray, y: np.ndarray) -> Cells:
         """Set the unburnt cells among ``(wb, x, y)`` burning; return them (unique, sorted by
         world then flat index)."""
         grid, w = self.grid, self.world_size

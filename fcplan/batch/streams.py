@@ -67,7 +67,9 @@ def spawn_streams(seed: int | np.integer | np.random.SeedSequence | None) -> lis
         If ``seed`` is not an int, a SeedSequence or None (a batch needs PCG64 streams).
     """
     if seed is not None and not isinstance(seed, (int, np.integer, np.random.SeedSequence)):
-        raise ValueError(f"seed: must be an int, a SeedSequence or None (got {type(seed).__name__})")
+        raise ValueError(
+            f"seed: must be an int, a SeedSequence or None (got {type(seed).__name__})"
+        )
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     return [np.random.default_rng(s) for s in ss.spawn(4)]
 
@@ -217,9 +219,7 @@ class TerrainJump:
         st = bg.state
         s0, inc = int(st["state"]["state"]), int(st["state"]["inc"])
         has, half = int(st["has_uint32"]), int(st["uinteger"])
-        base = np.array(
-            [s0 >> 64, s0 & _MASK64, inc >> 64, inc & _MASK64, has, half], dtype=_U
-        )
+        base = np.array([s0 >> 64, s0 & _MASK64, inc >> 64, inc & _MASK64, has, half], dtype=_U)
         rest = self.count - has  # 32-bit values taken from fresh 64-bit outputs
         outputs = (rest + 1) // 2
         bg.advance(outputs)

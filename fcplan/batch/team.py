@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -85,7 +86,11 @@ class BatchTeam:
         b, n = self.num, self.n
         self.pos = np.zeros((b, n, 2))
         self.z, self.z_target = np.zeros((b, n)), np.zeros((b, n))
-        self.battery, self.hover_s, self.distance = np.zeros((b, n)), np.zeros((b, n)), np.zeros((b, n))
+        self.battery, self.hover_s, self.distance = (
+            np.zeros((b, n)),
+            np.zeros((b, n)),
+            np.zeros((b, n)),
+        )
         self.tank = np.zeros((b, n), dtype=np.int64)
         self.mode = np.zeros((b, n), dtype=np.int8)
         self.goal = np.zeros((b, n, 2))
@@ -122,7 +127,7 @@ class BatchTeam:
         return np.minimum(np.maximum(c, 0.4), 1.0) * self.can_sense
 
     # ------------------------------------------------------------------ commands
-    def apply(self, b: int, commands: Mapping[str | int, Command] | None) -> None:
+    def apply(self, b: int, commands: Mapping[Any, Command] | None) -> None:
         """:meth:`fcplan.team.Team.apply` of ``commands`` to world ``b``'s team."""
         if not commands:
             return

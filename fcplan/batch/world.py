@@ -63,7 +63,8 @@ _BURNING_SENSED = BURNING | SENSED
 @dataclass(frozen=True, slots=True, eq=False)
 class BatchStepInfo:
     """What happened in one :meth:`BatchWorld.step` (cells as world index and flat ``x W + y``,
-    sorted by world then cell).
+    sorted by world; within a world ``ignited`` keeps the single world's order, the others are
+    sorted by cell).
 
     Attributes
     ----------
@@ -236,7 +237,9 @@ class BatchWorld:
         self._count_facilities(wb, flat, self.facility_burning, +1)
         return wb, flat
 
-    def _count_facilities(self, wb: np.ndarray, flat: np.ndarray, into: np.ndarray, sign: int) -> None:
+    def _count_facilities(
+        self, wb: np.ndarray, flat: np.ndarray, into: np.ndarray, sign: int
+    ) -> None:
         lab = self.facility_labels[flat]
         inside = lab >= 0
         if np.count_nonzero(inside):
@@ -306,7 +309,9 @@ class BatchWorld:
         order = np.lexsort((flat, wb))
         return wb[order], flat[order]
 
-    def _dump_round(self, rects: np.ndarray, pw: np.ndarray, pa: np.ndarray, dumped: np.ndarray) -> tuple:
+    def _dump_round(
+        self, rects: np.ndarray, pw: np.ndarray, pa: np.ndarray, dumped: np.ndarray
+    ) -> tuple:
         """One dumping agent ``pa[j]`` in each world ``pw[j]``: the (world, flat) cells put out."""
         x0, x1, y0, y1 = self._boxes(rects[pw, pa][:, None], self.fire.burn_box[pw])
         x0, x1, y0, y1 = x0[:, 0], x1[:, 0], y0[:, 0], y1[:, 0]

@@ -218,7 +218,9 @@ def recording_episode(recording: Any, env: TaskEnv, scenario_key: str) -> Episod
     from fcplan.recording import RecordingError
 
     if recording.seed is None:
-        raise RecordingError(f"recording ({recording.source}): no integer seed, cannot be re-simulated")
+        raise RecordingError(
+            f"recording ({recording.source}): no integer seed, cannot be re-simulated"
+        )
     sc, k, period = env.scenario, env.k, env.period
     mission = Mission(sc, recording.seed, replan_period=period / sc.ticks_per_second,
                       event_replans=False, graph_params=env.graph_params)  # fmt: skip
@@ -264,7 +266,9 @@ def _player_actions(graph: Any, cand: Any, given: list, goal: np.ndarray) -> np.
     n_a, k = cand.rows.shape
     out = np.full(n_a, k, dtype=np.int64)
     for i, agent in enumerate(graph.agent_ids):
-        cmd = next((c[agent] for c in given if agent in c and (c[agent].home or c[agent].route)), None)
+        cmd = next(
+            (c[agent] for c in given if agent in c and (c[agent].home or c[agent].route)), None
+        )
         if cmd is None or cmd.home or not cand.valid[i].any():
             continue
         target = np.asarray(cmd.route[0], dtype=np.float64)

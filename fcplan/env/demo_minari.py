@@ -95,8 +95,7 @@ def _spaces(records: Sequence[EpisodeRecord]) -> tuple[Any, Any]:
         got = {k: r.observations[k].shape[1:] for k in OBS_KEYS}
         if got != shapes:
             raise FcplanError(
-                f"minari: one dataset holds one team size and k (episode shapes {shapes} "
-                f"and {got})"
+                f"minari: one dataset holds one team size and k (episode shapes {shapes} and {got})"
             )
     b = FEATURE_BOUND
     obs = spaces.Dict(
@@ -128,7 +127,9 @@ def write_minari(
         import minari
         from minari.data_collector import EpisodeBuffer
     except ImportError:
-        raise FcplanError("format='minari' needs the minari package: pip install fcplan[minari]") from None
+        raise FcplanError(
+            "format='minari' needs the minari package: pip install fcplan[minari]"
+        ) from None
     if not records:
         raise FcplanError("minari: no episodes to write")
     obs_space, act_space = _spaces(records)
@@ -161,8 +162,12 @@ def _buffer(i: int, r: EpisodeRecord, cls: Any) -> Any:
     return cls(
         id=i,
         seed=int(r.seed),
-        options={"scenario": r.scenario, "source": r.source, "metrics": r.metrics,
-                 "return": r.return_},  # fmt: skip
+        options={
+            "scenario": r.scenario,
+            "source": r.source,
+            "metrics": r.metrics,
+            "return": r.return_,
+        },  # fmt: skip
         observations={k: r.observations[k] for k in OBS_KEYS},
         actions=r.actions,
         rewards=r.rewards.tolist(),
@@ -178,7 +183,8 @@ def _buffer(i: int, r: EpisodeRecord, cls: Any) -> Any:
 
 def dataset_metadata(dataset: Any) -> dict[str, Any]:
     """The fcplan metadata of a Minari dataset written by :func:`write_minari`."""
-    return json.loads(dataset.storage.metadata["fcplan"])  # type: ignore[no-any-return]
+    meta: dict[str, Any] = json.loads(dataset.storage.metadata["fcplan"])
+    return meta
 
 
 def episode_options(dataset: Any, index: int) -> dict[str, Any]:
@@ -202,10 +208,12 @@ def replay_episode(dataset: Any, index: int) -> dict[str, Any]:
 
     meta, opts = dataset_metadata(dataset), episode_options(dataset, index)
     ep = next(iter(dataset.iterate_episodes([index])))
-    env = TaskGymEnv(scenario_from_metadata(meta, opts["scenario"]), **env_kwargs_from_metadata(meta))
+    env = TaskGymEnv(
+        scenario_from_metadata(meta, opts["scenario"]), **env_kwargs_from_metadata(meta)
+    )
     obs, _ = env.reset(seed=opts["seed"])
     same_obs = all(np.array_equal(obs[k], ep.observations[k][0]) for k in OBS_KEYS)
-    same_rew, info = True, {}
+    same_rew, info = True, dict[str, Any]()
     for t, act in enumerate(ep.actions):
         obs, rew, _, _, info = env.step(act)
         same_obs &= all(np.array_equal(obs[k], ep.observations[k][t + 1]) for k in OBS_KEYS)

@@ -40,7 +40,9 @@ def autoreset_from(mode: str | AutoresetMode) -> AutoresetMode:
     names: dict[str, AutoresetMode] = dict(zip(AUTORESET_MODES, AutoresetMode, strict=True))
     names.update({m.value: m for m in AutoresetMode})
     if mode not in names:
-        raise EnvError(f"autoreset_mode: must be one of {', '.join(AUTORESET_MODES)} (got {mode!r})")
+        raise EnvError(
+            f"autoreset_mode: must be one of {', '.join(AUTORESET_MODES)} (got {mode!r})"
+        )
     return names[mode]
 
 
@@ -88,8 +90,10 @@ class BatchedEnv(VectorEnv):
 
     def _ended(self, ended: np.ndarray) -> None:
         """Note the worlds whose episode ended on this step (next-step autoreset)."""
-        self._pending = ended.copy() if self.autoreset_mode is AutoresetMode.NEXT_STEP else (
-            np.zeros(self.num_envs, dtype=bool)
+        self._pending = (
+            ended.copy()
+            if self.autoreset_mode is AutoresetMode.NEXT_STEP
+            else (np.zeros(self.num_envs, dtype=bool))
         )
 
     def close_extras(self, **kwargs: Any) -> None:

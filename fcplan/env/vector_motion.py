@@ -168,7 +168,9 @@ class VectorMotionEnv(BatchedEnv):
         self._fb_last[rows] = -1
 
     # ------------------------------------------------------------------ step
-    def step(self, actions: Any) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+    def step(
+        self, actions: Any
+    ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """Advance every world one tick with ``actions`` ((B, N) ints); see the module docstring."""
         batch = self.batch
         run = self._stepping(batch.done)

@@ -36,7 +36,6 @@ Examples
 
 from __future__ import annotations
 
-
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 

@@ -97,23 +97,23 @@ class TeamView:
 
     @property
     def pos(self) -> np.ndarray:
-        return self._team.pos[self._b]  # type: ignore[no-any-return]
+        return self._team.pos[self._b]
 
     @property
     def z(self) -> np.ndarray:
-        return self._team.z[self._b]  # type: ignore[no-any-return]
+        return self._team.z[self._b]
 
     @property
     def battery(self) -> np.ndarray:
-        return self._team.battery[self._b]  # type: ignore[no-any-return]
+        return self._team.battery[self._b]
 
     @property
     def tank(self) -> np.ndarray:
-        return self._team.tank[self._b]  # type: ignore[no-any-return]
+        return self._team.tank[self._b]
 
     @property
     def mode(self) -> np.ndarray:
-        return self._team.mode[self._b]  # type: ignore[no-any-return]
+        return self._team.mode[self._b]
 
 
 class VectorTaskEnv(BatchedEnv):
@@ -177,7 +177,9 @@ class VectorTaskEnv(BatchedEnv):
         else:
             given = list(seed)
             if len(given) != rows.size:
-                raise EnvError(f"seed: need {rows.size} seeds, one per world reset (got {len(given)})")
+                raise EnvError(
+                    f"seed: need {rows.size} seeds, one per world reset (got {len(given)})"
+                )
         self._reset_worlds(rows, given)
         self._started = True
         return self._observation(), {"tick": self.batch.tick.copy()}
@@ -192,7 +194,7 @@ class VectorTaskEnv(BatchedEnv):
             else:
                 if self._seed_seqs[b] is None:
                     self._seed_seqs[b] = np.random.SeedSequence()
-                world_seeds.append(self._seed_seqs[b].spawn(1)[0])  # type: ignore[union-attr]
+                world_seeds.append(self._seed_seqs[b].spawn(1)[0])
         mask = np.zeros(self.num_envs, dtype=bool)
         mask[rows] = True
         self.batch.reset(seeds=world_seeds, mask=mask)
@@ -220,7 +222,9 @@ class VectorTaskEnv(BatchedEnv):
         return {k: v.copy() for k, v in self._obs.items()}
 
     # ------------------------------------------------------------------ step
-    def step(self, actions: Any) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+    def step(
+        self, actions: Any
+    ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """One replan period of every world with ``actions`` ((B, A) ints)."""
         batch = self.batch
         run = self._stepping(batch.done | (self.steps >= self.one.max_steps))
@@ -247,7 +251,11 @@ class VectorTaskEnv(BatchedEnv):
         done = run & (batch.done | (self.steps >= self.one.max_steps))
         for b in np.flatnonzero(run).tolist():
             self._observe(b)
-        infos: dict[str, Any] = {"tick": batch.tick.copy(), "illegal": illegal, "conflict": conflict}
+        infos: dict[str, Any] = {
+            "tick": batch.tick.copy(),
+            "illegal": illegal,
+            "conflict": conflict,
+        }
         if np.count_nonzero(done):
             self._finals(done, infos)
         obs = self._observation()
@@ -278,7 +286,10 @@ class VectorTaskEnv(BatchedEnv):
         """Fold the tick into the belief of every world that ran it (one exact
         :class:`fcplan.world.StepInfo` per world: the part that is not batched)."""
         b_all = np.arange(self.num_envs + 1)
-        cuts = [np.searchsorted(part[0], b_all) for part in (info.ignited, info.sensed, info.newly_sensed, info.pruned)]
+        cuts = [
+            np.searchsorted(part[0], b_all)
+            for part in (info.ignited, info.sensed, info.newly_sensed, info.pruned)
+        ]
         rects = info.fov.tolist()
         ticks = self.batch.tick.tolist()
         tps = self.scenario.ticks_per_second
@@ -292,7 +303,9 @@ class VectorTaskEnv(BatchedEnv):
             )  # fmt: skip
             self.beliefs[b].update(step)
 
-    def _rewards(self, run: np.ndarray, start: np.ndarray, stop: np.ndarray, pruned: np.ndarray) -> np.ndarray:
+    def _rewards(
+        self, run: np.ndarray, start: np.ndarray, stop: np.ndarray, pruned: np.ndarray
+    ) -> np.ndarray:
         """(B,) reward of the step: ``PenaltyReward`` over the step's ticks, plus shaping."""
         batch = self.batch
         w, tps = self.scenario.scoring.propagation_weight, float(self.scenario.ticks_per_second)
@@ -332,6 +345,7 @@ class VectorTaskEnv(BatchedEnv):
         for b in range(self.num_envs):
             graph, cand = self.graphs[b], self.candidates[b]
             rng = self.batch.controller_rngs[b]
+            assert rng is not None  # (set by every reset)
             plan = solve(schedulers[b], graph, time_limit=time_limit, rng=rng)
             fallback[b] = getattr(plan.stats, "status", None) == "fallback"
             out[b] = plan_to_actions(plan, graph, cand, counts)

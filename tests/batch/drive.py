@@ -56,9 +56,20 @@ def mismatches(batch: BatchWorld, b: int, mission: Mission) -> list[str]:
     for name in ("pos", "z", "z_target", "battery", "tank", "mode", "goal", "has_goal", "armed",
                  "hover_s", "distance", "dumps", "sorties", "patrol"):  # fmt: skip
         pairs[name] = (getattr(team, name)[b], getattr(w.team, name))
-    bad = [k for k, (u, v) in pairs.items() if bits(np.asarray(u)) != bits(np.asarray(v).astype(np.asarray(u).dtype))]
+    bad = [
+        k
+        for k, (u, v) in pairs.items()
+        if bits(np.asarray(u)) != bits(np.asarray(v).astype(np.asarray(u).dtype))
+    ]
     rows, ref = batch.trace_rows(b), w.trace()
-    for key in ("active", "pruned", "sensed_active", "sensed_ever", "facility_burning", "facility_pruned"):
+    for key in (
+        "active",
+        "pruned",
+        "sensed_active",
+        "sensed_ever",
+        "facility_burning",
+        "facility_pruned",
+    ):
         if bits(rows[key]) != bits(getattr(ref, key)):
             bad.append(f"trace.{key}")
     if batch.record_agents:

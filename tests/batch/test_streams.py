@@ -62,7 +62,9 @@ def test_terrain_of_a_fire():
 
 
 @settings(max_examples=20, deadline=None)
-@given(counts=st.lists(st.lists(st.integers(0, 40), min_size=3, max_size=3), min_size=1, max_size=12))
+@given(
+    counts=st.lists(st.lists(st.integers(0, 40), min_size=3, max_size=3), min_size=1, max_size=12)
+)
 def test_uniform_blocks_equal_successive_draws(counts):
     """World ``b``'s values are ``random(k)`` of its own generator, call after call, including a
     request longer than the block (the rows grow)."""

@@ -86,7 +86,11 @@ def test_errors(root):
     with pytest.raises(FcplanError, match="team size"):
         demonstrations("greedy", ["practice", "open_world_example"], [0], format="minari",
                        dataset_id="fcplan/test/bad-v0", env_kwargs={"k": 3, "max_steps": 2})  # fmt: skip
-    kw = {"format": "minari", "dataset_id": "fcplan/test/once-v0", "env_kwargs": {"k": 3, "max_steps": 2}}
+    kw = {
+        "format": "minari",
+        "dataset_id": "fcplan/test/once-v0",
+        "env_kwargs": {"k": 3, "max_steps": 2},
+    }
     demonstrations("greedy", ["practice"], [0], **kw)
     with pytest.raises(FcplanError, match="exists"):
         demonstrations("greedy", ["practice"], [1], **kw)

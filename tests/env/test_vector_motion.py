@@ -115,7 +115,9 @@ def test_make_vec_and_gymnasium_checks():
     sc = load_scenario(1).replace(duration_s=3)
     env = gymnasium.make_vec("fcplan/Motion-v0", num_envs=3, scenario=sc)
     assert isinstance(env, VectorMotionEnv)
-    sync = gymnasium.make_vec("fcplan/Motion-v0", num_envs=3, scenario=sc, vectorization_mode="sync")
+    sync = gymnasium.make_vec(
+        "fcplan/Motion-v0", num_envs=3, scenario=sc, vectorization_mode="sync"
+    )
     # (Gymnasium's matcher reads the episode-end flags as single booleans: one world)
     one = gymnasium.make_vec("fcplan/Motion-v0", num_envs=1, scenario=sc)
     one_sync = gymnasium.make_vec("fcplan/Motion-v0", 1, "sync", scenario=sc)

@@ -48,7 +48,9 @@ def compare(sc, num, steps, mode="next_step", seed=10, **kw):
                     assert info["metrics"][i] == si["metrics"]
                     assert info["return"][i] == si["return"]
                     if mode == "same_step":
-                        assert all(bits(info["final_obs"][i][k]) == bits(sobs[i][k]) for k in sobs[i])
+                        assert all(
+                            bits(info["final_obs"][i][k]) == bits(sobs[i][k]) for k in sobs[i]
+                        )
                         sobs[i], _ = e.reset()
             assert rew[i] == sr and trunc[i] == st and not term[i], (t, i)
         ended = trunc.copy()
