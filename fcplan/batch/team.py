@@ -24,7 +24,7 @@ Examples
 >>> team.apply(1, {"A1": Command(route=((400.0, 400.0),))})
 >>> arrived = team.move(np.ones(2, dtype=bool))
 >>> team.pos[:, team.ids.index("A1")].round(1).tolist()  # world 0 idles, world 1 flies
-[[60.0, 550.0], [78.5, 532.4]]
+[[60.0, 540.0], [78.5, 532.4]]
 """
 
 from __future__ import annotations
