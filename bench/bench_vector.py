@@ -73,6 +73,14 @@ class Clock:
         setattr(owner, name, timed)
         return lambda: setattr(owner, name, inner)
 
+    def step(self, fn: Callable[..., Any], *args: Any) -> Any:
+        """``fn(*args)``, timed under ``"step"``."""
+        c, w = _CPU(), _WALL()
+        out = fn(*args)
+        self.cpu["step"] += _CPU() - c
+        self.wall["step"] += _WALL() - w
+        return out
+
 
 def single_env(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
     """Steps of ``episodes`` episodes of the single env with random legal actions, timed."""
@@ -84,10 +92,7 @@ def single_env(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
         undo = clock.wrap(env.mission, "step", "sim")
         while env.agents:
             act = {a: int(rng.choice(np.flatnonzero(obs[a]["action_mask"]))) for a in env.agents}
-            c, w = _CPU(), _WALL()
-            obs, *_ = env.step(act)
-            clock.cpu["step"] += _CPU() - c
-            clock.wall["step"] += _WALL() - w
+            obs, *_ = clock.step(env.step, act)
             steps += 1
         undo()
     return steps, clock
@@ -111,24 +116,23 @@ _PARTS = [
 
 
 def batched_env(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int, Clock]:
-    """World-steps of one whole episode of ``num`` worlds (and the autoreset step), timed."""
-    env = VectorMotionEnv(sc, num)
+    """World-steps of one whole motion-level episode of ``num`` worlds (and the autoreset
+    step), timed."""
+    return _batched(VectorMotionEnv(sc, num), sc.n_ticks + 1, _PARTS if parts else _PARTS[:1], seed)
+
+
+def _batched(env: Any, n_steps: int, parts: list, seed: int) -> tuple[int, Clock]:
+    """``n_steps`` steps of a batched env with random legal actions, ``parts`` timed too."""
     rng = np.random.default_rng(seed)
     clock = Clock()
-    undo = [clock.wrap(o, n, lab) for o, n, lab in _PARTS] if parts else []
-    if not parts:
-        undo.append(clock.wrap(bworld.BatchWorld, "step", "sim"))
+    undo = [clock.wrap(o, n, lab) for o, n, lab in parts]
     obs, _ = env.reset(seed=seed)
-    for _ in range(sc.n_ticks + 1):
+    for _ in range(n_steps):
         m = obs["action_mask"]
-        act = (rng.random(m.shape) * m).argmax(axis=2)
-        c, w = _CPU(), _WALL()
-        obs, *_ = env.step(act)
-        clock.cpu["step"] += _CPU() - c
-        clock.wall["step"] += _WALL() - w
+        obs, *_ = clock.step(env.step, (rng.random(m.shape) * m).argmax(axis=2))
     for u in undo:
         u()
-    return num * (sc.n_ticks + 1), clock
+    return env.num_envs * n_steps, clock
 
 
 def memory_per_world(sc: Any, small: int, large: int) -> tuple[float, float]:
@@ -159,11 +163,7 @@ def single_task(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
         done = False
         while not done:
             m = obs["action_mask"]
-            act = (rng.random(m.shape) * m).argmax(axis=1)
-            c, w = _CPU(), _WALL()
-            obs, _, _, done, _ = env.step(act)
-            clock.cpu["step"] += _CPU() - c
-            clock.wall["step"] += _WALL() - w
+            obs, _, _, done, _ = clock.step(env.step, (rng.random(m.shape) * m).argmax(axis=1))
             steps += 1
         undo()
     return steps, clock
@@ -181,22 +181,7 @@ _TASK_PARTS = [
 def batched_task(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int, Clock]:
     """World-steps of one whole task-level episode of ``num`` worlds (and the autoreset step)."""
     env = VectorTaskEnv(sc, num)
-    rng = np.random.default_rng(seed)
-    clock = Clock()
-    chosen = _TASK_PARTS if parts else _TASK_PARTS[:1]
-    undo = [clock.wrap(o, n, lab) for o, n, lab in chosen]
-    obs, _ = env.reset(seed=seed)
-    n = env.one.max_steps + 1
-    for _ in range(n):
-        m = obs["action_mask"]
-        act = (rng.random(m.shape) * m).argmax(axis=2)
-        c, w = _CPU(), _WALL()
-        obs, *_ = env.step(act)
-        clock.cpu["step"] += _CPU() - c
-        clock.wall["step"] += _WALL() - w
-    for u in undo:
-        u()
-    return num * n, clock
+    return _batched(env, env.one.max_steps + 1, _TASK_PARTS if parts else _TASK_PARTS[:1], seed)
 
 
 def mpe_rate(steps: int = 5000, seed: int = 0) -> float | None:

@@ -230,13 +230,8 @@ def recording_episode(recording: Any, env: TaskEnv, scenario_key: str) -> Episod
     goal = np.full((n_a, 2), np.nan)
     obs, acts, rews, ticks, ill, con = [], [], [], [], [], []
     for start in range(0, n_ticks, period):
-        graph = mission.task_graph()
-        cand = rank_candidates(graph, k)
-        obs.append({
-            "agents": agent_features(graph, cand, start / max(sc.n_ticks, 1)),
-            "tasks": task_features(graph, cand, goal),
-            "action_mask": cand.action_mask(),
-        })  # fmt: skip
+        graph, cand, seen = _observe(mission, k, goal)
+        obs.append(seen)
         ticks.append(start)
         stop = min(start + period, n_ticks)
         given = [by_tick.get(t, {}) for t in range(start, stop)]
@@ -247,17 +242,24 @@ def recording_episode(recording: Any, env: TaskEnv, scenario_key: str) -> Episod
         for t in range(start, stop):
             mission.step(by_tick.get(t))
         rews.append(_period_reward(trace, start, stop, sc))
-    graph = mission.task_graph()
-    cand = rank_candidates(graph, k)
-    obs.append({
-        "agents": agent_features(graph, cand, n_ticks / max(sc.n_ticks, 1)),
-        "tasks": task_features(graph, cand, goal),
-        "action_mask": cand.action_mask(),
-    })  # fmt: skip
+    obs.append(_observe(mission, k, goal)[2])
     ticks.append(n_ticks)
     rec = _record(obs, acts, rews, ticks, ill, con, scenario_key, recording.seed, recording.source)
     rec.metrics = {n: m.as_dict() for n, m in recording.metrics().items()}
     return rec
+
+
+def _observe(mission: Mission, k: int, goal: np.ndarray) -> tuple[Any, Any, dict[str, np.ndarray]]:
+    """The mission's graph and candidates now, and the env's joint observation of them."""
+    graph = mission.task_graph()
+    cand = rank_candidates(graph, k)
+    frac = mission.world.tick / max(mission.scenario.n_ticks, 1)
+    obs = {
+        "agents": agent_features(graph, cand, frac),
+        "tasks": task_features(graph, cand, goal),
+        "action_mask": cand.action_mask(),
+    }
+    return graph, cand, obs
 
 
 def _player_actions(graph: Any, cand: Any, given: list, goal: np.ndarray) -> np.ndarray:

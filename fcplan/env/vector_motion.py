@@ -53,12 +53,13 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from fcplan.batch import BatchStepInfo, BatchWorld
+from fcplan.env.motion import MotionEnv
 from fcplan.env.motion_obs import N_AGENT_FEATURES, N_FOV
 from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows
 from fcplan.env.vector_obs import BatchMotionObs
 from fcplan.errors import EnvError
 from fcplan.metrics import facility_penalty
-from fcplan.mission import ScenarioLike, as_scenario
+from fcplan.mission import ScenarioLike
 from fcplan.team import CLIMB_PER_TICK
 
 __all__ = ["VectorMotionEnv"]
@@ -92,17 +93,12 @@ class VectorMotionEnv(BatchedEnv):
         dump_cost: float = 0.0,
         reward_fn: Any = None,
     ) -> None:
-        sc = as_scenario(scenario)
         self._setup(num_envs, autoreset_mode)
-        if int(cell_px) < 1:
-            raise EnvError(f"cell_px: must be >= 1 (got {cell_px})")
-        if int(view) < 1 or int(view) % 2 == 0:
-            raise EnvError(f"view: must be an odd number >= 1 (got {view})")
-        if not stale_s > 0:
-            raise EnvError(f"stale_s: must be > 0 (got {stale_s})")
         if reward_fn is not None:
             raise EnvError("reward_fn: a custom reward works on one World and is not batched")
-        self.scenario = sc
+        #: the single env of the same options (checks them; never stepped)
+        self.one = MotionEnv(scenario, cell_px=cell_px, view=view, stale_s=stale_s)
+        self.scenario = sc = self.one.scenario
         b = self.num_envs
         self.idle_rule = bool(idle_rule)
         self.shaping = (float(sense_bonus), float(prune_bonus), float(dump_cost))
