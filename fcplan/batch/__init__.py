@@ -30,7 +30,8 @@ terrain                 (B, 6) uint64      per world the PCG64 state before its 
                                            computed where fronts stand (:mod:`~fcplan.batch.streams`)
 cells                   (B, nb^2, 256) u8  one byte per cell, stored by 16 x 16 blocks: fire state
                                            in bits 0-1, sensed in bit 2 (:mod:`~fcplan.batch.cells`)
-block counts            (B, nb^2) int32    burning cells per block (the scans skip empty blocks)
+block counts            (B, nb^2) int32    burning cells per block, and per 64-px super-block
+                                           (the scans skip empty ones)
 team ``pos``, ``goal``  (B, N, 2) float64  ``z``, ``battery``, ``tank``, ``mode``, ... (B, N)
 routes                  (B, N, R, 2) f64   padded; ``route_len`` (B, N)
 sensing, pruning draws  (B, 4096) float64  per world uniforms drawn ahead, and a cursor (B,)

@@ -6,12 +6,14 @@ are stored as ``nb x nb`` blocks of ``BLOCK x BLOCK`` cells (``nb = ceil(W / BLO
 of world ``b`` is ``state[b, (x >> 4) nb + (y >> 4), (x & 15) 16 + (y & 15)]``. One byte holds the
 fire state in its two low bits (:data:`fcplan.fire.UNBURNT`, ``BURNING``, ``PRUNED``) and
 whether the cell was ever sensed in bit 2 (:data:`SENSED`), so "burning and sensed" is the byte
-value 5. :attr:`CellGrid.blocks` counts the burning cells of every block, ``(B, nb * nb)`` int32.
+value 5. :attr:`CellGrid.blocks` counts the burning cells of every block, ``(B, nb * nb)`` int32,
+and :attr:`CellGrid.supers` those of every super-block of 4 x 4 blocks (64 px), ``(B, ns * ns)``.
 
 Why blocks: sensing and pruning look for burning cells inside fields of view that are mostly
 empty (on scenario #24 a field of view overlaps the fire's box by thousands of cells and holds a
-handful of burning ones). :func:`scan_boxes` enumerates, for every (world, box) pair at once, only
-the blocks of the box that hold a burning cell, and gathers each as one contiguous 256-byte row.
+handful of burning ones). :func:`scan_boxes` enumerates, for every (world, box) pair at once, the
+super-blocks of the box, then only the blocks of super-blocks with fire that hold a burning cell,
+and gathers each as one contiguous 256-byte row.
 
 Examples
 --------
@@ -19,7 +21,7 @@ Examples
 >>> grid = CellGrid(num=2, world_size=40)
 >>> g = grid.index(np.array([1]), np.array([17]), np.array([5]))
 >>> grid.flat_state[g] = 1
->>> grid.blocks[1, 3] += 1  # block (1, 0) of world 1 (nb = 3) holds one burning cell
+>>> grid.count(np.array([1]), np.array([17]), np.array([5]), +1)  # its block holds fire now
 >>> pair, x, y = scan_boxes(grid, np.array([1]), np.array([0]), np.array([39]), np.array([0]),
 ...                         np.array([39]), lambda v: v == 1)
 >>> pair.tolist(), x.tolist(), y.tolist()
@@ -38,6 +40,10 @@ __all__ = ["CellGrid", "scan_boxes", "runs", "SENSED", "BLOCK", "STATE_BITS"]
 BLOCK = 16
 _SHIFT = 4
 _LOW = BLOCK - 1
+#: side of a super-block, in blocks
+SUPER = 4
+_SUPER_SHIFT = 6  # (16 px blocks x 4)
+_SUB = (np.repeat(np.arange(SUPER), SUPER), np.tile(np.arange(SUPER), SUPER))
 #: bit of a cell's byte: the cell was sensed at least once
 SENSED = 4
 #: the bits of a cell's byte holding its fire state
@@ -73,6 +79,9 @@ class CellGrid:
         self.flat_state = self.state.reshape(-1)
         self.blocks = np.zeros((self.num, nb * nb), dtype=np.int32)
         self.flat_blocks = self.blocks.reshape(-1)
+        self.ns = ns = -(-nb // SUPER)
+        self.supers = np.zeros((self.num, ns * ns), dtype=np.int32)
+        self.flat_supers = self.supers.reshape(-1)
         self.used = np.tile(np.array([nb, -1, nb, -1], dtype=np.int64), (self.num, 1))
 
     def index(self, world: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -85,6 +94,14 @@ class CellGrid:
     def block_index(self, world: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Indices into :attr:`flat_blocks` of the blocks of cells ``(x, y)`` of ``world``."""
         return world * (self.nb * self.nb) + (x >> _SHIFT) * self.nb + (y >> _SHIFT)
+
+    def count(self, world: np.ndarray, x: np.ndarray, y: np.ndarray, sign: int) -> None:
+        """Add ``sign`` per cell ``(x, y)`` of ``world`` to the burning counts of its block and
+        super-block (cells that started or stopped burning)."""
+        ufunc = np.add if sign > 0 else np.subtract
+        ufunc.at(self.flat_blocks, self.block_index(world, x, y), 1)
+        ns = self.ns
+        ufunc.at(self.flat_supers, world * (ns * ns) + (x >> _SUPER_SHIFT) * ns + (y >> _SUPER_SHIFT), 1)
 
     def touch(self, worlds: np.ndarray, lo: tuple, hi: tuple) -> None:
         """Note that cells of ``worlds`` (distinct) within ``[lo[0], hi[0]] x [lo[1], hi[1]]``
@@ -102,6 +119,8 @@ class CellGrid:
             nb = self.nb
             self.state[b].reshape(nb, nb, -1)[bx0 : bx1 + 1, by0 : by1 + 1] = 0
             self.blocks[b].reshape(nb, nb)[bx0 : bx1 + 1, by0 : by1 + 1] = 0
+            ns, k = self.ns, _SUPER_SHIFT - _SHIFT
+            self.supers[b].reshape(ns, ns)[bx0 >> k : (bx1 >> k) + 1, by0 >> k : (by1 >> k) + 1] = 0
         self.used[b] = (self.nb, -1, self.nb, -1)
 
     def world_array(self, b: int) -> np.ndarray:
@@ -139,19 +158,10 @@ def scan_boxes(
         which :class:`fcplan.World` scans a field of view).
     """
     nb, w = grid.nb, grid.world_size
-    bx0, by0 = x0 >> _SHIFT, y0 >> _SHIFT
-    nby = (y1 >> _SHIFT) - by0 + 1
-    count = ((x1 >> _SHIFT) - bx0 + 1) * nby
-    rep = np.repeat(np.arange(world.size), count)
-    local = np.arange(rep.size) - np.repeat(np.cumsum(count) - count, count)
-    ny = nby[rep]
-    bx = bx0[rep] + local // ny
-    by = by0[rep] + local % ny
-    blk = world[rep] * (nb * nb) + bx * nb + by
-    full = np.flatnonzero(grid.flat_blocks[blk])
-    if full.size == 0:
+    rep, bx, by = _blocks_with_fire(grid, world, x0, x1, y0, y1)
+    if rep.size == 0:
         return _EMPTY, _EMPTY, _EMPTY
-    rep, bx, by, blk = rep[full], bx[full], by[full], blk[full]
+    blk = world[rep] * (nb * nb) + bx * nb + by
     hit = test(grid.state.reshape(-1, BLOCK * BLOCK)[blk]).reshape(-1, BLOCK, BLOCK)
     cx = (bx << _SHIFT)[:, None] + _LX  # (K, 16) cell x of each block row
     cy = (by << _SHIFT)[:, None] + _LX
@@ -168,6 +178,35 @@ def scan_boxes(
     pair, rem = np.divmod(key, ww)
     x, y = np.divmod(rem, w)
     return pair, x, y
+
+
+def _ragged(lo_x: np.ndarray, hi_x: np.ndarray, lo_y: np.ndarray, hi_y: np.ndarray) -> tuple:
+    """Every ``(i, x, y)`` with ``lo_x[i] <= x <= hi_x[i]``, ``lo_y[i] <= y <= hi_y[i]``."""
+    ny = hi_y - lo_y + 1
+    count = (hi_x - lo_x + 1) * ny
+    rep = np.repeat(np.arange(lo_x.size), count)
+    local = np.arange(rep.size) - np.repeat(np.cumsum(count) - count, count)
+    n = ny[rep]
+    return rep, lo_x[rep] + local // n, lo_y[rep] + local % n
+
+
+def _blocks_with_fire(grid: CellGrid, world: np.ndarray, x0: np.ndarray, x1: np.ndarray,
+                      y0: np.ndarray, y1: np.ndarray) -> tuple:  # fmt: skip
+    """``(box, bx, by)`` of every block holding a burning cell inside each box: the super-blocks
+    of the box first (4 x 4 blocks each), then the blocks of the super-blocks with fire."""
+    ns, nb = grid.ns, grid.nb
+    bx0, bx1, by0, by1 = x0 >> _SHIFT, x1 >> _SHIFT, y0 >> _SHIFT, y1 >> _SHIFT
+    k = _SUPER_SHIFT - _SHIFT
+    rep, sx, sy = _ragged(bx0 >> k, bx1 >> k, by0 >> k, by1 >> k)
+    hot = np.flatnonzero(grid.flat_supers[world[rep] * (ns * ns) + sx * ns + sy])
+    rep, sx, sy = rep[hot], sx[hot], sy[hot]
+    bx = ((sx << k)[:, None] + _SUB[0]).reshape(-1)
+    by = ((sy << k)[:, None] + _SUB[1]).reshape(-1)
+    rep = np.repeat(rep, SUPER * SUPER)
+    inside = (bx >= bx0[rep]) & (bx <= bx1[rep]) & (by >= by0[rep]) & (by <= by1[rep])
+    rep, bx, by = rep[inside], bx[inside], by[inside]
+    full = np.flatnonzero(grid.flat_blocks[world[rep] * (nb * nb) + bx * nb + by])
+    return rep[full], bx[full], by[full]
 
 
 def runs(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

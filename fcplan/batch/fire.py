@@ -291,7 +291,7 @@ class BatchFire:
             if wb.size == 0:
                 return _EMPTY, _EMPTY, _EMPTY
         grid.flat_state[g] = BURNING
-        np.add.at(grid.flat_blocks, grid.block_index(wb, x, y), 1)
+        grid.count(wb, x, y, +1)
         # per world (the cells are sorted by world, then x): counts and the box of the new cells
         start, counts = runs(wb)
         worlds = wb[start]
@@ -312,7 +312,7 @@ class BatchFire:
         grid, w = self.grid, self.world_size
         g = grid.index(wb, x, y)
         grid.flat_state[g] = (grid.flat_state[g] & SENSED) | PRUNED
-        np.subtract.at(grid.flat_blocks, grid.block_index(wb, x, y), 1)
+        grid.count(wb, x, y, -1)
         counts = np.bincount(wb, minlength=self.num)
         self.n_burning -= counts
         self.n_pruned += counts

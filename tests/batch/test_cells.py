@@ -28,14 +28,14 @@ def test_scan_equals_a_dense_scan(seed, density):
     """Random grids and boxes: the burning cells found per box are those of the dense array,
     box by box in row-major order."""
     rng = np.random.default_rng(seed)
-    w, num = 70, 3
+    w, num = 150, 3
     grid = CellGrid(num, w)
     dense = (rng.random((num, w, w)) < density).astype(np.uint8)
     for b in range(num):
         x, y = np.nonzero(dense[b])
         wb = np.full(x.size, b)
         grid.flat_state[grid.index(wb, x, y)] = 1
-        np.add.at(grid.flat_blocks, grid.block_index(wb, x, y), 1)
+        grid.count(wb, x, y, +1)
     p = 6
     world = rng.integers(0, num, p)
     a, c = np.sort(rng.integers(0, w, (2, p)), axis=0), np.sort(rng.integers(0, w, (2, p)), axis=0)
