@@ -13,10 +13,19 @@ Prints, for scenarios #1 and #24 (greedy, seed 0, 180 s = 1,800 ticks):
   the fire events), of ``render_frame`` alone at 512 and 320 px, and of the whole
   ``fcplan replay --video`` path to MP4 (512 px) and GIF (320 px).
 
+``--memory`` instead measures the peak resident memory (``ru_maxrss`` of the child, from
+``os.wait4``) of whole ``fcplan replay REC --video OUT`` processes on #24 (greedy, seed 0,
+recorded by the same tree) at 512 px, 1x speed (one frame per tick), for a 30-s, a 90-s and the
+whole 180-s episode, GIF and MP4: bounded memory means the peak does not grow with the clip. ``--old PATH`` runs the same
+commands from another source tree (e.g. an export of ``main`` before streaming) for before/after;
+``python -c "import fcplan.video, fcplan.render, fcplan.recording"`` is the baseline (the
+interpreter and the libraries alone).
+
 Usage::
 
     python bench/bench_recording.py           # about a minute
     python bench/bench_recording.py --quick   # fewer repeats
+    python bench/bench_recording.py --memory [--old PATH]   # a few minutes
 """
 
 from __future__ import annotations
@@ -24,8 +33,11 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
+from pathlib import Path
 
 from fcplan import World, load_scenario, run_episode
 from fcplan.belief import Belief
@@ -90,10 +102,53 @@ def _bench_scenario(name, tmp: str, repeats: int):
     return rec
 
 
+def peak_rss(args: list[str], tree: Path) -> tuple[float, float]:
+    """Peak resident MiB and wall seconds of one ``python args`` process run from ``tree``."""
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    t0 = time.perf_counter()
+    with tempfile.TemporaryFile() as err:  # progress bars and errors, shown only on failure
+        child = subprocess.Popen(
+            [sys.executable, *args], cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=err
+        )
+        _, status, usage = os.wait4(child.pid, 0)
+        child.returncode = os.waitstatus_to_exitcode(status)
+        if child.returncode:
+            err.seek(0)
+            raise SystemExit(f"{' '.join(args)}: status {child.returncode}: {err.read().decode()}")
+    return usage.ru_maxrss / 1024, time.perf_counter() - t0  # Linux: ru_maxrss in KiB
+
+
+def memory(old: Path | None) -> None:
+    """Print peak RSS of ``fcplan replay --video`` by clip length, format and tree."""
+    tmp = tempfile.mkdtemp()
+    trees = {"new": Path(__file__).resolve().parents[1], **({"old": old.resolve()} if old else {})}
+    base = ["-c", "import fcplan.video, fcplan.render, fcplan.recording"]
+    print(f"load average {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} CPUs")
+    print("peak RSS of fcplan replay r24.npz --video OUT --size 512 (1x: one frame per tick)")
+    print(f"{'tree':<5} {'format':<7} {'clip s':>6} {'frames':>6} {'peak MiB':>9} {'wall s':>7}")
+    for tree, path in trees.items():
+        rec = os.path.join(tmp, f"r24_{tree}.npz")  # each tree replays its own recording format
+        peak_rss(["-m", "fcplan", "run", "24", "--record", rec], path)
+        mib, _ = peak_rss(base, path)
+        print(f"{tree:<5} {'(none)':<7} {'-':>6} {'-':>6} {mib:>9.0f} {'-':>7}")
+        for suffix in (".gif", ".mp4"):
+            for end in (30, 90, 180):
+                out = os.path.join(tmp, f"v{suffix}")
+                cmd = ["-m", "fcplan", "replay", rec, "--video", out, "--end", str(end)]
+                mib, wall = peak_rss(cmd, path)
+                print(f"{tree:<5} {suffix[1:]:<7} {end:>6} {10 * end:>6} {mib:>9.0f} {wall:>7.1f}")
+    print(f"load average {os.getloadavg()[0]:.2f} (1 min) at the end")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--memory", action="store_true", help="peak RSS of replay --video instead")
+    ap.add_argument("--old", type=Path, help="with --memory: another source tree to compare")
     args = ap.parse_args()
+    if args.memory:
+        memory(args.old)
+        return
     repeats = 2 if args.quick else 5
     tmp = tempfile.mkdtemp()
     print(f"load average {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} CPUs")

@@ -16,19 +16,27 @@ Examples
 1800
 >>> sorted(result.metrics)
 ['manual', 'reference2020']
+
+A run whose scheduler fell back to greedy on more than half of its replans is flagged
+(:attr:`EpisodeResult.fallback_majority`, also in :meth:`EpisodeResult.summary`): its score is
+mostly greedy's, not the named scheduler's, and tables must say so.
+
+>>> result.fallback_majority, fell_back_mostly(fallbacks=6, replans=10)
+(False, True)
 """
 
 from __future__ import annotations
 
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fcplan.metrics import Metrics, Outcomes, compute_all, compute_outcomes
-from fcplan.mission import Mission, ScenarioLike, as_scenario
+from fcplan.mission import EpisodeObserver, Mission, ScenarioLike, as_scenario
 from fcplan.scenario import Scenario
 from fcplan.scheduling import Scheduler, SolveStats, make_scheduler
 from fcplan.taskgraph import TaskGraphParams
@@ -37,7 +45,16 @@ from fcplan.trace import Trace
 if TYPE_CHECKING:
     from fcplan.recording import Recorder
 
-__all__ = ["run_episode", "EpisodeResult"]
+__all__ = ["run_episode", "EpisodeResult", "fell_back_mostly"]
+
+
+def fell_back_mostly(fallbacks: int, replans: int) -> bool:
+    """Whether ``fallbacks`` are more than half of ``replans`` (none: False).
+
+    The rule behind :attr:`EpisodeResult.fallback_majority` and the ``fallback_majority``
+    column of comparisons, sweeps and reports.
+    """
+    return bool(replans > 0 and fallbacks > replans / 2)
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,6 +77,9 @@ class EpisodeResult:
     wall_time_s : float
         Wall time of the whole episode.
     ticks : int
+
+    :attr:`fallbacks` counts the replans where greedy stood in; :attr:`fallback_majority` flags
+    an episode where that happened on more than half of them.
     """
 
     scenario: str
@@ -87,6 +107,12 @@ class EpisodeResult:
         """Number of replans where the scheduler failed and greedy stood in."""
         return sum(s.status == "fallback" for s in self.solves)
 
+    @property
+    def fallback_majority(self) -> bool:
+        """Whether the scheduler fell back to greedy on more than half of its replans (its score
+        is then mostly greedy's; :func:`fell_back_mostly`)."""
+        return fell_back_mostly(self.fallbacks, len(self.solves))
+
     def summary(self) -> dict[str, Any]:
         """Flat dict of the headline numbers (for tables)."""
         out: dict[str, Any] = {
@@ -109,6 +135,7 @@ class EpisodeResult:
             wall_time_s=self.wall_time_s,
             replans=len(self.solves),
             fallbacks=self.fallbacks,
+            fallback_majority=self.fallback_majority,
             optimal_replans=statuses.count("optimal"),
             time_limit_replans=statuses.count("time_limit"),
             solve_p50_ms=float(np.median(st) * 1e3) if st.size else 0.0,
@@ -130,6 +157,7 @@ def run_episode(
     event_replans: bool = True,
     record: str | os.PathLike[str] | None = None,
     latency: str | None = None,
+    observers: Sequence[EpisodeObserver] = (),
 ) -> EpisodeResult:
     """Play one episode of ``scenario`` with ``scheduler`` (a :class:`fcplan.mission.Mission`).
 
@@ -154,6 +182,9 @@ def run_episode(
         Planning takes time in the world: a plan applies that many ticks after its replan, the
         team flying its last orders meanwhile (:meth:`fcplan.mission.Mission.run`). None (the
         default) stops the world while the scheduler thinks, as the manual's game does.
+    observers : sequence of EpisodeObserver
+        Also told about every replan, command and tick (:class:`fcplan.mission.BaseObserver`),
+        e.g. a progress bar; they watch and change nothing.
 
     Returns
     -------
@@ -179,7 +210,7 @@ def run_episode(
         replan_period=replan_period,
         event_replans=event_replans,
         graph_params=graph_params,
-        observers=() if recorder is None else (recorder,),
+        observers=(*observers, *(() if recorder is None else (recorder,))),
     )
     mission.run(scheduler, time_limit=time_limit, latency=latency)
     trace = mission.world.trace()

@@ -22,9 +22,21 @@ __all__ = [
     "UnknownNameError",
     "EnvError",
     "LegacyError",
+    "install_hint",
 ]
 
 _MISSING = object()
+
+
+def install_hint(extra: str) -> str:
+    """How to install fcplan's optional ``extra``, from an index and from a source checkout.
+
+    Examples
+    --------
+    >>> install_hint("video")
+    'pip install "fcplan[video]" (from a checkout: pip install -e ".[video]")'
+    """
+    return f'pip install "fcplan[{extra}]" (from a checkout: pip install -e ".[{extra}]")'
 
 
 class FcplanError(Exception):

@@ -1,11 +1,16 @@
 """Videos of recorded episodes: MP4 (imageio + ffmpeg) or GIF (Pillow), drawn by fcplan.render.
 
 :func:`replay_ticks` chooses which ticks become frames (a time window and a playback speed);
-:func:`write_video` renders them with :func:`fcplan.render.render_frame` and encodes them one at a
-time (MP4 streams to ffmpeg; GIF keeps one byte per pixel per frame and uses one palette for the
-whole clip, so colours never flicker and unchanged areas cost nothing).
+:func:`write_video` renders them with :func:`fcplan.render.render_frame` and streams them to the
+encoder one at a time, so memory stays bounded whatever the episode's length: MP4 frames go down
+ffmpeg's pipe, GIF frames are encoded and written by :class:`GifStream` as they come (one palette
+for the whole clip, so colours never flicker; only the changed area of each frame is stored).
+Nothing holds the clip's frames (a 180-s episode at 512 px held 1.6 GB as a GIF before;
+``bench/bench_recording.py --memory`` measures the peak).
 
-The encoders are optional: ``pip install "fcplan[video]"``.
+The file appears under its name only when complete: it is written beside it and renamed, so an
+interrupted or failed write leaves nothing half-written. MP4 needs ``fcplan[video]``
+(imageio and imageio-ffmpeg); GIF needs only Pillow, a core dependency.
 
 Examples
 --------
@@ -15,13 +20,15 @@ range(1, 1801, 10)
 
 from __future__ import annotations
 
+import contextlib
 import os
-from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING
+import struct
+from collections.abc import Callable, Iterable, Iterator
+from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
 
-from fcplan.errors import FcplanError
+from fcplan.errors import FcplanError, install_hint
 
 if TYPE_CHECKING:
     from fcplan.recording import Recording
@@ -29,11 +36,12 @@ if TYPE_CHECKING:
 #: called as ``progress(done, total)`` after each frame
 Progress = Callable[[int, int], None]
 
-__all__ = ["VideoError", "replay_ticks", "write_video", "VIDEO_SUFFIXES"]
+__all__ = ["GifStream", "VideoError", "replay_ticks", "write_video", "VIDEO_SUFFIXES"]
 
 VIDEO_SUFFIXES = (".mp4", ".gif")
-_GIF_COLORS = 128  # palette entries for the picture; index 255 marks "unchanged" (transparent)
+_GIF_COLORS = 128  # palette entries taken from the first frame; index 255 marks "unchanged"
 _GIF_CLEAR = 255
+_GIF_MAX_DELAY = 0xFFFF  # centiseconds, the largest delay of one GIF frame
 
 
 class VideoError(FcplanError, ValueError):
@@ -142,9 +150,19 @@ def _write_mp4(
         import imageio.v2 as imageio
         import imageio_ffmpeg  # noqa: F401  (the ffmpeg binary imageio needs)
     except ImportError:
-        raise VideoError(
-            'MP4 needs imageio and imageio-ffmpeg: pip install "fcplan[video]"'
-        ) from None
+        raise VideoError(f"MP4 needs imageio and imageio-ffmpeg: {install_hint('video')}") from None
+    with _atomic(path) as tmp:
+        return _encode_mp4(imageio, images, tmp, fps, total, progress)
+
+
+def _encode_mp4(
+    imageio: Any,
+    images: Iterable[np.ndarray],
+    path: str,
+    fps: float,
+    total: int,
+    progress: Progress | None,
+) -> int:
     n = 0
     try:
         writer = imageio.get_writer(
@@ -172,42 +190,161 @@ def _write_mp4(
 def _write_gif(
     images: Iterable[np.ndarray], path: str, fps: float, total: int, progress: Progress | None
 ) -> int:
+    from fcplan.render import COLORS
+
+    n = 0
     try:
-        from PIL import Image
-    except ImportError:
-        raise VideoError('GIF needs Pillow: pip install "fcplan[video]"') from None
-    palette = None
-    frames = []
-    prev = None
-    for img in images:
-        im = Image.fromarray(img)
-        if palette is None:
-            palette = im.quantize(colors=_GIF_COLORS, method=Image.Quantize.MEDIANCUT)
-        idx = np.asarray(im.quantize(palette=palette, dither=Image.Dither.NONE))
-        # pixels unchanged since the previous frame become transparent: long runs of one index
-        # that LZW packs tightly (the previous frame shows through, disposal 1)
-        out = idx if prev is None else np.where(idx == prev, _GIF_CLEAR, idx).astype(np.uint8)
-        prev = idx
-        frame = Image.fromarray(out, mode="P")
-        colors = palette.getpalette()
-        assert colors is not None  # (a quantized image has a palette)
-        frame.putpalette(colors[: 3 * _GIF_COLORS] + [0, 0, 0] * (256 - _GIF_COLORS))
-        frames.append(frame)
-        if progress is not None:
-            progress(len(frames), total)
-    if not frames:
-        raise VideoError(f"{path}: no frames to write")
-    try:
-        frames[0].save(
-            path,
-            save_all=True,
-            append_images=frames[1:],
-            duration=int(round(1000 / fps)),
-            loop=0,
-            optimize=False,
-            disposal=1,
-            transparency=_GIF_CLEAR,
-        )
+        with _atomic(path) as tmp, open(tmp, "wb") as fh:
+            gif = GifStream(fh, fps, colors=COLORS.values())
+            for img in images:
+                gif.add(img)
+                n += 1
+                if progress is not None:
+                    progress(n, total)
+            if n == 0:
+                raise VideoError(f"{path}: no frames to write")
+            gif.close()
     except OSError as exc:
-        raise VideoError(f"{path}: cannot write: {exc}") from None
-    return len(frames)
+        raise VideoError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    return n
+
+
+class GifStream:
+    """An animated GIF written frame by frame: memory holds two frames, whatever the length.
+
+    One global palette, fixed at the first frame, serves the whole clip, so colours never flicker:
+    the exact ``colors`` given (the renderer's named colours: fire that appears later keeps its
+    colour) plus up to :data:`_GIF_COLORS` median-cut colours of the first frame (the shades of
+    anti-aliased text and overlays); every frame is mapped to it without dithering. Each later frame stores only
+    the bounding box of the pixels that changed, with unchanged pixels inside it set to the
+    transparent index (the previous frame shows through: disposal 1), which LZW packs into long
+    runs; a frame identical to the previous one lengthens the previous one's delay instead. Frame
+    delays follow a clock at ``fps`` (GIF counts in 1/100 s: at 30 fps the delays run 3, 3, 4, ...
+    so the clip keeps its length). The LZW image data is Pillow's encoder
+    (``Image.tobytes("gif", "P")``); the file structure (GIF89a: screen descriptor, global colour
+    table, NETSCAPE2.0 loop, per frame a graphic control extension and an image descriptor) is
+    written here, so nothing is held between frames (Pillow's own writers keep every frame, or,
+    through ``GifImagePlugin.getdata``, a class per frame until the garbage collector runs).
+
+    Parameters
+    ----------
+    fh : binary file
+        Open for writing.
+    fps : float
+        Frames per second.
+    colors : iterable of (r, g, b)
+        Colours the palette must hold exactly (at most 127 are used).
+
+    Examples
+    --------
+    >>> import io
+    >>> from PIL import Image
+    >>> buf = io.BytesIO()
+    >>> gif = GifStream(buf, fps=10, colors=[(255, 255, 255)])
+    >>> frame = np.zeros((8, 12, 3), np.uint8)
+    >>> gif.add(frame); frame[2, 3] = 255; gif.add(frame); gif.add(frame); gif.close()
+    >>> im = Image.open(buf)
+    >>> im.size, im.n_frames, im.info["duration"]
+    ((12, 8), 2, 100)
+    >>> im.seek(1); im.info["duration"]  # the third frame, identical, lengthened the second
+    200
+    """
+
+    def __init__(
+        self, fh: BinaryIO, fps: float, colors: Iterable[tuple[int, int, int]] = ()
+    ) -> None:
+        self.fh = fh
+        self.fps = fps
+        self.colors = list(dict.fromkeys(tuple(int(v) for v in c) for c in colors))[:127]
+        self.frames = 0  # frames added
+        self._palette: Any = None
+        self._prev: np.ndarray | None = None  # palette indices of the last frame
+        self._pending: tuple[np.ndarray, tuple[int, int], int] | None = None
+        self._written_cs = 0  # centiseconds of delays written or pending
+
+    def add(self, img: np.ndarray) -> None:
+        """Append one RGB frame, ``(H, W, 3) uint8`` (the same size as the first)."""
+        from PIL import Image
+
+        im = Image.fromarray(img)
+        if self._palette is None:
+            self._palette = self._make_palette(im)
+            self._header(im.size)
+        idx = np.array(im.quantize(palette=self._palette, dither=Image.Dither.NONE))
+        idx[idx == _GIF_CLEAR] = 0  # entry 255 repeats entry 0: a tie, never the transparent one
+        self.frames += 1
+        delay = round(100 * self.frames / self.fps) - self._written_cs
+        self._written_cs += delay
+        prev, self._prev = self._prev, idx
+        if prev is None:
+            self._pending = (idx, (0, 0), delay)
+            return
+        changed = idx != prev
+        if not changed.any():
+            assert self._pending is not None
+            data, offset, cs = self._pending
+            if cs + delay <= _GIF_MAX_DELAY:
+                self._pending = (data, offset, cs + delay)
+                return
+            self._flush()  # a delay is 16 bits: go on with a 1-px frame that changes nothing
+            self._pending = (np.full((1, 1), _GIF_CLEAR, np.uint8), (0, 0), delay)
+            return
+        rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
+        box = (slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1))
+        crop = np.where(changed[box], idx[box], _GIF_CLEAR).astype(np.uint8)
+        self._flush()
+        self._pending = (crop, (int(cols[0]), int(rows[0])), delay)
+
+    def close(self) -> None:
+        """Write the last frame and the trailer (the file stays open: the caller's)."""
+        self._flush()
+        self.fh.write(b";")
+
+    def _make_palette(self, first: Any) -> Any:
+        """A ``P`` image holding the clip's 256-entry palette: ``colors``, then the first frame's
+        median-cut colours, then repeats of entry 0 (entry 255 is the transparent index)."""
+        from PIL import Image
+
+        q = first.quantize(colors=_GIF_COLORS, method=Image.Quantize.MEDIANCUT)
+        used = int(np.asarray(q).max()) + 1
+        shades = np.asarray(q.getpalette()[: 3 * used], np.uint8).reshape(-1, 3)
+        entries = list(dict.fromkeys([*self.colors, *map(tuple, shades.tolist())]))[:255]
+        entries += [entries[0]] * (256 - len(entries))
+        palette = Image.new("P", (1, 1))
+        palette.putpalette([v for rgb in entries for v in rgb])
+        return palette
+
+    def _header(self, size: tuple[int, int]) -> None:
+        table = bytes(self._palette.getpalette()[: 3 * 256])
+        w, h = size
+        self.fh.write(b"GIF89a" + struct.pack("<HHBBB", w, h, 0xF7, 0, 0) + table)
+        self.fh.write(b"!\xff\x0bNETSCAPE2.0\x03\x01" + struct.pack("<H", 0) + b"\x00")
+
+    def _flush(self) -> None:
+        """Write the pending frame: graphic control extension (delay, disposal 1, transparent
+        index), image descriptor (its box, no local table) and its LZW data (Pillow's encoder)."""
+        if self._pending is None:
+            return
+        from PIL import Image
+
+        data, (x, y), cs = self._pending
+        self._pending = None
+        h, w = data.shape
+        lzw = Image.frombytes("P", (w, h), data.tobytes()).tobytes("gif", "P")
+        self.fh.write(b"!\xf9\x04" + struct.pack("<BHBB", 0x05, cs, _GIF_CLEAR, 0))
+        self.fh.write(b"," + struct.pack("<HHHHB", x, y, w, h, 0) + b"\x08" + lzw + b"\x00")
+
+
+@contextlib.contextmanager
+def _atomic(path: str) -> Iterator[str]:
+    """A path beside ``path`` (same suffix) to write, renamed onto ``path`` once the block ends
+    normally; removed if it fails or is interrupted, so nothing half-written is left."""
+    head, tail = os.path.split(path)
+    stem, suffix = os.path.splitext(tail)
+    tmp = os.path.join(head, f".{stem}.{os.getpid()}.part{suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)

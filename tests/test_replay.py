@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+import io
+import tracemalloc
+
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
+from PIL import Image, ImageSequence
 
 from fcplan import run_episode
 from fcplan.cli import main
 from fcplan.recording import load_recording
 from fcplan.render import panel_width, render_frame
-from fcplan.video import VideoError, replay_ticks, write_video
+from fcplan.video import GifStream, VideoError, replay_ticks, write_video
 
 
 @pytest.fixture(scope="module")
@@ -135,3 +139,111 @@ def test_cli_errors(rec_path, tmp_path, capsys):
     assert main(["replay", str(rec_path), "--video", str(tmp_path / "o.avi")]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 2 and all(line.startswith("fcplan: error:") for line in err)
+
+
+PALETTE = np.array([(0, 0, 0), (255, 72, 24), (84, 190, 255), (226, 228, 234)], np.uint8)
+
+
+def _gif(frames, fps, colors=PALETTE):
+    buf = io.BytesIO()
+    gif = GifStream(buf, fps, colors=[tuple(c) for c in colors])
+    for f in frames:
+        gif.add(f)
+    gif.close()
+    buf.seek(0)
+    return Image.open(buf)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.lists(st.integers(0, 2**32 - 1), min_size=1, max_size=10),
+    st.sampled_from([5, 10, 20, 25]),
+    st.data(),
+)
+def test_gif_stream_decodes_to_the_frames_it_was_given(seeds, fps, data):
+    """Frames whose colours are all in the palette decode exactly, each shown for 1/fps s
+    (identical neighbours merged into one longer frame), whatever changed between frames."""
+    frames = []
+    for s in seeds:
+        rng = np.random.default_rng(s)
+        if frames and data.draw(st.booleans()):
+            frame = frames[-1].copy()  # a repeat or a small change of the previous frame
+            frame[rng.integers(0, 6), rng.integers(0, 9)] = PALETTE[rng.integers(0, 4)]
+        else:
+            frame = PALETTE[rng.integers(0, 4, size=(6, 9))]
+        frames.append(frame)
+    im = _gif(frames, fps)
+    shown = []
+    for frame in ImageSequence.Iterator(im):
+        assert frame.info["duration"] % (1000 // fps) == 0
+        shown += [np.asarray(frame.convert("RGB"))] * (frame.info["duration"] * fps // 1000)
+    assert len(shown) == len(frames)
+    for got, want in zip(shown, frames, strict=True):
+        np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize("fps", [3, 7.5, 30])
+def test_gif_delays_follow_the_clock(fps):
+    """Delays are whole 1/100 s that add up to the clip's length at ``fps`` (30 fps: 3, 3, 4,
+    ...), instead of each frame's delay rounded on its own (30 fps would run 10 % slow)."""
+    frames = [PALETTE[np.full((4, 4), k % 4)] for k in range(30)]
+    im = _gif(frames, fps)
+    total = sum(f.info["duration"] for f in ImageSequence.Iterator(im))
+    assert total == 10 * round(100 * 30 / fps)
+
+
+def test_gif_still_frames_longer_than_a_gif_delay_keep_their_length():
+    """A picture that stays the same for longer than one GIF delay can say (655.35 s) is
+    continued by frames that change nothing, so the clip keeps its length."""
+    frames = [PALETTE[np.zeros((4, 4), int)]] * 700
+    im = _gif(frames, fps=1)
+    durations = [f.info["duration"] for f in ImageSequence.Iterator(im)]
+    assert sum(durations) == 700_000 and max(durations) <= 655_350
+
+
+def test_gif_memory_does_not_grow_with_the_clip():
+    """Writing ten times more frames does not raise the peak of traced memory: frames are
+    encoded and written as they come, none is kept."""
+    rng = np.random.default_rng(0)
+    base = PALETTE[rng.integers(0, 4, size=(96, 128))]
+
+    class Sink(io.RawIOBase):  # a file that keeps nothing (the output is not the point)
+        def write(self, b):
+            return len(b)
+
+    def peak(n):
+        frames = (np.roll(base, k, axis=1) for k in range(n))
+        tracemalloc.start()
+        try:
+            gif = GifStream(Sink(), 10, colors=[tuple(c) for c in PALETTE])
+            for f in frames:
+                gif.add(f)
+            gif.close()
+            return tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+
+    small, large = peak(20), peak(200)
+    assert large < 1.5 * small, (small, large)
+
+
+@pytest.mark.parametrize("suffix", [".gif", ".mp4"])
+def test_a_failed_video_leaves_no_file(rec_path, tmp_path, suffix, monkeypatch):
+    """A write interrupted half-way (here a frame that fails to render) leaves neither the video
+    nor its temporary file behind."""
+    if suffix == ".mp4":
+        pytest.importorskip("imageio_ffmpeg")
+    import fcplan.render as render
+
+    calls = []
+
+    def failing(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return render_frame(*args, **kwargs)
+
+    monkeypatch.setattr(render, "render_frame", failing)
+    with pytest.raises(KeyboardInterrupt):
+        write_video(load_recording(rec_path), tmp_path / f"v{suffix}", size=96, speed=20)
+    assert list(tmp_path.iterdir()) == []

@@ -4,9 +4,16 @@
 the chosen command and turns every :class:`~fcplan.errors.FcplanError` into one line on stderr and
 exit status 2 (``--debug`` shows the traceback instead); so are the failures the environment
 causes rather than a bug (an :class:`OSError` such as a full disk, and :class:`MemoryError`).
-A message is cut to :data:`MAX_MESSAGE` characters. Ctrl-C exits 130; SIGTERM is handled the same
-way (the command stops its workers and keeps what it stored) and exits 143; a closed pipe
-(``fcplan scenarios | head``) ends quietly.
+A message is cut to :data:`MAX_MESSAGE` characters; a bad argument reads ``fcplan run: error:
+argument --seed: ...`` (the command, then the problem). Ctrl-C exits 130; SIGTERM is handled the
+same way (the command stops its workers and keeps what it stored) and exits 143; a closed pipe
+(``fcplan scenarios | head``) ends quietly. A bare ``fcplan`` prints the help on stdout and a
+one-line hint on stderr (exit 2); ``--help`` and ``--version`` return 0.
+
+Start-up is part of the interface: building the parser imports only the command modules, which
+import nothing heavy at module level (numpy, scipy, networkx, pandas, pygame and the solvers load
+inside ``run``), so ``fcplan --help`` and ``fcplan scenarios`` start in a fraction of a second
+(``bench/bench_startup.py``; ``tests/cli/test_cli_startup.py`` checks the imports).
 
 Examples
 --------
@@ -20,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import difflib
 import os
 import signal
 import sys
@@ -35,6 +43,7 @@ import fcplan.cli.report as report
 import fcplan.cli.run as run
 import fcplan.cli.scenario as scenario
 import fcplan.cli.scenarios as scenarios
+import fcplan.cli.schedulers as schedulers
 import fcplan.cli.sweep as sweep
 from fcplan.cli.util import CliError, Parser
 from fcplan.errors import FcplanError
@@ -47,7 +56,18 @@ MAX_MESSAGE = 1000
 #: The command modules, in the order ``fcplan --help`` lists them. Each defines
 #: ``add_parser(sub)``, which adds its parser to the sub-parsers ``sub`` (built with
 #: ``parser_class=fcplan.cli.util.Parser``) and sets ``run=<function(args) -> int>`` as a default.
-COMMANDS = (scenarios, scenario, run, compare, play, sweep, report, replay, import_legacy)
+COMMANDS = (
+    scenarios,
+    scenario,
+    schedulers,
+    run,
+    compare,
+    play,
+    sweep,
+    report,
+    replay,
+    import_legacy,
+)
 
 #: The names of the :data:`COMMANDS` modules.
 COMMAND_MODULES: tuple[str, ...] = tuple(m.__name__ for m in COMMANDS)
@@ -55,9 +75,20 @@ COMMAND_MODULES: tuple[str, ...] = tuple(m.__name__ for m in COMMANDS)
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``fcplan`` parser with every command of :data:`COMMANDS`."""
-    p = Parser(prog="fcplan", description="FireCommander multi-robot task assignment testbed")
+    from fcplan import __version__
+
+    p = Parser(
+        prog="fcplan",
+        description="FireCommander multi-robot task assignment testbed",
+        epilog="fcplan COMMAND --help describes a command; start with: fcplan run 12",
+    )
     p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    p.add_argument(
+        "--version",
+        action="version",
+        version=f"fcplan {__version__} (Python {sys.version.split()[0]})",
+    )
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     for command in COMMANDS:
         command.add_parser(sub)
     return p
@@ -84,8 +115,32 @@ def _sigterm_as_interrupt() -> Iterator[None]:
         signal.signal(signal.SIGTERM, previous)
 
 
-def _error(message: str) -> int:
-    text = " ".join(f"fcplan: error: {message}".split())
+def _unrecognized(
+    parser: argparse.ArgumentParser, args: argparse.Namespace, extras: list[str]
+) -> CliError:
+    """The error for arguments no parser took, naming the command and the closest options
+    (``fcplan compare: unrecognized arguments: --seed 3 (did you mean --seeds?)``)."""
+    command = parser
+    sub = getattr(parser, "_subparsers", None)
+    if sub is not None and getattr(args, "command", None):
+        command = sub._group_actions[0].choices.get(args.command, parser)
+    options = [o for a in command._actions for o in a.option_strings if o.startswith("--")]
+    hints = {
+        extra: difflib.get_close_matches(extra.split("=")[0], options, n=1, cutoff=0.6)
+        for extra in extras
+        if extra.startswith("-")
+    }
+    close = {e.split("=")[0]: m[0] for e, m in hints.items() if m}
+    if len(close) == 1:
+        hint = f" (did you mean {next(iter(close.values()))}?)"
+    else:
+        hint = f" (did you mean {', '.join(f'{m} for {e}' for e, m in close.items())}?)"
+    hint = hint if close else ""
+    return CliError(f"unrecognized arguments: {' '.join(extras)}{hint}", prog=command.prog)
+
+
+def _error(message: str, prog: str = "fcplan") -> int:
+    text = " ".join(f"{prog}: error: {message}".split())
     if len(text) > MAX_MESSAGE:
         text = text[: MAX_MESSAGE - 3] + "..."
     print(text, file=sys.stderr)
@@ -103,10 +158,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     debug = "--debug" in argv
     try:
         with _sigterm_as_interrupt():
-            args = build_parser().parse_args(argv)
-            if getattr(args, "run", None) is not None:
-                return int(args.run(args))
-            raise CliError(f"unknown command {args.command!r}")  # pragma: no cover
+            parser = build_parser()
+            try:
+                args, extras = parser.parse_known_args(argv)
+            except SystemExit as exc:  # --help, --version
+                return exc.code if isinstance(exc.code, int) else 0
+            if extras:
+                raise _unrecognized(parser, args, extras)
+            if getattr(args, "run", None) is None:  # a bare `fcplan` (or only --debug)
+                print(parser.format_help(), end="")
+                raise CliError("a command is needed (see above, or: fcplan run 12)", prog="fcplan")
+            return int(args.run(args))
+    except CliError as exc:
+        if debug:
+            raise
+        return _error(exc.message, exc.prog or "fcplan")
     except FcplanError as exc:
         if debug:
             raise

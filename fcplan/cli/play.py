@@ -31,6 +31,7 @@ from fcplan.cli.util import (
     check_output,
     positive_float,
     positive_int,
+    scenario_name,
     seed,
 )
 
@@ -48,7 +49,11 @@ def add_parser(sub: SubParsers) -> None:
         "welcome screen offers the scenario mode, the open-world designer and the tutorial. "
         "Headless: SDL_VIDEODRIVER=dummy.",
     )
-    p.add_argument("--scenario", help="start directly in this scenario: practice, 1..24, or a TOML")
+    p.add_argument(
+        "--scenario",
+        type=scenario_name,
+        help="start directly in this scenario: practice, 1..24, or a TOML",
+    )
     p.add_argument("--seed", type=seed, default=None, help="random seed (integer >= 0, default 0)")
     p.add_argument("--record", metavar="PATH", help="save the recording here (default: user data "
                    "folder, fcplan/recordings/)")  # fmt: skip
@@ -82,6 +87,12 @@ def add_parser(sub: SubParsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``fcplan play``; print where the game was recorded and its score."""
+    import importlib.util
+
+    from fcplan.errors import install_hint
+
+    if importlib.util.find_spec("pygame") is None:  # before the display: name what is missing
+        raise CliError(f"fcplan play needs pygame: {install_hint('game')}")
     from fcplan.game.app import load_script, require_display, run_app
     from fcplan.game.screens import App
 

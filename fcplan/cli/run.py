@@ -8,7 +8,10 @@
 Prints the scenario, scheduler and seed, the ticks and simulated time, the wall time, the number of
 replans with the median and 95th-percentile solve times and the fallbacks, then both metric
 definitions (:func:`fcplan.metrics.format_metrics`). ``--json`` prints the same as one JSON
-document instead; ``--record`` also writes a recording for ``fcplan replay``.
+document instead; ``--record`` also writes a recording for ``fcplan replay``. An episode that
+takes more than two seconds shows a progress bar in simulated seconds on stderr
+(:mod:`fcplan.cli.progress`). ``fcplan run --help`` lists the registered schedulers;
+``fcplan schedulers`` describes them and their settings.
 
 Examples
 --------
@@ -26,19 +29,35 @@ import argparse
 import json
 from typing import TYPE_CHECKING
 
-from fcplan.cli.util import SubParsers, check_output, positive_float, seed
+from fcplan.cli.util import SubParsers, check_output, positive_float, scenario_name, seed
 
 if TYPE_CHECKING:
     import numpy as np
 
-__all__ = ["add_parser", "run"]
+__all__ = ["add_parser", "run", "schedulers_epilog"]
 
 
 def add_parser(sub: SubParsers) -> None:
     """Add ``fcplan run`` to the ``fcplan`` sub-parsers ``sub``."""
-    r = sub.add_parser("run", help="run one episode and print the manual's metrics")
-    r.add_argument("scenario", help="practice, 1..24, or a TOML file")
-    r.add_argument("--scheduler", "-s", default="greedy", help="registered scheduler name")
+    r = sub.add_parser(
+        "run",
+        help="run one episode and print the manual's metrics",
+        description="Play one episode and print both metric definitions.",
+        epilog_fn=schedulers_epilog,
+    )
+    r.add_argument(
+        "scenario",
+        type=scenario_name,
+        help="practice, 1..24, another name fcplan scenarios lists, or a .toml file",
+    )
+    r.add_argument(
+        "--scheduler",
+        "-s",
+        default="greedy",
+        metavar="SPEC",
+        help="a registered scheduler, with settings as NAME:KEY=VALUE[:KEY=VALUE] "
+        "(default greedy; listed below)",
+    )
     r.add_argument("--seed", type=seed, default=0, help="random seed (integer >= 0)")
     r.add_argument(
         "--replan-period",
@@ -59,8 +78,19 @@ def add_parser(sub: SubParsers) -> None:
     r.set_defaults(run=run)
 
 
+def schedulers_epilog() -> str:
+    """The registered schedulers, for ``fcplan run --help`` (computed only when help is shown)."""
+    from fcplan.scheduling import available_schedulers
+
+    return (
+        f"schedulers: {', '.join(available_schedulers())}. fcplan schedulers describes each "
+        "and its settings; e.g. -s milp:slots=3"
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the episode and print its results."""
+    from fcplan.cli.progress import EpisodeProgress, progress_bar
     from fcplan.episode import run_episode
     from fcplan.metrics import format_metrics
     from fcplan.scenario import load_scenario
@@ -69,14 +99,17 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.record, "--record")
     scenario = load_scenario(args.scenario)
     scheduler = make_scheduler(args.scheduler)
-    res = run_episode(
-        scenario,
-        scheduler,
-        seed=args.seed,
-        replan_period=args.replan_period,
-        time_limit=args.time_limit,
-        record=args.record,
-    )
+    label = f"{scenario.name} {getattr(scheduler, 'name', args.scheduler)}"
+    with progress_bar(scenario.duration_s, desc=label, unit="s") as bar:
+        res = run_episode(
+            scenario,
+            scheduler,
+            seed=args.seed,
+            replan_period=args.replan_period,
+            time_limit=args.time_limit,
+            record=args.record,
+            observers=[EpisodeProgress(bar, scenario.ticks_per_second)],
+        )
     if args.json:
         out = {
             "scenario": res.scenario,

@@ -4,6 +4,7 @@
 
     fcplan sweep CONFIG.toml [--results DIR] [--jobs N] [--dask ADDRESS|local] [--retry-failed]
                              [--quiet] [--wall-time]
+                             [--seeds auto [--max-seeds 50] [--seed-batch 5] [--metric NAME]]
 
 Runs :func:`fcplan.experiments.sweep` (default results folder: ``results/<CONFIG stem>``, so
 re-running the same command resumes); it prints a summary, one warning line per failed episode,
@@ -11,7 +12,10 @@ and exits 0 when every episode is stored (completed or failed) and 1 when some w
 died): re-run to play them. A second sweep into a folder in use, or a full disk, stops with a
 one-line error (exit 2; the rows stored so far are kept); so does SIGTERM or Ctrl-C (exit 143 or
 130), after stopping the workers. ``--wall-time`` lets time limits bind on the wall clock
-(default: schedulers with a deterministic mode run in it).
+(default: schedulers with a deterministic mode run in it). ``--seeds auto`` replaces the file's
+seeds by batches of seeds until every pair of schedulers is resolved on ``--metric`` or
+``--max-seeds`` are played, and says why it stopped; a progress bar (in episodes) goes to stderr
+unless ``--quiet``.
 
 Examples
 --------
@@ -64,6 +68,28 @@ def add_parser(sub: SubParsers) -> None:
         action="store_true",
         help="let time limits bind on the wall clock (results depend on machine load)",
     )
+    s.add_argument(
+        "--seeds",
+        choices=["auto"],
+        default=None,
+        help="auto: replace the file's seeds by batches until every pair of schedulers is "
+        "resolved or --max-seeds",
+    )
+    s.add_argument(
+        "--max-seeds", type=positive_int, default=50, help="--seeds auto: the cap (default 50)"
+    )
+    s.add_argument(
+        "--seed-batch",
+        type=positive_int,
+        default=5,
+        help="--seeds auto: seeds added per batch (default 5)",
+    )
+    s.add_argument(
+        "--metric",
+        default="manual.final_score",
+        metavar="NAME",
+        help="--seeds auto: the metric that decides (default manual.final_score)",
+    )
     s.set_defaults(run=run)
 
 
@@ -80,6 +106,10 @@ def run(args: argparse.Namespace) -> int:
         retry_failed=args.retry_failed,
         progress=not args.quiet,
         deterministic=not args.wall_time,
+        seeds=args.seeds,
+        max_seeds=args.max_seeds,
+        seed_batch=args.seed_batch,
+        metric=args.metric,
     )
     print(summary.format())
     for e in summary.errors:

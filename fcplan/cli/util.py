@@ -6,6 +6,11 @@ defines ``add_parser(sub: SubParsers) -> None``, which adds its parser to the su
 ``fcplan`` parser and sets ``run=<function(args) -> int>`` as a default; heavy imports stay inside
 ``run``.
 
+:class:`Parser` never abbreviates options (``--seed`` is not taken for ``--seeds``), raises
+:class:`CliError` instead of exiting, and can compute its epilog only when help is shown
+(``epilog_fn``: ``fcplan run --help`` lists the registered schedulers without every other
+command paying for the entry-point scan).
+
 Examples
 --------
 >>> positive_int("3")
@@ -16,6 +21,16 @@ Examples
 Traceback (most recent call last):
 ...
 fcplan.cli.util.CliError: fcplan x: unrecognized arguments: --nope
+>>> p = Parser(prog="fcplan x")
+>>> _ = p.add_argument("--seeds")
+>>> p.parse_args(["--seed", "3"])
+Traceback (most recent call last):
+...
+fcplan.cli.util.CliError: fcplan x: unrecognized arguments: --seed 3
+>>> scenario_name("0")
+Traceback (most recent call last):
+...
+argparse.ArgumentTypeError: no scenario '0': the shipped scenarios are practice and 1..24 (plus the names fcplan scenarios lists) or a .toml file
 """
 
 from __future__ import annotations
@@ -23,9 +38,11 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import stat
+from collections.abc import Callable
 from pathlib import Path
-from typing import NoReturn, TypeAlias
+from typing import Any, NoReturn, TypeAlias
 
 from fcplan.errors import FcplanError
 
@@ -39,20 +56,56 @@ __all__ = [
     "positive_float",
     "positive_int",
     "scenario_list",
+    "scenario_name",
     "seed",
     "seed_list",
 ]
 
 
 class CliError(FcplanError):
-    """A bad command-line argument; ``fcplan`` prints it on one line and exits 2."""
+    """A bad command-line argument; ``fcplan`` prints it on one line and exits 2.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong and what is allowed.
+    prog : str, optional
+        The command the argument belongs to (``"fcplan run"``); the printed line then reads
+        ``fcplan run: error: MESSAGE`` and ``str()`` is ``"fcplan run: MESSAGE"``.
+    """
+
+    def __init__(self, message: str, *, prog: str | None = None) -> None:
+        self.message, self.prog = message, prog
+        super().__init__(f"{prog}: {message}" if prog else message)
 
 
 class Parser(argparse.ArgumentParser):
-    """An ``ArgumentParser`` whose errors raise :class:`CliError` instead of exiting."""
+    """An ``ArgumentParser`` whose errors raise :class:`CliError` instead of exiting, which never
+    abbreviates long options, and whose epilog may be computed when help is shown.
+
+    Parameters
+    ----------
+    *args, **kwargs
+        As :class:`argparse.ArgumentParser` (``allow_abbrev`` defaults to False).
+    epilog_fn : callable, optional
+        Returns the epilog; called only by :meth:`format_help`.
+    """
+
+    def __init__(
+        self, *args: Any, epilog_fn: Callable[[], str] | None = None, **kwargs: Any
+    ) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
+        self.epilog_fn = epilog_fn
 
     def error(self, message: str) -> NoReturn:  # one line, exit 2 (handled in fcplan.cli.main)
-        raise CliError(f"{self.prog}: {message}")
+        raise CliError(message, prog=self.prog)
+
+    def format_help(self) -> str:
+        """The help text, with the epilog from ``epilog_fn`` when there is one."""
+        if self.epilog_fn is not None:
+            self.epilog = self.epilog_fn()
+        return super().format_help()
 
 
 #: The sub-parsers object (``Parser.add_subparsers(parser_class=Parser)``) a command adds to.
@@ -92,14 +145,39 @@ def positive_int(text: str) -> int:
     return v
 
 
+_SCENARIO_ZERO = re.compile(r"#?0+")
+
+
+def _no_scenario_zero(text: str) -> argparse.ArgumentTypeError:
+    return argparse.ArgumentTypeError(
+        f"no scenario {text!r}: the shipped scenarios are practice and 1..24 (plus the names "
+        "fcplan scenarios lists) or a .toml file"
+    )
+
+
+def scenario_name(text: str) -> str:
+    """A scenario as the user wrote it (a name, a number, a path), refusing ``0``: the practice
+    scenario is given by name, so that a typo such as ``fcplan run 0`` does not quietly play it
+    (the library's :func:`fcplan.load_scenario` keeps accepting ``0``, the practice's number in
+    the scenario files)."""
+    if _SCENARIO_ZERO.fullmatch(text.strip()):
+        raise _no_scenario_zero(text)
+    return text
+
+
 def scenario_list(text: str) -> list[int | str]:
-    """Scenarios as numbers, ranges and names (:func:`fcplan.experiments.parse_range`)."""
+    """Scenarios as numbers, ranges and names (:func:`fcplan.experiments.parse_range`); no ``0``
+    (see :func:`scenario_name`)."""
     from fcplan.experiments.compare import RangeError, parse_range
 
     try:
-        return parse_range(text)
+        items = parse_range(text)
     except RangeError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+    for item in items:
+        if item == 0 or (isinstance(item, str) and _SCENARIO_ZERO.fullmatch(item.strip())):
+            raise _no_scenario_zero(str(item))
+    return items
 
 
 def seed_list(text: str) -> list[int | str]:

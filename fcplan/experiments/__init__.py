@@ -9,9 +9,17 @@ cores, and summarises the outcomes with confidence intervals.
   per-scheduler table, JSON/CSV output, a text table); :func:`parse_range`
   (:mod:`~fcplan.experiments.ranges`) reads the CLI's ``1-24``/``1,3,5-7``/``practice`` lists.
   The ``fcplan compare`` command is a thin layer over them.
-* :mod:`~fcplan.experiments.stats`: the mean and Student-t confidence interval of the mean, and
-  paired differences; :mod:`~fcplan.experiments.tables`: the columns every experiment table
-  summarises, taken from the metric table :data:`fcplan.metrics.METRICS`.
+* :mod:`~fcplan.experiments.stats`: the mean and Student-t confidence interval of the mean,
+  paired differences, the Wilcoxon signed-rank test, Holm's adjustment, the pairs an 80 %-power
+  study needs, Friedman's test; :mod:`~fcplan.experiments.tables`: the columns every experiment
+  table summarises, taken from the metric table :data:`fcplan.metrics.METRICS`.
+* :mod:`~fcplan.experiments.analysis`: the statistics of a study, one implementation for
+  ``compare`` and ``report``: paired tables with verdicts in words, fractions of the ``oracle``,
+  rankings per metric and which metric separates the schedulers
+  (:mod:`~fcplan.experiments.statblocks` turns them into tables);
+  :mod:`~fcplan.experiments.autoseeds`: ``seeds="auto"``, seeds added in batches until every pair
+  is resolved, with a stopping rule corrected for the repeated looks;
+  :mod:`~fcplan.experiments.progress`: one ``tqdm`` bar counted in episodes.
 
 * :mod:`~fcplan.experiments.sweep`: :func:`sweep` runs a TOML grid (scenarios x schedulers and
   their settings x seeds x scenario overrides, :mod:`~fcplan.experiments.config`) on a local
@@ -19,8 +27,9 @@ cores, and summarises the outcomes with confidence intervals.
   episode at once in a Parquet results folder (:mod:`~fcplan.experiments.results`);
   :func:`load_results` reads it back as a pandas DataFrame. Re-running resumes.
 * :mod:`~fcplan.experiments.report`: :func:`report` turns a results folder into Markdown, PNG and
-  HTML: tables with confidence intervals, paired Wilcoxon comparisons, plots
-  (:mod:`~fcplan.experiments.plots`).
+  HTML: tables with confidence intervals, the statistics of the study, plots
+  (:mod:`~fcplan.experiments.plots`); it refuses to pool different studies written into one
+  folder (:mod:`~fcplan.experiments.studies`).
 
 Sweeps and comparisons run their episodes on the same backends
 (:mod:`~fcplan.experiments.backends`: in-process, a local process pool restarted when a worker

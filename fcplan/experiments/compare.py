@@ -44,30 +44,35 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from fcplan.errors import FcplanError
+from fcplan.experiments.autoseeds import AutoSeeds
 from fcplan.experiments.backends import select_backend
 from fcplan.experiments.comparison import ComparisonResult
-from fcplan.experiments.progress import ProgressPrinter
+from fcplan.experiments.config import short_hash
+from fcplan.experiments.progress import Progress, ProgressCallback, episode_progress
 from fcplan.experiments.ranges import RangeError, parse_range
-from fcplan.experiments.tables import SCORE_COLUMNS, fallback_majority
+from fcplan.experiments.tables import SCORE_COLUMNS, check_metric, fallback_majority
 from fcplan.experiments.workers import default_jobs, runtime_factories
 
 __all__ = [
     "compare",
     "fallback_majority",
     "scheduler_variant",
+    "study_hash",
     "ComparisonResult",
     "parse_range",
     "RangeError",
-    "ProgressPrinter",
     "METRICS",
 ]
 
@@ -193,6 +198,7 @@ def _identity(task: _Task) -> dict[str, Any]:
         "scenario": task.scenario.name,
         "difficulty": task.scenario.difficulty,
         "scheduler": task.variant.label,
+        "scheduler_name": task.variant.name,
         "seed": task.seed,
     }
 
@@ -247,8 +253,13 @@ def compare(
     jobs: int | None = None,
     time_limit: float | None = None,
     replan_period: float = 1.0,
-    progress: Callable[[int, int, dict[str, Any]], None] | None = None,
+    progress: Progress = True,
     deterministic: bool = True,
+    metrics: Sequence[str] = ("manual.final_score",),
+    max_seeds: int = 50,
+    seed_batch: int = 5,
+    resume: ComparisonResult | str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
 ) -> ComparisonResult:
     """Run every (scenario, scheduler, seed) episode and collect the scores.
 
@@ -260,8 +271,11 @@ def compare(
     schedulers : sequence of str
         Scheduler specs: registered names (:func:`fcplan.available_schedulers`), with settings as
         ``name:key=value``. Each is built once up front; every episode builds its own instance.
-    seeds : sequence of int
-        Seeds >= 0; each (scenario, scheduler) pair is played once per seed.
+    seeds : sequence of int, or ``"auto"``
+        Seeds >= 0; each (scenario, scheduler) pair is played once per seed. ``"auto"`` plays
+        seeds 0, 1, 2, ... in batches of ``seed_batch`` until every pair of schedulers is
+        resolved on the headline metric, or ``max_seeds`` seeds are played
+        (:mod:`fcplan.experiments.autoseeds`; the result's ``stopped`` says why it stopped).
     jobs : int, optional
         Worker processes (default: the CPUs this process may use). ``jobs=1`` runs the episodes
         in this process, one after another.
@@ -269,12 +283,25 @@ def compare(
         Seconds per scheduler call (default: each scheduler's own).
     replan_period : float
         Simulated seconds between periodic replans.
-    progress : callable, optional
-        Called as ``progress(done, total, row)`` after each episode (``row`` is its episode
-        dict), in completion order. :class:`ProgressPrinter` prints throttled progress lines.
+    progress : bool or callable
+        ``True`` (default): a progress bar on stderr counted in episodes
+        (:mod:`fcplan.experiments.progress`); ``False``: silent; or a ``progress(done, total,
+        row)`` callback called after each episode in completion order.
     deterministic : bool
         Run every scheduler that has a deterministic mode in it (the default, see the module
         docstring); False is the wall-time mode.
+    metrics : sequence of str
+        Metrics with a paired table (:meth:`ComparisonResult.comparisons`); the first is the
+        headline (fractions of the oracle, the ``"auto"`` stopping rule).
+    max_seeds, seed_batch : int
+        The cap and the batch of ``seeds="auto"``.
+    resume : ComparisonResult or path, optional
+        A comparison of the same study (same scenarios, schedulers and settings; checked by its
+        ``study_hash``) whose completed episodes are reused instead of played again. A path that
+        does not exist yet is ignored (nothing to resume).
+    checkpoint : path, optional
+        Where the JSON of the comparison so far is written after each batch of ``"auto"``
+        (resume from it after an interruption).
 
     Returns
     -------
@@ -285,8 +312,9 @@ def compare(
     fcplan.UnknownNameError
         An unknown scenario or scheduler name.
     fcplan.FcplanError
-        A scheduler that cannot be constructed, a bad seed, ``jobs``, ``time_limit`` or
-        ``replan_period``. Nothing has run when these are raised.
+        A scheduler that cannot be constructed, a bad seed, ``jobs``, ``time_limit``,
+        ``replan_period``, metric or auto setting, or a ``resume`` of another study. Nothing has
+        run when these are raised.
     KeyboardInterrupt
         After cancelling the pending episodes and stopping the workers.
     """
@@ -294,53 +322,219 @@ def compare(
     if not isinstance(deterministic, bool):
         raise FcplanError(f"deterministic must be True or False, got {deterministic!r}")
     variants = _check_schedulers(schedulers, deterministic)
-    seed_list = _check_seeds(seeds)
+    metric_list = _check_metrics(metrics)
+    auto = AutoSeeds(seed_batch, max_seeds, metric_list[0]) if _is_auto(seeds) else None
+    seed_list = [] if auto else _check_seeds(seeds)
     tl = None if time_limit is None else _positive("time_limit", time_limit)
     rp = _positive("replan_period", replan_period)
+    jobs = _check_jobs(jobs)
+    settings = {"time_limit": tl, "replan_period": rp, "deterministic": deterministic}
+    study = study_hash(scen, variants, settings)
+    runner = _Runner(scen, variants, tl, rp, jobs, episode_progress(progress, "compare"))
+    runner.reuse(_resumed(resume, study))
+    meta = {**settings, "jobs": jobs, "study_hash": study, "metrics": metric_list}
+    t0 = time.perf_counter()
+    try:
+        if auto is None:
+            runner.play(seed_list)
+            return runner.result(seed_list, meta, time.perf_counter() - t0)
+        return _auto(runner, auto, meta, t0, checkpoint)
+    finally:
+        close = getattr(runner.progress, "close", None)
+        if close is not None:
+            close()
+
+
+def _auto(
+    runner: _Runner,
+    auto: AutoSeeds,
+    meta: dict[str, Any],
+    t0: float,
+    checkpoint: str | os.PathLike[str] | None,
+) -> ComparisonResult:
+    """Play batches of seeds until :meth:`AutoSeeds.decide` stops; the result says why."""
+    meta = {**meta, "seeds": "auto", "seed_batch": auto.batch, "max_seeds": auto.max_seeds}
+    look = 0
+    while True:
+        look += 1
+        seeds = auto.seeds(look)
+        runner.play(seeds)
+        result = runner.result(seeds, meta, time.perf_counter() - t0)
+        pairs = result.comparisons(
+            auto.metric, confidence=auto.look_confidence, alpha=auto.look_alpha
+        )
+        decision = auto.decide(pairs, look)
+        result.stopped = decision.reason if decision.stop else ""
+        if checkpoint is not None:
+            _write_checkpoint(result, checkpoint)
+        if decision.stop:
+            return result
+
+
+def _check_jobs(jobs: Any) -> int:
+    """``jobs`` (default: the CPUs this process may use), or a one-line error."""
     if jobs is None:
-        jobs = default_jobs()
+        return default_jobs()
     if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
         raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
-    tasks = [
-        _Task(len(seed_list) * (i * len(variants) + j) + k, s, v, seed, tl, rp)
-        for i, s in enumerate(scen)
-        for j, v in enumerate(variants)
-        for k, seed in enumerate(seed_list)
-    ]
-    jobs = int(min(jobs, len(tasks)))
-    t0 = time.perf_counter()
-    rows, times = _play(tasks, jobs, runtime_factories([v.name for v in variants]), progress)
-    settings = {"time_limit": tl, "replan_period": rp, "jobs": jobs, "deterministic": deterministic}
-    return ComparisonResult(
-        episodes=rows,
-        solve_times_ms=times,
-        scenarios=[s.name for s in scen],
-        schedulers=[v.label for v in variants],
-        seeds=seed_list,
-        settings=settings,
-        wall_time_s=time.perf_counter() - t0,
+    return int(jobs)
+
+
+def _is_auto(seeds: Any) -> bool:
+    return isinstance(seeds, str) and seeds.strip().lower() == "auto"
+
+
+def _check_metrics(metrics: Sequence[str]) -> list[str]:
+    if isinstance(metrics, str):
+        metrics = [metrics]
+    out = [check_metric(m) for m in dict.fromkeys(metrics)]
+    if not out:
+        raise FcplanError("metrics: give at least one metric")
+    return out
+
+
+def study_hash(scenarios: Sequence[Any], variants: Sequence[_Variant], settings: dict) -> str:
+    """Hash of what a comparison's episodes depend on besides the seed: the scenario documents,
+    the scheduler specs (label, registered name, settings), time limit, replan period and mode.
+
+    Examples
+    --------
+    >>> from fcplan.scenario import load_scenario
+    >>> v = [_Variant("greedy", "greedy", {})]
+    >>> len(study_hash([load_scenario(3)], v, {"time_limit": None}))
+    12
+    """
+    return short_hash(
+        {
+            "scenarios": [s.to_dict() for s in scenarios],
+            "schedulers": [[v.label, v.name, v.settings] for v in variants],
+            "settings": settings,
+        },
+        12,
     )
 
 
-def _play(
-    tasks: list[_Task],
-    jobs: int,
-    runtime: dict[str, Callable[..., Any]],
-    progress: Callable[[int, int, dict[str, Any]], None] | None,
-) -> tuple[list[dict[str, Any]], list[list[float]]]:
-    """Play ``tasks`` on a backend; return their rows and solve times in grid order."""
-    total = len(tasks)
-    rows: list[dict[str, Any]] = [{} for _ in range(total)]
-    times: list[list[float]] = [[] for _ in range(total)]
-    _, outcomes = select_backend(tasks, jobs, runtime, play=_run_task)
+def _resumed(
+    resume: ComparisonResult | str | os.PathLike[str] | None, study: str
+) -> ComparisonResult | None:
+    """The comparison to resume from (None: nothing to resume), checked to be of ``study``."""
+    if resume is None:
+        return None
+    if not isinstance(resume, ComparisonResult):
+        if not Path(resume).exists():
+            return None
+        try:
+            resume = ComparisonResult.from_json(resume)
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise FcplanError(
+                f"{resume}: not a comparison JSON file to resume from: {exc}"
+            ) from None
+    theirs = resume.settings.get("study_hash")
+    if theirs != study:
+        raise FcplanError(
+            f"cannot resume from a comparison of another study (study hash {theirs}, this one "
+            f"{study}: different scenarios, schedulers or settings); remove it or write elsewhere"
+        )
+    return resume
+
+
+def _write_checkpoint(result: ComparisonResult, path: str | os.PathLike[str]) -> None:
+    """Write ``result`` as JSON atomically (a temporary file renamed over ``path``)."""
+    target = Path(path)
+    tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
     try:
-        for done, (task, result, lost) in enumerate(outcomes, 1):
-            if result is None:  # its worker process kept dying, or the task could not be sent
-                rows[task.index] = _failed_row(task, str(lost))
-            else:
-                idx, rows[idx], times[idx] = result
-            if progress is not None:
-                progress(done, total, rows[task.index])
-    finally:
-        outcomes.close()
-    return rows, times
+        result.to_json(tmp)
+        os.replace(tmp, target)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise FcplanError(f"cannot write {target}: {exc.strerror or exc}") from None
+
+
+class _Runner:
+    """Plays episodes of a fixed (scenarios x schedulers) grid for growing seed lists, keeping
+    every finished episode (keyed by scenario index, scheduler index and seed)."""
+
+    def __init__(
+        self,
+        scenarios: list[Any],
+        variants: list[_Variant],
+        time_limit: float | None,
+        replan_period: float,
+        jobs: int,
+        progress: ProgressCallback | None,
+    ) -> None:
+        self.scenarios = scenarios
+        self.variants = variants
+        self.time_limit = time_limit
+        self.replan_period = replan_period
+        self.jobs = jobs
+        self.progress = progress
+        self.runtime = runtime_factories([v.name for v in variants])
+        self.done: dict[tuple[int, int, int], tuple[dict[str, Any], list[float]]] = {}
+        self.played = 0  # episodes played by this runner (for the progress count)
+        self.planned = 0
+
+    def reuse(self, old: ComparisonResult | None) -> None:
+        """Keep the completed episodes of ``old`` (failed ones are played again)."""
+        if old is None:
+            return
+        names = [s.name for s in self.scenarios]
+        labels = [v.label for v in self.variants]
+        times = old.solve_times_ms or [[] for _ in old.episodes]
+        for row, t in zip(old.episodes, times, strict=True):
+            if row.get("error") or names.count(row["scenario"]) != 1:
+                continue  # failed, or a scenario name that does not identify one scenario
+            if row["scheduler"] in labels:
+                key = (names.index(row["scenario"]), labels.index(row["scheduler"]), row["seed"])
+                self.done[key] = (row, list(t))
+
+    def play(self, seeds: Sequence[int]) -> None:
+        """Play the episodes of ``seeds`` not done yet."""
+        todo = [
+            (i, j, seed)
+            for i in range(len(self.scenarios))
+            for j in range(len(self.variants))
+            for seed in seeds
+            if (i, j, seed) not in self.done
+        ]
+        tasks = [
+            _Task(k, self.scenarios[i], self.variants[j], seed, self.time_limit, self.replan_period)
+            for k, (i, j, seed) in enumerate(todo)
+        ]
+        self.planned += len(tasks)
+        jobs = max(1, min(self.jobs, len(tasks)))
+        _, outcomes = select_backend(tasks, jobs, self.runtime, play=_run_task)
+        try:
+            for task, result, lost in outcomes:
+                if result is None:  # its worker process kept dying, or it could not be sent
+                    row, times = _failed_row(task, str(lost)), []
+                else:
+                    _, row, times = result
+                self.done[todo[task.index]] = (row, times)
+                self.played += 1
+                if self.progress is not None:
+                    self.progress(self.played, self.planned, row)
+        finally:
+            outcomes.close()
+
+    def result(
+        self, seeds: Sequence[int], settings: dict[str, Any], wall: float
+    ) -> ComparisonResult:
+        """The comparison of ``seeds`` (grid order: scenario, scheduler, seed)."""
+        rows, times = [], []
+        for i in range(len(self.scenarios)):
+            for j in range(len(self.variants)):
+                for seed in seeds:
+                    row, t = self.done[(i, j, seed)]
+                    rows.append(row)
+                    times.append(t)
+        return ComparisonResult(
+            episodes=rows,
+            solve_times_ms=times,
+            scenarios=[s.name for s in self.scenarios],
+            schedulers=[v.label for v in self.variants],
+            seeds=list(seeds),
+            settings={**settings, "jobs": min(self.jobs, max(len(rows), 1))},
+            wall_time_s=wall,
+        )

@@ -38,7 +38,8 @@ import csv
 import json
 import math
 import os
-from collections.abc import Callable, Sequence
+import textwrap
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -46,8 +47,16 @@ from typing import Any
 import numpy as np
 
 from fcplan.errors import UnknownNameError
-from fcplan.experiments.stats import MeanCI, mean_ci, paired_mean_ci
-from fcplan.experiments.tables import SCORE_COLUMNS, Column, difficulty_key, fallback_majority
+from fcplan.experiments.analysis import StudyStats, paired_scores, paired_table, study_stats
+from fcplan.experiments.statblocks import blocks, fixed_width
+from fcplan.experiments.stats import MeanCI, PairedComparison, mean_ci, paired_mean_ci
+from fcplan.experiments.tables import (
+    OUTCOME_COLUMNS,
+    SCORE_COLUMNS,
+    Column,
+    difficulty_key,
+    fallback_majority,
+)
 
 __all__ = ["ComparisonResult"]
 
@@ -77,9 +86,14 @@ class ComparisonResult:
         Scenario names and scheduler names, in the order given.
     seeds : list of int
     settings : dict
-        ``time_limit``, ``replan_period``, ``jobs``.
+        ``time_limit``, ``replan_period``, ``deterministic``, ``jobs``, ``study_hash`` (what
+        the episodes depend on besides the seed: a comparison can only resume from one of the
+        same study), ``metrics`` (the paired tables' metrics, headline first) and, for
+        ``seeds="auto"``, ``seeds``, ``seed_batch`` and ``max_seeds``.
     wall_time_s : float
         Wall time of the whole comparison.
+    stopped : str
+        Why a ``seeds="auto"`` comparison stopped (``""`` for a fixed seed list).
     """
 
     episodes: list[dict[str, Any]]
@@ -89,6 +103,7 @@ class ComparisonResult:
     seeds: list[int] = field(default_factory=list)
     settings: dict[str, Any] = field(default_factory=dict)
     wall_time_s: float = 0.0
+    stopped: str = ""
 
     # ---- tables -------------------------------------------------------------------------
 
@@ -111,8 +126,8 @@ class ComparisonResult:
         row: dict[str, Any] = dict(label)
         row["episodes"] = len(good)
         row["errors"] = len(eps) - len(good)
-        for col in SCORE_COLUMNS:
-            ci = mean_ci([e[col.name] for e in good])
+        for col in SCORE_COLUMNS + OUTCOME_COLUMNS:
+            ci = mean_ci([e.get(col.name, math.nan) for e in good])
             row[f"{col.key}_mean"] = ci.mean
             row[f"{col.key}_ci"] = ci.half_width
         st = (
@@ -196,37 +211,88 @@ class ComparisonResult:
         --------
         >>> from fcplan.experiments import compare
         >>> from fcplan.scenario import load_scenario
-        >>> r = compare([load_scenario(3).replace(duration_s=10)], ["greedy"], [0], jobs=1)
+        >>> r = compare([load_scenario(3).replace(duration_s=10)], ["greedy"], [0], jobs=1,
+        ...             progress=False)
         >>> r.paired("greedy", "greedy").mean
         0.0
         """
         for name in (a, b):
-            if name not in self._schedulers():
-                raise UnknownNameError(
-                    f"scheduler {name!r} is not in this comparison: {', '.join(self._schedulers())}"
-                )
-        rows_a = {(i, e["scenario"], e["seed"]): e for i, e in self._by_pair(a)}
-        rows_b = {(i, e["scenario"], e["seed"]): e for i, e in self._by_pair(b)}
-        keys = [k for k in rows_a if k in rows_b]
-        va = [rows_a[k][metric] for k in keys if not (rows_a[k]["error"] or rows_b[k]["error"])]
-        vb = [rows_b[k][metric] for k in keys if not (rows_a[k]["error"] or rows_b[k]["error"])]
-        return paired_mean_ci(va, vb)
+            self._check_name(name)
+        scores = paired_scores(self.pair_rows(), [a, b], metric, _pair_key)
+        common = [k for k in scores[a] if k in scores[b]]
+        return paired_mean_ci([scores[a][k] for k in common], [scores[b][k] for k in common])
 
-    def _by_pair(self, name: str) -> list[tuple[int, dict[str, Any]]]:
-        """(occurrence number of its (scenario, seed), episode) of one scheduler, in order."""
-        count: dict[tuple[str, Any], int] = {}
+    def _check_name(self, name: str) -> None:
+        if name not in self._schedulers():
+            raise UnknownNameError(
+                f"scheduler {name!r} is not in this comparison: {', '.join(self._schedulers())}"
+            )
+
+    def pair_rows(self) -> list[dict[str, Any]]:
+        """The completed episodes, each with ``_pair``: (scenario, seed, occurrence), the
+        instance it played (a scenario name given twice counts its occurrences apart)."""
+        count: dict[tuple[str, str, Any], int] = {}
         out = []
         for e in self.episodes:
-            if e["scheduler"] == name:
-                k = (e["scenario"], e["seed"])
-                out.append((count.get(k, 0), e))
-                count[k] = count.get(k, 0) + 1
+            k = (e["scheduler"], e["scenario"], e["seed"])
+            n = count.get(k, 0)
+            count[k] = n + 1
+            if not e.get("error"):
+                out.append({**e, "_pair": (e["scenario"], e["seed"], n)})
         return out
+
+    @property
+    def references(self) -> list[str]:
+        """The clairvoyant schedulers (registered name ``oracle``): references, not policies."""
+        names = {e["scheduler"]: e.get("scheduler_name") for e in self.episodes}
+        return [s for s in self._schedulers() if (names.get(s) or s.split(":")[0]) == "oracle"]
+
+    @property
+    def metrics(self) -> list[str]:
+        """The metrics of the paired tables, headline first."""
+        return list(self.settings.get("metrics") or ["manual.final_score"])
+
+    def statistics(self, *, confidence: float = 0.95) -> StudyStats:
+        """Paired tables (per metric of :attr:`metrics`), fractions of the oracle and rankings
+        per metric (:func:`fcplan.experiments.analysis.study_stats`).
+
+        Examples
+        --------
+        >>> from fcplan.experiments import compare
+        >>> from fcplan.scenario import load_scenario
+        >>> r = compare([load_scenario(3).replace(duration_s=10)], ["greedy", "idle"], [0, 1],
+        ...             jobs=1, progress=False)
+        >>> st = r.statistics()
+        >>> [(c.a, c.b, c.n) for c in st.paired["manual.final_score"]]
+        [('greedy', 'idle', 2)]
+        """
+        return study_stats(
+            self.pair_rows(),
+            self._schedulers(),
+            self.metrics,
+            _pair_key,
+            references=self.references,
+            confidence=confidence,
+        )
+
+    def comparisons(
+        self, metric: str | None = None, *, confidence: float = 0.95, alpha: float = 0.05
+    ) -> list[PairedComparison]:
+        """Every pair of compared schedulers (the oracle left out) on ``metric`` (default: the
+        headline), Holm-adjusted over the pairs (:func:`~fcplan.experiments.analysis.paired_table`).
+        """
+        metric = metric or self.metrics[0]
+        policies = [s for s in self._schedulers() if s not in self.references]
+        rows = self.pair_rows()
+        return paired_table(rows, policies, metric, _pair_key, confidence=confidence, alpha=alpha)
 
     # ---- text ---------------------------------------------------------------------------
 
-    def format(self, *, by_difficulty: bool = False) -> str:
-        """A fixed-width text table: one line per scheduler, ``mean ± ci`` cells.
+    def format(self, *, by_difficulty: bool = False, statistics: bool = True) -> str:
+        """A fixed-width text table: one line per scheduler, ``mean ± ci`` cells; then (with
+        ``statistics``) the paired differences of every metric of :attr:`metrics`, the fraction
+        of the oracle and the ranking per metric (:meth:`statistics`), and why a
+        ``seeds="auto"`` comparison stopped.
 
         Scores are the manual's unless marked ref2020; ``± nan`` means fewer than two episodes.
         """
@@ -261,6 +327,12 @@ class ComparisonResult:
                     f"{r['episodes']} episode(s) fell back to greedy on more than half of their "
                     "replans; their scores are mostly greedy's"
                 )
+        if statistics:
+            for block in blocks(self.statistics()):
+                note = textwrap.fill(f"{block.title}. {block.note}", 100)
+                out += ["", note, fixed_width(*block.cells)]
+        if self.stopped:
+            out += ["", f"seeds auto: {self.stopped}"]
         return "\n".join(out)
 
     def __str__(self) -> str:
@@ -287,7 +359,9 @@ class ComparisonResult:
             "seeds": self.seeds,
             "settings": self.settings,
             "wall_time_s": self.wall_time_s,
+            "stopped": self.stopped,
             "table": self.table(),
+            "paired": self.statistics().paired_records(),
             "table_by_difficulty": self.table(by_difficulty=True),
             "episodes": self.episodes,
             "solve_times_ms": self.solve_times_ms,
@@ -303,7 +377,7 @@ class ComparisonResult:
     def from_json(cls, path: str | os.PathLike[str]) -> ComparisonResult:
         """Read a file written by :meth:`to_json` (its tables are recomputed from the episodes)."""
         doc = json.loads(Path(path).read_text(encoding="utf-8"))
-        keep = {"scenario", "difficulty", "scheduler", "seed", "error"}
+        keep = {"scenario", "difficulty", "scheduler", "scheduler_name", "seed", "error"}
         episodes = [
             {k: (math.nan if v is None and k not in keep else v) for k, v in e.items()}
             for e in doc["episodes"]
@@ -316,10 +390,16 @@ class ComparisonResult:
             seeds=list(doc.get("seeds", [])),
             settings=dict(doc.get("settings", {})),
             wall_time_s=float(doc.get("wall_time_s") or 0.0),
+            stopped=str(doc.get("stopped") or ""),
         )
 
 
 _Cell = Callable[[dict[str, Any]], str]
+
+
+def _pair_key(row: Mapping[str, Any]) -> Hashable:
+    """The instance of a :meth:`ComparisonResult.pair_rows` row."""
+    return row["_pair"]
 
 
 def _score_cell(col: Column) -> _Cell:

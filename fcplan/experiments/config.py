@@ -179,6 +179,26 @@ class SweepConfig:
         d["scenarios"] = [s.to_dict() for s in self.scenarios]
         return short_hash(d, 12)
 
+    @property
+    def study_hash(self) -> str:
+        """Hash of the grid without its seeds (12 hex characters): the *study*.
+
+        Two sweeps of one study differ only in their seeds, so their episodes can be pooled
+        (running more seeds into a folder extends the study); the report refuses to pool
+        episodes of different studies (:func:`fcplan.experiments.report`).
+
+        Examples
+        --------
+        >>> a = load_sweep_config({"scenarios": [3], "schedulers": ["idle"], "seeds": "0-1"})
+        >>> b = load_sweep_config({"scenarios": [3], "schedulers": ["idle"], "seeds": "0-9"})
+        >>> a.study_hash == b.study_hash, a.config_hash == b.config_hash
+        (True, False)
+        """
+        d = self.to_dict()
+        d["scenarios"] = [s.to_dict() for s in self.scenarios]
+        del d["seeds"], d["name"]
+        return short_hash(d, 12)
+
     def override_combinations(self) -> list[dict[str, Any]]:
         """Every combination of override values (one dict per combination)."""
         keys = list(self.overrides)
@@ -266,13 +286,20 @@ def _number_axis(
 
 
 def _seeds(source: str, value: Any) -> tuple[int, ...]:
-    from fcplan.experiments.compare import RangeError, parse_range
+    from fcplan.experiments.ranges import RangeError, parse_range
 
     if value is None:
         raise _err(source, "seeds", 'is required, e.g. seeds = "0-4" or seeds = [0, 7]')
     if isinstance(value, int) and not isinstance(value, bool):
         value = [value]
     if isinstance(value, str):
+        if value.strip().lower() == "auto":
+            raise _err(
+                source,
+                "seeds",
+                "give seeds here and run fcplan sweep --seeds auto (or "
+                "sweep(..., seeds='auto')) to add seeds until the schedulers are told apart",
+            )
         try:
             return tuple(parse_range(value, names=False))  # type: ignore[arg-type]
         except RangeError as exc:
@@ -286,7 +313,7 @@ def _seeds(source: str, value: Any) -> tuple[int, ...]:
 
 
 def _scenarios(source: str, value: Any, base_dir: Path | None) -> tuple[Any, ...]:
-    from fcplan.experiments.compare import RangeError, parse_range
+    from fcplan.experiments.ranges import RangeError, parse_range
     from fcplan.scenario import Scenario, load_scenario
 
     if value is None:

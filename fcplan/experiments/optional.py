@@ -7,7 +7,7 @@ Examples
 >>> require("no_such_module_xyz", "plot")
 Traceback (most recent call last):
 ...
-fcplan.experiments.optional.MissingDependencyError: this needs no_such_module_xyz: pip install "fcplan[plot]"
+fcplan.experiments.optional.MissingDependencyError: this needs no_such_module_xyz: pip install "fcplan[plot]" (from a checkout: pip install -e ".[plot]")
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
-from fcplan.errors import FcplanError
+from fcplan.errors import FcplanError, install_hint
 
 __all__ = ["MissingDependencyError", "require"]
 
@@ -30,4 +30,4 @@ def require(module: str, extra: str) -> ModuleType:
         return importlib.import_module(module)
     except ImportError:
         top = module.split(".")[0]
-        raise MissingDependencyError(f'this needs {top}: pip install "fcplan[{extra}]"') from None
+        raise MissingDependencyError(f"this needs {top}: {install_hint(extra)}") from None

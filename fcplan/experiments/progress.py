@@ -1,138 +1,152 @@
-"""Progress reporting for long experiments: a terminal progress bar, or plain lines.
+"""Progress of long experiments: one ``tqdm`` bar, counted in episodes, for compare and sweep.
 
-Both are ``progress(done, total, row)`` callbacks, called after each finished episode (``row`` is
-the episode's result dict; a non-empty ``row["error"]`` counts as failed).
+:func:`~fcplan.experiments.compare` and :func:`~fcplan.experiments.sweep` take
+``progress=True`` (the default: a bar on stderr), ``progress=False`` (silent; ``--quiet`` on the
+command line) or a ``progress(done, total, row)`` callback of your own, called after each finished
+episode (``row`` is the episode's result; a non-empty ``row["error"]`` counts as failed, and
+sweeps mark failed rows with ``status``).
 
-* :class:`ProgressPrinter` prints throttled plain lines (``sweep: 12/40 episodes (30%), 2.1/s,
-  elapsed 0:06, ETA 0:13``): for logs, CI and pipes.
-* :class:`ProgressBar` redraws one line in place (``\\r``) with a bar, the rate and the ETA, when
-  its stream is a terminal, and falls back to :class:`ProgressPrinter` lines otherwise.
-
-:func:`make_progress` picks the right one for a stream.
+The bar is :class:`tqdm.auto.tqdm`: in a terminal it redraws one line in place (``compare:
+40%|####      | 8/20 episodes [00:04<00:06, 1.90ep/s, failed=1]``); in Jupyter it is a widget updated in
+place when ``ipywidgets`` is installed (the ``notebooks`` extra), else one text line redrawn at
+most every 15 s, so an executed notebook stores a handful of updates instead of a line per
+episode. Wherever stderr is not a terminal (logs, pipes, notebooks without widgets) it redraws at
+most every 15 s. Its total may grow while it runs (``--seeds auto`` adds batches).
 
 Examples
 --------
 >>> import io
 >>> out = io.StringIO()
->>> bar = make_progress(out, label="sweep")  # not a terminal: plain lines
->>> bar(1, 2, {}); bar(2, 2, {"error": "boom"})
->>> print(out.getvalue().splitlines()[-1])  # doctest: +ELLIPSIS
-sweep: 2/2 episodes (100%), ... 1 failed
+>>> with EpisodeBar("sweep", file=out) as bar:
+...     bar(1, 2, {}); bar(2, 2, {"error": "boom"})
+>>> "2/2" in out.getvalue() and "failed=1" in out.getvalue()
+True
 """
 
 from __future__ import annotations
 
-import math
 import sys
-import time
+import warnings
+from collections.abc import Callable
+from types import TracebackType
 from typing import IO, Any
 
-__all__ = ["ProgressBar", "ProgressPrinter", "make_progress"]
+from fcplan.errors import FcplanError
+
+__all__ = ["EpisodeBar", "Progress", "ProgressCallback", "episode_progress"]
+
+ProgressCallback = Callable[[int, int, dict[str, Any]], None]
+"""``progress(done, total, row)``, called after each finished episode."""
+
+Progress = bool | ProgressCallback | None
+"""What the ``progress`` argument of compare and sweep accepts."""
+
+_QUIET_INTERVAL_S = 15.0  # redraw interval where stderr is not a terminal
+_FORMAT = (
+    "{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} episodes "
+    "[{elapsed}<{remaining}, {rate_fmt}{postfix}]"
+)
 
 
-def _clock(seconds: float) -> str:
-    s = int(round(seconds)) if math.isfinite(seconds) else 0
-    h, rem = divmod(s, 3600)
-    m, s = divmod(rem, 60)
-    return f"{h}:{m:02d}:{s:02d}" if h else f"{m}:{s:02d}"
+def _tqdm() -> Any:
+    """:class:`tqdm.auto.tqdm`, imported without its 'IProgress not found' warning (a Jupyter
+    kernel without ipywidgets gets the text bar, which is what the warning would say)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        from tqdm.auto import tqdm
+    return tqdm
 
 
-class ProgressPrinter:
-    """A ``progress`` callback that prints plain lines, throttled.
+def _failed(row: dict[str, Any]) -> bool:
+    return bool(row.get("error")) or row.get("status", "ok") != "ok"
 
-    Each line reads ``compare: 12/40 episodes (30%), 2.1/s, elapsed 0:06, ETA 0:13`` (plus the
-    number of failed episodes, if any). At most one line per ``interval`` seconds, and always one
-    for the last episode.
+
+class EpisodeBar:
+    """A ``progress(done, total, row)`` callback that draws a :class:`tqdm.auto.tqdm` bar.
 
     Parameters
     ----------
-    stream : file, optional
-        Where to print (default ``sys.stderr``).
-    interval : float
-        Minimum seconds between lines.
     label : str
-        The line's prefix.
+        The bar's description (``"compare"``, ``"sweep"``).
+    file : stream, optional
+        Where to draw (default ``sys.stderr``).
+    initial : int
+        Episodes already done before the first call (a resumed sweep's stored episodes).
+
+    Use it as a context manager (or call :meth:`close`), which ends the bar's line.
     """
 
-    def __init__(
-        self, stream: IO[str] | None = None, interval: float = 1.0, label: str = "compare"
-    ):
-        self.stream = stream
-        self.interval = interval
+    def __init__(self, label: str, *, file: IO[str] | None = None, initial: int = 0) -> None:
         self.label = label
-        self._t0 = time.perf_counter()
-        self._last = -math.inf
-        self._errors = 0
+        self.file = file if file is not None else sys.stderr
+        self.initial = initial
+        self.failed = 0
+        self._bar: Any = None
 
-    def _status(self, done: int, total: int) -> tuple[str, float, float]:
-        elapsed = time.perf_counter() - self._t0
-        rate = done / elapsed if elapsed > 0 else math.inf
-        eta = (total - done) / rate if rate > 0 and math.isfinite(rate) else 0.0
-        return f"{rate:.1f}/s", elapsed, eta
-
-    def _due(self, done: int, total: int, row: dict[str, Any]) -> bool:
-        """Count a failed episode; say whether a line is due (throttled; always at the end)."""
-        if row.get("error"):
-            self._errors += 1
-        now = time.perf_counter()
-        if done < total and now - self._last < self.interval:
-            return False
-        self._last = now
-        return True
+    def _open(self, total: int) -> Any:
+        isatty = getattr(self.file, "isatty", None)
+        tty = bool(isatty is not None and isatty())
+        return _tqdm()(
+            total=total + self.initial,
+            initial=self.initial,
+            desc=self.label,
+            unit="ep",
+            bar_format=_FORMAT,
+            file=self.file,
+            mininterval=0.5 if tty else _QUIET_INTERVAL_S,
+            dynamic_ncols=tty,
+            leave=True,
+        )
 
     def __call__(self, done: int, total: int, row: dict[str, Any]) -> None:
-        if not self._due(done, total, row):
-            return
-        rate, elapsed, eta = self._status(done, total)
-        text = (
-            f"{self.label}: {done}/{total} episodes ({100 * done / max(total, 1):.0f}%), {rate}, "
-            f"elapsed {_clock(elapsed)}, ETA {_clock(eta)}"
-        )
-        if self._errors:
-            text += f", {self._errors} failed"
-        print(text, file=self.stream or sys.stderr, flush=True)
+        if self._bar is None:
+            self._bar = self._open(total)
+        bar = self._bar
+        if total + self.initial != bar.total:
+            bar.total = total + self.initial
+        if _failed(row):
+            self.failed += 1
+            bar.set_postfix(failed=self.failed, refresh=False)
+        bar.update(done + self.initial - bar.n)
 
+    def close(self) -> None:
+        """Draw the final state and end the line (a no-op if nothing was drawn)."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
 
-class ProgressBar(ProgressPrinter):
-    """A one-line progress bar redrawn in place (for terminals).
+    def __enter__(self) -> EpisodeBar:
+        return self
 
-    ``sweep [##########----------] 12/40 30% 2.1 ep/s ETA 0:13, 1 failed``; redrawn at most every
-    ``interval`` seconds and ended with a newline after the last episode.
-    """
-
-    def __init__(
+    def __exit__(
         self,
-        stream: IO[str] | None = None,
-        interval: float = 0.2,
-        label: str = "sweep",
-        width: int = 24,
-    ):
-        super().__init__(stream, interval, label)
-        self.width = width
-
-    def __call__(self, done: int, total: int, row: dict[str, Any]) -> None:
-        if not self._due(done, total, row):
-            return
-        elapsed = time.perf_counter() - self._t0
-        rate = done / elapsed if elapsed > 0 else 0.0
-        eta = (total - done) / rate if rate > 0 else math.nan
-        fill = int(round(self.width * done / max(total, 1)))
-        bar = "#" * fill + "-" * (self.width - fill)
-        text = (
-            f"\r{self.label} [{bar}] {done}/{total} {100 * done / max(total, 1):3.0f}% "
-            f"{60 * rate:.1f} ep/min ETA {_clock(eta) if eta == eta else '?'}"
-        )
-        if self._errors:
-            text += f", {self._errors} failed"
-        stream = self.stream or sys.stderr
-        stream.write(text + "\x1b[K" + ("\n" if done >= total else ""))
-        stream.flush()
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
 
 
-def make_progress(stream: IO[str] | None = None, *, label: str = "sweep") -> ProgressPrinter:
-    """A :class:`ProgressBar` if ``stream`` (default stderr) is a terminal, else plain lines."""
-    stream = stream or sys.stderr
-    isatty = getattr(stream, "isatty", None)
-    if isatty is not None and isatty():
-        return ProgressBar(stream, label=label)
-    return ProgressPrinter(stream, label=label)
+def episode_progress(
+    progress: Progress, label: str, *, initial: int = 0
+) -> ProgressCallback | None:
+    """The callback for a ``progress`` argument: an :class:`EpisodeBar` for ``True``, None for
+    ``False``/None, a callable as given.
+
+    Raises
+    ------
+    fcplan.FcplanError
+        Anything else (one line).
+
+    Examples
+    --------
+    >>> episode_progress(False, "compare") is None
+    True
+    """
+    if progress is True:
+        return EpisodeBar(label, initial=initial)
+    if progress is False or progress is None:
+        return None
+    if callable(progress):
+        return progress
+    raise FcplanError(f"progress must be True, False or a callable, got {progress!r}")

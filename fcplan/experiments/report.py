@@ -1,7 +1,10 @@
 """Reports: tables with confidence intervals, paired comparisons and plots from sweep results.
 
-:func:`report` reads a results folder (:func:`~fcplan.experiments.load_results`) and writes, into
-``out`` (default ``RESULTS/report``):
+:func:`report` reads a results folder (:func:`~fcplan.experiments.load_results`), keeps the
+episodes of its one study (a folder holding several studies is refused with a one-line error
+naming them, unless one is chosen with ``study`` or they are pooled with ``allow_mixed``, which
+the report then states: :mod:`fcplan.experiments.studies`) and writes, into ``out`` (default
+``RESULTS/report``):
 
 * ``report.md`` (also returned and printed by ``fcplan report``):
 
@@ -12,11 +15,19 @@
   - the same *per difficulty group* (practice, easy, moderate, hard, custom);
   - *per setting* (scheduler x overrides x replan period x time limit) when the sweep varied
     any of those;
-  - *paired comparisons*: for every pair of schedulers, the episodes both completed on the same
-    (scenario, seed, overrides, replan period, time limit) are paired; the table gives the number
-    of pairs, the mean difference of the metric ± its 95 % CI, wins/ties/losses, and the p-value
-    of the two-sided Wilcoxon signed-rank test (:func:`scipy.stats.wilcoxon`, zero differences
-    dropped; ``p = 1`` when every pair ties, NaN without pairs);
+  - *paired differences* of every ``metric`` (headline first): for every pair of schedulers,
+    the episodes both completed on the same instance (study, scenario, seed, overrides, replan
+    period, time limit) are paired; the table gives the number of pairs, the mean difference
+    ``a - b`` with its 95 % Student-t interval, Cohen's ``d_z``, wins/ties/losses, the
+    two-sided Wilcoxon signed-rank p-value (:func:`~fcplan.experiments.stats.wilcoxon_p`) and its
+    Holm adjustment over the pairs, and a verdict in words (``"unresolved at n=5 (...)"`` when
+    the interval is too wide to tell: :mod:`fcplan.experiments.analysis`);
+  - *fraction of the oracle*, when a clairvoyant ``oracle`` was swept: each scheduler's
+    headline metric as a fraction of the oracle's on the same instance (the oracle is a
+    reference: it is left out of the paired tables and rankings);
+  - *ranking per metric* (final score, NRR, time to containment, contained, burned area,
+    facility damage): the order by mean, the pairs that differ, the median ``|d_z|``, Friedman's
+    test and Kendall's ``W``, and which metric separates the schedulers best;
   - the schedulers with episodes that fell back to greedy on more than half of their replans
     (:func:`~fcplan.experiments.tables.fallback_majority`, from the ``fallbacks`` and ``replans``
     columns): those episodes' scores are mostly greedy's;
@@ -29,7 +40,8 @@
   (time per scheduler call against the task graph's size, every replan, and the median against
   team size per episode).
 * ``report.html`` with ``html=True``: the same tables and the plots embedded.
-* ``per_scheduler.csv``, ``per_difficulty.csv``, ``paired.csv``: the numbers of the tables.
+* ``per_scheduler.csv``, ``per_difficulty.csv``, ``paired.csv``, ``rankings.csv`` (and
+  ``oracle_fraction.csv``): the numbers of the tables.
 
 Examples
 --------
@@ -50,11 +62,10 @@ from __future__ import annotations
 import base64
 import html as _html
 import json
-import math
 import os
 import re
 import sys
-import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -62,6 +73,7 @@ from typing import Any
 import numpy as np
 
 from fcplan.errors import FcplanError
+from fcplan.experiments.analysis import StudyStats, metric_label, results_pair_key, study_stats
 from fcplan.experiments.optional import require
 from fcplan.experiments.plots import (
     plot_distribution,
@@ -70,21 +82,16 @@ from fcplan.experiments.plots import (
     scheduler_colors,
 )
 from fcplan.experiments.results import load_results
+from fcplan.experiments.statblocks import blocks
 from fcplan.experiments.stats import mean_ci
-from fcplan.experiments.tables import (
-    REPORT_COLUMNS,
-    difficulty_key,
-    fallback_majority,
-    higher_is_better,
-)
+from fcplan.experiments.studies import Selection, select_study
+from fcplan.experiments.tables import REPORT_COLUMNS, difficulty_key, fallback_majority
 
 __all__ = ["METRICS", "Report", "report"]
 
 METRICS: dict[str, tuple[str, int]] = {c.name: (c.label, c.decimals) for c in REPORT_COLUMNS}
 """Column -> (label, decimals) of the metrics tabulated with a CI (from
 :data:`fcplan.experiments.tables.REPORT_COLUMNS`)."""
-
-_PAIR_ON = ["scenario", "seed", "overrides", "replan_period", "time_limit"]
 
 Section = tuple[str, Any]
 """One block of the report: (``"h1"`` | ``"h2"`` | ``"p"`` | ``"table"`` | ``"img"``, content)."""
@@ -101,8 +108,18 @@ class Report:
         ``per_scheduler``, ``per_difficulty`` (and ``per_setting``): numeric columns
         ``<metric>`` (mean) and ``<metric> ci`` (half-width) for every metric in :data:`METRICS`.
     paired : DataFrame
-        Columns ``a``, ``b``, ``metric``, ``pairs``, ``mean_diff``, ``ci``, ``wins``, ``ties``,
-        ``losses``, ``p_wilcoxon``.
+        One row per pair of compared schedulers and metric: ``a``, ``b``, ``metric``, ``pairs``,
+        ``mean_diff``, ``ci`` (half-width), ``low``, ``high``, ``effect_dz``, ``wins``, ``ties``,
+        ``losses``, ``p_wilcoxon``, ``p_holm``, ``resolved``, ``pairs_needed_80``, ``verdict``
+        (:meth:`fcplan.experiments.analysis.StudyStats.paired_records`).
+    fractions : DataFrame
+        Each scheduler's headline metric as a fraction of the oracle's (empty without an
+        oracle).
+    rankings : DataFrame
+        One row per ranking metric: ``ranking``, ``pairs_differing``, ``median_abs_dz``,
+        ``friedman_p``, ``kendall_w``.
+    statistics : StudyStats or None
+        The objects behind ``paired``, ``fractions`` and ``rankings``.
     files : list of Path
         Everything written.
     """
@@ -110,6 +127,9 @@ class Report:
     markdown: str
     tables: dict[str, Any]
     paired: Any
+    fractions: Any = None
+    rankings: Any = None
+    statistics: StudyStats | None = None
     files: list[Path] = field(default_factory=list)
 
 
@@ -156,54 +176,8 @@ def _scheduler_order(results: Any, df: Any) -> list[str]:
     return order + sorted(present - set(order))
 
 
-def _wilcoxon(d: np.ndarray) -> float:
-    if d.size == 0:
-        return math.nan
-    if np.all(d == 0):
-        return 1.0
-    stats = require("scipy.stats", "dev")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return float(stats.wilcoxon(d).pvalue)
-
-
-def _paired(df: Any, metric: str) -> Any:
-    pd = require("pandas", "parquet")
-    ok = df[df["status"] == "ok"]
-    names = list(dict.fromkeys(df["scheduler"]))
-    rows = []
-    for i, a in enumerate(names):
-        for b in names[i + 1 :]:
-            xa = ok[ok["scheduler"] == a].set_index(_PAIR_ON)[metric]
-            xb = ok[ok["scheduler"] == b].set_index(_PAIR_ON)[metric]
-            both = xa.to_frame("a").join(xb.to_frame("b"), how="inner")
-            d = (both["a"] - both["b"]).to_numpy(np.float64)
-            ci = mean_ci(d)
-            rows.append(
-                {
-                    "a": a,
-                    "b": b,
-                    "metric": metric,
-                    "pairs": int(d.size),
-                    "mean_diff": ci.mean,
-                    "ci": ci.half_width,
-                    "wins": int((d > 0).sum()),
-                    "ties": int((d == 0).sum()),
-                    "losses": int((d < 0).sum()),
-                    "p_wilcoxon": _wilcoxon(d),
-                }
-            )
-    cols = ["a", "b", "metric", "pairs", "mean_diff", "ci", "wins", "ties", "losses"]
-    return pd.DataFrame(rows, columns=[*cols, "p_wilcoxon"])
-
-
 # --------------------------------------------------------------------------------------------
 # text
-
-
-def _label(metric: str) -> str:
-    """The header of a result column (the column's own name if it is not tabulated)."""
-    return METRICS.get(metric, (metric,))[0]
 
 
 def _cell(v: Any, d: int = 1) -> str:
@@ -241,12 +215,6 @@ def _html_table(head: list[str], body: list[list[str]]) -> str:
     return f"<table><thead><tr>{h}</tr></thead><tbody>{rows}</tbody></table>"
 
 
-def _p(p: float) -> str:
-    if p != p:
-        return "nan"
-    return f"{p:.2g}" if p >= 1e-4 else "<1e-4"
-
-
 # --------------------------------------------------------------------------------------------
 # report
 
@@ -256,8 +224,10 @@ def report(
     out: str | os.PathLike[str] | None = None,
     *,
     html: bool = False,
-    metric: str = "manual.final_score",
+    metric: str | Sequence[str] = "manual.final_score",
     plots: bool = True,
+    allow_mixed: bool = False,
+    study: str | None = None,
 ) -> Report:
     """Write the report of a sweep's results folder (see the module docstring).
 
@@ -269,11 +239,17 @@ def report(
         Output folder (default ``results/report``; created if needed).
     html : bool
         Also write ``report.html`` (plots embedded).
-    metric : str
-        The metric of the paired comparisons and the plots (a column such as
-        ``manual.final_score`` or ``reference2020.final_score``).
+    metric : str or sequence of str
+        The metric(s) of the paired comparisons (a column such as ``manual.final_score``,
+        ``reference2020.final_score`` or ``outcome.burned_area_cells``); the first is the
+        headline: the fractions of the oracle and the plots use it.
     plots : bool
         Write the PNG plots (needs matplotlib).
+    allow_mixed : bool
+        Pool the episodes of several studies written into the folder (the report says so);
+        by default a folder holding several studies is refused (:mod:`fcplan.experiments.studies`).
+    study : str, optional
+        Report only this study of the folder (its hash or a unique prefix).
 
     Returns
     -------
@@ -282,9 +258,13 @@ def report(
     Raises
     ------
     FcplanError
-        No episodes in the folder, an unknown metric, or damaged/foreign files (ResultsError).
+        No episodes in the folder, an unknown metric, several studies (without ``study`` or
+        ``allow_mixed``), or damaged/foreign files (ResultsError).
     """
-    df = _load(results, metric)
+    metric_list = [metric] if isinstance(metric, str) else list(dict.fromkeys(metric))
+    df = _load(results, metric_list)
+    selection = select_study(df, results, study=study, allow_mixed=allow_mixed)
+    df = selection.rows
     names = _scheduler_order(results, df)
     df = df.assign(_o=df["scheduler"].map({n: i for i, n in enumerate(names)}))
     df = df.sort_values(["_o", "scenario", "seed"], kind="stable").drop(columns="_o")
@@ -292,7 +272,7 @@ def report(
     scenarios = sorted(df["scenario"].unique(), key=_scenario_order)
     metrics = [m for m in METRICS if m in df.columns]
     tables, setting_cols = _tables(df, diffs, metrics)
-    paired = _paired(df, metric)
+    study_st = _statistics(df, names, metric_list)
     out_dir = Path(out) if out is not None else Path(results) / "report"
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
@@ -300,37 +280,65 @@ def report(
         raise FcplanError(f"{out_dir}: cannot create the report folder: {exc}") from None
     images: list[tuple[str, Path]] = []
     if plots and (df["status"] == "ok").any():
-        images = _draw_plots(out_dir, df, names, diffs, scenarios, metric)
-    sections = _sections(df, names, scenarios, tables, setting_cols, metrics, paired, metric)
+        images = _draw_plots(out_dir, df, names, diffs, scenarios, metric_list[0])
+    sections = _sections(df, selection, names, scenarios, tables, setting_cols, metrics, study_st)
     sections += [("img", image) for image in images]
     markdown = "\n\n".join(_markdown(kind, content) for kind, content in sections) + "\n"
-    files = [out_dir / "report.md", *(p for _, p in images)]
-    files += [p.with_suffix(".pdf") for _, p in images]
     (out_dir / "report.md").write_text(markdown, encoding="utf-8")
-    csvs = (
-        ("per_scheduler", tables["per_scheduler"]),
-        ("per_difficulty", tables["per_difficulty"]),
-    )
-    for name, t in (*csvs, ("paired", paired)):
+    rep = Report(markdown=markdown, tables=tables, paired=_frame(study_st.paired_records()))
+    rep.fractions = _frame(study_st.fraction_records())
+    rep.rankings = _frame(study_st.ranking_records())
+    rep.statistics = study_st
+    rep.files = [out_dir / "report.md", *(p for _, p in images)]
+    rep.files += [p.with_suffix(".pdf") for _, p in images]
+    csvs = {
+        "per_scheduler": tables["per_scheduler"],
+        "per_difficulty": tables["per_difficulty"],
+        "paired": rep.paired,
+        "rankings": rep.rankings,
+    }
+    if study_st.fractions:
+        csvs["oracle_fraction"] = rep.fractions
+    for name, t in csvs.items():
         t.to_csv(out_dir / f"{name}.csv", index=False)
-        files.append(out_dir / f"{name}.csv")
+        rep.files.append(out_dir / f"{name}.csv")
     if html:
-        files.append(_write_html(out_dir / "report.html", sections))
-    return Report(markdown=markdown, tables=tables, paired=paired, files=files)
+        rep.files.append(_write_html(out_dir / "report.html", sections))
+    return rep
 
 
-def _load(results: str | os.PathLike[str], metric: str) -> Any:
-    """The stored episodes, checked to hold ``metric``, with groupable setting columns."""
+def _statistics(df: Any, names: list[str], metrics: list[str]) -> StudyStats:
+    """The paired tables, fractions of the oracle and rankings of the completed episodes."""
+    ok = df[df["status"] == "ok"]
+    rows = ok.to_dict("records")
+    kinds = dict(zip(df["scheduler"], df.get("scheduler_name", df["scheduler"]), strict=True))
+    references = [n for n in names if str(kinds.get(n, n)) == "oracle"]
+    return study_stats(rows, names, metrics, results_pair_key, references=references)
+
+
+def _frame(records: list[dict[str, Any]]) -> Any:
+    pd = require("pandas", "parquet")
+    return pd.DataFrame.from_records(records)
+
+
+def _load(results: str | os.PathLike[str], metrics: list[str]) -> Any:
+    """The stored episodes, checked to hold ``metrics``, with groupable setting columns."""
     pd = require("pandas", "parquet")
     df = load_results(results)
     if df.empty:
         raise FcplanError(f"{results}: no episodes stored yet (run fcplan sweep first)")
-    if metric not in df.columns or not pd.api.types.is_numeric_dtype(df[metric]):
-        numeric = [c for c in df.columns if c.startswith(("manual.", "reference2020."))]
-        numeric = [c for c in numeric if pd.api.types.is_numeric_dtype(df[c])]
-        raise FcplanError(
-            f"--metric {metric!r}: not a numeric result column; use one of " + ", ".join(numeric)
-        )
+    for metric in metrics:
+        if metric not in df.columns or not pd.api.types.is_numeric_dtype(df[metric]):
+            numeric = [
+                c
+                for c in df.columns
+                if c.startswith(("manual.", "reference2020.", "outcome."))
+                and pd.api.types.is_numeric_dtype(df[c])
+            ]
+            raise FcplanError(
+                f"--metric {metric!r}: not a numeric result column; use one of "
+                + ", ".join(numeric)
+            )
     for c in ("overrides", "time_limit"):
         if c not in df:
             df[c] = "{}" if c == "overrides" else np.nan
@@ -366,7 +374,7 @@ def _draw_plots(
     if "matplotlib.pyplot" not in sys.modules:
         mpl.use("Agg")  # files only; a notebook keeps its own backend
     colors = scheduler_colors(names)
-    label = _label(metric)
+    label = metric_label(metric)
     ok = df[df["status"] == "ok"]
     p = out_dir / "score_distribution.png"
     plot_distribution(ok, names, metric, label, p, colors)
@@ -387,25 +395,32 @@ def _draw_plots(
 
 def _sections(
     df: Any,
+    selection: Selection,
     names: list[str],
     scenarios: list[str],
     tables: dict[str, Any],
     setting_cols: list[str],
     metrics: list[str],
-    paired: Any,
-    metric: str,
+    study: StudyStats,
 ) -> list[Section]:
     """The report's content, shared by its Markdown and HTML forms (plots not included)."""
     n_ok = int((df["status"] == "ok").sum())
-    sweeps = sorted(df["config_hash"].dropna().unique()) if "config_hash" in df else []
+    found = selection.studies
+    which = (
+        f"study {found[0].describe()}"
+        if len(found) == 1
+        else f"{len(found)} studies: " + ", ".join(s.describe() for s in found)
+    )
     intro = (
-        f"{len(df)} episodes ({n_ok} completed, {len(df) - n_ok} failed) from "
-        f"{len(sweeps)} sweep(s): {len(names)} scheduler(s) x {len(scenarios)} scenario(s) x "
+        f"{len(df)} episodes ({n_ok} completed, {len(df) - n_ok} failed) of {which}: "
+        f"{len(names)} scheduler(s) x {len(scenarios)} scenario(s) x "
         f"{df['seed'].nunique()} seed(s). Cells are mean ± 95% CI half-width (Student t) over "
         "completed episodes; ± nan means fewer than two. Scores are the manual's unless marked "
         "ref2020."
     )
     sections: list[Section] = [("h1", "fcplan sweep report"), ("p", intro)]
+    if selection.note:
+        sections.append(("p", selection.note))
     sections += [
         ("h2", "Per scheduler"),
         ("table", _ci_cells(tables["per_scheduler"], ["scheduler"], metrics)),
@@ -417,7 +432,8 @@ def _sections(
             ("h2", "Per setting"),
             ("table", _ci_cells(tables["per_setting"], ["scheduler", *setting_cols], metrics)),
         ]
-    sections += _paired_sections(paired, metric)
+    for block in blocks(study):
+        sections += [("h2", block.title), ("p", block.note), ("table", block.cells)]
     sections += _fallback_sections(df[df["status"] == "ok"])
     failed = df[df["status"] != "ok"]
     if len(failed):
@@ -448,32 +464,6 @@ def _fallback_sections(ok: Any) -> list[Section]:
     )
     head = ["scheduler", "episodes mostly fallen back", "completed episodes"]
     return [("h2", "Fallback warning"), ("p", note), ("table", (head, rows))]
-
-
-def _paired_sections(paired: Any, metric: str) -> list[Section]:
-    """The paired-comparison heading, note and table."""
-    head = ["a", "b", "pairs", "a - b", "a wins/ties/losses", "p (Wilcoxon)", "verdict"]
-    body = [
-        [
-            r.a,
-            r.b,
-            str(r.pairs),
-            f"{_cell(r.mean_diff, 2)} ± {_cell(r.ci, 2)}",
-            f"{r.wins}/{r.ties}/{r.losses}",
-            _p(r.p_wilcoxon),
-            _verdict(r),
-        ]
-        for r in paired.itertuples()
-    ]
-    return [
-        ("h2", f"Paired comparisons ({_label(metric)})"),
-        (
-            "p",
-            "Episodes paired on (scenario, seed, overrides, replan period, time limit); "
-            "difference = a - b; p: two-sided Wilcoxon signed-rank test.",
-        ),
-        ("table", (head, body)),
-    ]
 
 
 def _markdown(kind: str, content: Any) -> str:
@@ -520,13 +510,3 @@ def _write_html(path: Path, sections: list[Section]) -> Path:
     )
     path.write_text(doc, encoding="utf-8")
     return path
-
-
-def _verdict(r: Any) -> str:
-    """Which scheduler is better at the 5 % level (lower is better for penalties and times)."""
-    if r.pairs == 0 or r.p_wilcoxon != r.p_wilcoxon:
-        return "-"
-    if r.p_wilcoxon >= 0.05 or r.mean_diff == 0:
-        return "no significant difference"
-    lower_better = not higher_is_better(r.metric)
-    return f"{r.a} better" if (r.mean_diff > 0) != lower_better else f"{r.b} better"

@@ -23,6 +23,13 @@ Each file carries the schema metadata key ``fcplan`` = ``{"format": "fcplan-swee
 "version": 1}``. :func:`load_results` refuses (with :class:`ResultsError` naming the file) a
 Parquet file without it, a file that is not valid Parquet, and any other file in the folder.
 
+Reading a folder from outside is bounded: only regular files are opened (a FIFO named
+``x.parquet`` would block the reader forever), a row file of more than :data:`MAX_ROW_BYTES`
+bytes is refused unread, and a row's Parquet footer is checked before its data are decoded: one
+row, at most :data:`MAX_ROW_VALUES` values in all its columns (a 1.5 KB file can declare a list
+of 10^8 values run-length encoded: a decompression bomb). A manifest must be a regular file of at
+most :data:`MAX_MANIFEST_BYTES` holding a JSON object (:func:`load_manifests`).
+
 Examples
 --------
 >>> import tempfile
@@ -41,16 +48,21 @@ import json
 import os
 import re
 import socket
+import stat
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 from fcplan.errors import FcplanError
 from fcplan.experiments.optional import require
 
 __all__ = [
+    "MAX_MANIFEST_BYTES",
+    "MAX_ROW_BYTES",
+    "MAX_ROW_VALUES",
     "ResultsError",
+    "load_manifests",
     "load_results",
     "lock_results",
     "remove_stale_temporaries",
@@ -59,7 +71,15 @@ __all__ = [
     "write_manifest",
 ]
 
-FORMAT = {"format": "fcplan-sweep-episode", "version": 1}
+FORMAT: dict[str, Any] = {"format": "fcplan-sweep-episode", "version": 1}
+#: Bound on one row file (a row of a 180-s episode is about 20 KB; one of a 10^6-tick episode
+#: with its per-replan lists about 3 MB).
+MAX_ROW_BYTES = 64 * 2**20
+#: Bound on the values one row file's footer may declare, over all its columns (the per-replan
+#: lists of a 10^6-tick episode replanned every second hold 3 x 10^5).
+MAX_ROW_VALUES = 2**24
+#: Bound on one manifest (a sweep grid of thousands of settings is a few hundred KB).
+MAX_MANIFEST_BYTES = 16 * 2**20
 _META_KEY = b"fcplan"
 _ROW_FILE = re.compile(r"^[0-9A-Za-z_-]+\.parquet$")
 _MANIFEST = re.compile(r"^manifest-[0-9a-f]+\.json$")
@@ -221,7 +241,10 @@ def _row_files(directory: str | os.PathLike[str]) -> Iterator[Path]:
     if not d.is_dir():
         raise ResultsError(f"{d}: not a folder (results are a folder of Parquet files)")
     for p in sorted(d.iterdir()):
-        if p.is_dir() or _TMP.match(p.name) or _MANIFEST.match(p.name):
+        if p.is_dir() or _TMP.match(p.name):
+            continue
+        if _MANIFEST.match(p.name):
+            _manifest(p)
             continue
         if not _ROW_FILE.match(p.name):
             raise ResultsError(
@@ -233,26 +256,116 @@ def _row_files(directory: str | os.PathLike[str]) -> Iterator[Path]:
         yield p
 
 
+def _open_regular(path: Path, cap: int) -> IO[bytes]:
+    """``path`` opened for reading if it is a regular file of at most ``cap`` bytes (opened
+    without blocking and checked with ``fstat``, so a FIFO or device is never waited on)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise ResultsError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise ResultsError(f"{path}: not a regular file (a FIFO, socket or device?); remove it")
+        if st.st_size > cap:
+            raise ResultsError(
+                f"{path}: {st.st_size:,} bytes, more than the {cap:,} a results file may have; "
+                "not written by fcplan sweep: move it elsewhere"
+            )
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def _manifest(path: Path) -> dict[str, Any]:
+    """The sweep grid a manifest holds (a JSON object), or a one-line ResultsError."""
+    try:
+        with _open_regular(path, MAX_MANIFEST_BYTES) as fh:
+            data = fh.read(MAX_MANIFEST_BYTES + 1)
+    except OSError as exc:
+        raise ResultsError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    try:
+        doc = json.loads(data[:MAX_MANIFEST_BYTES].decode("utf-8"))
+    except (ValueError, RecursionError) as exc:
+        reason = getattr(exc, "msg", type(exc).__name__)
+        doc = f"not valid JSON ({reason})"
+    if not isinstance(doc, dict):
+        why = doc if isinstance(doc, str) else "not a JSON object"
+        raise ResultsError(
+            f"{path}: damaged sweep manifest: {why}; delete it (the next sweep of this grid "
+            "writes it again)"
+        )
+    return doc
+
+
+def load_manifests(directory: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """The sweep grids (``manifest-*.json``) stored in a results folder, oldest first.
+
+    Raises
+    ------
+    ResultsError
+        A manifest that is not a regular file, is larger than :data:`MAX_MANIFEST_BYTES` or does
+        not hold a JSON object (named).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> d = tempfile.mkdtemp()
+    >>> _ = write_manifest(d, "0a", {"schedulers": [{"label": "greedy"}]})
+    >>> load_manifests(d)
+    [{'schedulers': [{'label': 'greedy'}]}]
+    """
+    found = [p for p in Path(directory).iterdir() if _MANIFEST.match(p.name)]
+    return [_manifest(p) for p in sorted(found, key=lambda p: (p.lstat().st_mtime, p.name))]
+
+
+def _check_footer(pf: Any, path: Path) -> None:
+    """Refuse, from its footer alone, a row file that is too big to decode (see the module)."""
+    md = pf.metadata
+    if md.num_rows != 1:
+        raise ResultsError(f"{path}: expected one episode row, found {md.num_rows}")
+    values = sum(
+        md.row_group(g).column(c).num_values
+        for g in range(md.num_row_groups)
+        for c in range(md.num_columns)
+    )
+    if values > MAX_ROW_VALUES:
+        raise ResultsError(
+            f"{path}: declares {values:,} values, more than the {MAX_ROW_VALUES:,} of an "
+            "episode row; not written by fcplan sweep: move it elsewhere"
+        )
+
+
 def _read(path: Path, columns: list[str] | None = None) -> Any:
     pq = require("pyarrow.parquet", "parquet")
+    fh = _open_regular(path, MAX_ROW_BYTES)
     try:
-        pf = pq.ParquetFile(path)
+        pf = pq.ParquetFile(fh)
+        _check_footer(pf, path)
         meta = pf.schema_arrow.metadata or {}
         table = pf.read(columns=columns)
+    except ResultsError:
+        raise
     except Exception as exc:  # noqa: BLE001 - any reader failure means a damaged file
         raise ResultsError(
             f"{path}: not a readable Parquet file ({type(exc).__name__}: {exc}); delete it to "
             "re-run that episode"
         ) from None
+    finally:
+        fh.close()
     try:
         fmt = json.loads(meta.get(_META_KEY, b"{}"))
-    except ValueError:
+    except (ValueError, RecursionError):
         fmt = {}
-    if fmt.get("format") != FORMAT["format"]:
+    if not isinstance(fmt, dict) or fmt.get("format") != FORMAT["format"]:
         raise ResultsError(f"{path}: a Parquet file not written by fcplan sweep (foreign file)")
-    if fmt.get("version", 0) > FORMAT["version"]:
+    version = fmt.get("version", 0)
+    newest: int = FORMAT["version"]
+    if not isinstance(version, int) or version > newest:
         raise ResultsError(
-            f"{path}: written by a newer fcplan (results format version {fmt.get('version')})"
+            f"{path}: results format version {version!r:.40} is not one this fcplan reads "
+            f"(1..{FORMAT['version']}; written by a newer fcplan?)"
         )
     if table.num_rows != 1:
         raise ResultsError(f"{path}: expected one episode row, found {table.num_rows}")
@@ -301,8 +414,10 @@ def load_results(directory: str | os.PathLike[str]) -> Any:
         table = pa.concat_tables(
             [t.replace_schema_metadata(None) for t in tables], promote_options="permissive"
         )
-    except pa.ArrowInvalid as exc:
-        raise ResultsError(f"{directory}: episode files with incompatible columns: {exc}") from None
-    df = table.to_pandas()
-    order = [c for c in ("finished_at", "key") if c in df.columns]
-    return df.sort_values(order, kind="stable").reset_index(drop=True)
+        df = table.to_pandas()
+        order = [c for c in ("finished_at", "key") if c in df.columns]
+        return df.sort_values(order, kind="stable").reset_index(drop=True)
+    except (pa.ArrowException, TypeError, ValueError) as exc:
+        raise ResultsError(
+            f"{directory}: episode files with incompatible columns: {str(exc)[:200]}"
+        ) from None

@@ -35,6 +35,21 @@ Processes and files.
 * Schedulers with a deterministic mode run in it unless ``deterministic=False`` (``fcplan sweep
   --wall-time``), see :mod:`fcplan.experiments.config`.
 
+Studies. Every row carries its sweep's ``config_hash`` (the grid) and ``study_hash`` (the grid
+without its seeds, :attr:`~fcplan.experiments.config.SweepConfig.study_hash`): re-running a sweep
+with more seeds into its folder extends the same study, while a different grid written into the
+same folder is another study, which :func:`~fcplan.experiments.report` refuses to pool without
+``allow_mixed``. The folder keeps one ``manifest-<study_hash>.json`` per study (the grid of its
+latest run).
+
+Seeds auto. ``seeds="auto"`` (``fcplan sweep --seeds auto``) replaces the file's seeds by 0, 1,
+2, ... played in batches of ``seed_batch`` until every pair of schedulers is resolved on
+``metric`` over the whole study (the report's paired table, pooled over settings; the
+``oracle`` left out) or ``max_seeds`` seeds are played (:mod:`fcplan.experiments.autoseeds`);
+:attr:`SweepSummary.stopped` says why it stopped. A re-run resumes: stored episodes are skipped.
+
+Progress is one ``tqdm`` bar counted in episodes (:mod:`fcplan.experiments.progress`), on stderr.
+
 Examples
 --------
 >>> import tempfile
@@ -52,8 +67,8 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import os
-import sys
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -61,9 +76,11 @@ from pathlib import Path
 from typing import Any
 
 from fcplan.errors import FcplanError
+from fcplan.experiments.analysis import paired_table, results_pair_key
+from fcplan.experiments.autoseeds import AutoSeeds
 from fcplan.experiments.backends import select_backend
 from fcplan.experiments.config import SweepConfig, load_sweep_config
-from fcplan.experiments.progress import make_progress
+from fcplan.experiments.progress import EpisodeBar, Progress, ProgressCallback, episode_progress
 from fcplan.experiments.results import (
     ResultsError,
     load_results,
@@ -73,6 +90,7 @@ from fcplan.experiments.results import (
     write_manifest,
     write_row,
 )
+from fcplan.experiments.tables import check_metric
 from fcplan.experiments.workers import default_jobs, runtime_factories
 
 __all__ = ["SweepSummary", "sweep"]
@@ -102,6 +120,8 @@ class SweepSummary:
     errors : list of str
         ``"<label> <scenario> seed <n>: <error>"`` for the failed episodes.
     wall_time_s : float
+    stopped : str
+        Why a ``seeds="auto"`` sweep stopped (``""`` otherwise).
     """
 
     results: Path
@@ -114,6 +134,7 @@ class SweepSummary:
     lost: list[str] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
     wall_time_s: float = 0.0
+    stopped: str = ""
 
     def load(self) -> Any:
         """:func:`~fcplan.experiments.load_results` of the results folder."""
@@ -131,6 +152,8 @@ class SweepSummary:
             text += (
                 f"\n{len(self.lost)} episode(s) lost, re-run to play them; first: {self.lost[0]}"
             )
+        if self.stopped:
+            text += f"\nseeds auto: {self.stopped}"
         return text
 
 
@@ -146,8 +169,12 @@ def sweep(
     jobs: int | None = None,
     dask: str | None = None,
     retry_failed: bool = False,
-    progress: bool | Callable[[int, int, dict[str, Any]], None] = True,
+    progress: Progress = True,
     deterministic: bool = True,
+    seeds: str | None = None,
+    max_seeds: int = 50,
+    seed_batch: int = 5,
+    metric: str = "manual.final_score",
 ) -> SweepSummary:
     """Run a sweep, storing each finished episode in ``results`` at once.
 
@@ -167,11 +194,17 @@ def sweep(
     retry_failed : bool
         Also re-run episodes stored as failed (see the module docstring).
     progress : bool or callable
-        ``True``: a progress bar on stderr (plain lines when stderr is not a terminal);
-        ``False``: silent; or a ``progress(done, total, row)`` callback.
+        ``True``: a progress bar on stderr (:mod:`fcplan.experiments.progress`); ``False``:
+        silent; or a ``progress(done, total, row)`` callback.
     deterministic : bool
         Run schedulers that have a deterministic mode in it (default); False is the wall-time
         mode (:func:`~fcplan.experiments.config.load_sweep_config`).
+    seeds : ``"auto"``, optional
+        Replace the file's seeds by batches of ``seed_batch`` until every pair of schedulers is
+        resolved on ``metric`` or ``max_seeds`` are played (module docstring).
+    max_seeds, seed_batch : int
+    metric : str
+        The headline metric of ``seeds="auto"``.
 
     Returns
     -------
@@ -187,31 +220,46 @@ def sweep(
     """
     cfg = load_sweep_config(config, deterministic=deterministic)
     _check_backend_args(jobs, dask)
+    auto = None
+    if seeds is not None:
+        if not (isinstance(seeds, str) and seeds.strip().lower() == "auto"):
+            raise FcplanError(f"seeds: 'auto' or None (the file's seeds), got {seeds!r}")
+        auto = AutoSeeds(seed_batch, max_seeds, check_metric(metric))
     jobs = jobs or default_jobs()
-    specs = list({s.key: s for s in cfg.episodes()}.values())
     out = _results_folder(results)
-    with lock_results(out):
-        remove_stale_temporaries(out)
-        return _run(cfg, specs, out, jobs, dask, retry_failed, progress)
+    report = episode_progress(progress, "sweep")
+    try:
+        with lock_results(out):
+            remove_stale_temporaries(out)
+
+            def run(step: SweepConfig, rep: ProgressCallback | None) -> SweepSummary:
+                return _run(step, out, jobs, dask, retry_failed, rep)
+
+            if auto is None:
+                return run(cfg, report)
+            return _auto(cfg, auto, out, run, report)
+    finally:
+        if isinstance(report, EpisodeBar):
+            report.close()
 
 
 def _run(
     cfg: SweepConfig,
-    specs: list[Any],
     out: Path,
     jobs: int,
     dask: str | None,
     retry_failed: bool,
-    progress: bool | Callable[[int, int, dict[str, Any]], None],
+    report: ProgressCallback | None,
 ) -> SweepSummary:
-    """Play the episodes of ``specs`` not stored in ``out`` (which this process has locked)."""
+    """Play the episodes of ``cfg`` not stored in ``out`` (which this process has locked)."""
+    specs = list({s.key: s for s in cfg.episodes()}.values())
     status = stored_status(out)
     todo = [s for s in specs if s.key not in status or (retry_failed and status[s.key] != "ok")]
     h = cfg.config_hash
-    write_manifest(out, h, {"config_hash": h, "source": cfg.source, **cfg.to_dict()})
+    doc = {"config_hash": h, "study_hash": cfg.study_hash, "source": cfg.source, **cfg.to_dict()}
+    write_manifest(out, cfg.study_hash, doc)
     runtime = runtime_factories([v.name for v in cfg.schedulers])
     backend, outcomes = select_backend(todo, jobs, runtime, dask=dask)
-    report = make_progress(sys.stderr, label="sweep") if progress is True else progress or None
     summary = SweepSummary(out, h, backend, total=len(specs), skipped=len(specs) - len(todo))
     t0 = time.perf_counter()
     try:
@@ -223,6 +271,66 @@ def _run(
         outcomes.close()
         summary.wall_time_s = time.perf_counter() - t0
     return summary
+
+
+def _auto(
+    cfg: SweepConfig,
+    auto: AutoSeeds,
+    out: Path,
+    run: Callable[[SweepConfig, ProgressCallback | None], SweepSummary],
+    report: ProgressCallback | None,
+) -> SweepSummary:
+    """Sweep seeds ``0 .. k batch - 1`` for k = 1, 2, ... until :meth:`AutoSeeds.decide` stops
+    (``run(config, progress)`` plays the episodes of a config not stored yet)."""
+    policies = [v.label for v in cfg.schedulers if v.name != "oracle"]
+    played = planned = 0
+
+    def batch_report(done: int, total: int, row: dict[str, Any]) -> None:
+        if report is not None:
+            report(played + done, planned + total, row)
+
+    total = SweepSummary(out, cfg.config_hash, "", total=0)
+    look = 0
+    while True:
+        look += 1
+        step = dataclasses.replace(cfg, seeds=tuple(auto.seeds(look)))
+        s = run(step, batch_report)
+        played, planned = played + s.ran + len(s.lost), planned + s.total - s.skipped
+        total = dataclasses.replace(
+            total,
+            config_hash=s.config_hash,
+            backend=s.backend,
+            total=s.total,
+            ran=total.ran + s.ran,
+            failed=total.failed + s.failed,
+            lost=total.lost + s.lost,
+            errors=total.errors + s.errors,
+            wall_time_s=total.wall_time_s + s.wall_time_s,
+        )
+        rows = _study_rows(out, cfg.study_hash, step.seeds)
+        pairs = paired_table(
+            rows,
+            policies,
+            auto.metric,
+            results_pair_key,
+            confidence=auto.look_confidence,
+            alpha=auto.look_alpha,
+        )
+        decision = auto.decide(pairs, look)
+        if decision.stop or s.lost:  # lost episodes: stop, a re-run plays them and goes on
+            total.skipped = total.total - total.ran - len(total.lost)
+            total.stopped = decision.reason if decision.stop else "stopped: episodes were lost"
+            return total
+
+
+def _study_rows(out: Path, study: str, seeds: tuple[int, ...]) -> list[dict[str, Any]]:
+    """The completed episodes of ``study`` and ``seeds`` stored in ``out`` (episodes of later
+    seeds, stored by an earlier run, do not count before their look)."""
+    df = load_results(out)
+    if df.empty or "study_hash" not in df:
+        return []
+    keep = (df["study_hash"] == study) & (df["status"] == "ok") & df["seed"].isin(seeds)
+    return df[keep].to_dict("records")
 
 
 def _check_backend_args(jobs: Any, dask: Any) -> None:
@@ -258,6 +366,7 @@ def _store(
         summary.lost.append(f"{_describe(spec)}: {lost}")
         return {"error": lost}
     row["config_hash"] = cfg.config_hash
+    row["study_hash"] = cfg.study_hash
     row["sweep"] = cfg.name
     try:
         write_row(out, row)

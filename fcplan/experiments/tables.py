@@ -10,7 +10,11 @@ time), which the sweep report tabulates as well.
 
 * :data:`SCORE_COLUMNS`: what :func:`~fcplan.experiments.compare` tabulates; each has the short
   ``key`` of its ``<key>_mean`` / ``<key>_ci`` fields in comparison tables and CSV files.
-* :data:`REPORT_COLUMNS`: what :func:`~fcplan.experiments.report` tabulates (scores, then runs).
+* :data:`OUTCOME_COLUMNS`: the outcome metrics (time to containment, contained, burned area,
+  facility damage), which separate schedulers where the manual's scores saturate;
+  :data:`RANKING_COLUMNS`: the metrics schedulers are ranked on (final score, NRR, outcomes).
+* :data:`REPORT_COLUMNS`: what :func:`~fcplan.experiments.report` tabulates (scores, outcomes,
+  then runs).
 * :func:`higher_is_better`: the direction of any result column, for paired verdicts.
 * :func:`difficulty_key`: rows by difficulty group come in the order of
   :data:`fcplan.scenario.model.DIFFICULTIES` (practice, easy, moderate, hard, custom).
@@ -34,18 +38,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fcplan.errors import UnknownNameError
-from fcplan.metrics import DEFINITIONS, metric_spec
+from fcplan.errors import FcplanError, UnknownNameError
+from fcplan.metrics import DEFINITIONS, METRICS, OUTCOMES, MetricSpec, metric_spec
 from fcplan.scenario.model import DIFFICULTIES
 
 __all__ = [
     "Column",
+    "OUTCOME_COLUMNS",
+    "RANKING_COLUMNS",
     "REPORT_COLUMNS",
     "RUN_COLUMNS",
     "SCORE_COLUMNS",
+    "check_metric",
     "difficulty_key",
     "fallback_majority",
     "higher_is_better",
+    "metric_columns",
 ]
 
 
@@ -83,6 +91,11 @@ def _score(key: str, metric: str, definition: str = "manual", label: str = "") -
     )
 
 
+def _outcome(key: str, spec: MetricSpec) -> Column:
+    """The episode-summary column ``outcome.<name>`` of an outcome metric."""
+    return Column(f"outcome.{spec.name}", spec.column, spec.decimals, spec.higher_is_better, key)
+
+
 SCORE_COLUMNS: tuple[Column, ...] = (
     _score("final_score", "final_score"),
     _score("ofs", "overall_firefighting"),
@@ -95,6 +108,21 @@ SCORE_COLUMNS: tuple[Column, ...] = (
 )
 """Scores in experiment tables: the manual's metrics and the reference2020 final score."""
 
+OUTCOME_COLUMNS: tuple[Column, ...] = tuple(
+    _outcome(key, spec)
+    for key, spec in zip(("contain_s", "contained", "burned", "damage"), OUTCOMES, strict=True)
+)
+"""The outcome metrics (:mod:`fcplan.metrics.outcomes`: time to containment, contained, burned
+area, facility damage), columns ``outcome.<name>`` of episode summaries and sweep results."""
+
+RANKING_COLUMNS: tuple[Column, ...] = (
+    SCORE_COLUMNS[0],
+    next(c for c in SCORE_COLUMNS if c.key == "nrr"),
+    *OUTCOME_COLUMNS,
+)
+"""The metrics schedulers are ranked on (:mod:`fcplan.experiments.analysis`): the manual's final
+score and NRR, and the outcome metrics."""
+
 RUN_COLUMNS: tuple[Column, ...] = (
     Column("solve_p50_ms", "solve p50 ms", 2, False),
     Column("solve_p95_ms", "solve p95 ms", 2, False),
@@ -103,7 +131,7 @@ RUN_COLUMNS: tuple[Column, ...] = (
 )
 """Measurements of the episode run that the sweep report tabulates after the scores."""
 
-REPORT_COLUMNS: tuple[Column, ...] = SCORE_COLUMNS + RUN_COLUMNS
+REPORT_COLUMNS: tuple[Column, ...] = SCORE_COLUMNS + OUTCOME_COLUMNS + RUN_COLUMNS
 """Every column of the sweep report's tables, in order."""
 
 # Result columns outside the tables that are better when lower (matched as substrings).
@@ -121,12 +149,14 @@ def higher_is_better(name: str) -> bool:
     --------
     >>> higher_is_better("reference2020.total_negative_reward"), higher_is_better("tasks_mean")
     (False, True)
+    >>> higher_is_better("outcome.burned_area_cells"), higher_is_better("outcome.contained")
+    (False, True)
     """
     for col in REPORT_COLUMNS:
         if col.name == name:
             return col.higher_is_better
     definition, _, metric = name.partition(".")
-    if definition in DEFINITIONS:
+    if definition in (*DEFINITIONS, "outcome"):
         try:
             return metric_spec(metric).higher_is_better
         except UnknownNameError:
@@ -150,3 +180,31 @@ def fallback_majority(row: dict) -> bool:
     """
     replans, fallbacks = row.get("replans") or 0, row.get("fallbacks") or 0
     return bool(replans == replans and replans > 0 and fallbacks > replans / 2)
+
+
+def metric_columns() -> list[str]:
+    """Every numeric metric column of episode rows: ``<definition>.<metric>`` for both
+    definitions (the verbal grade excluded) and ``outcome.<name>``.
+
+    Examples
+    --------
+    >>> cols = metric_columns()
+    >>> "manual.final_score" in cols, "outcome.burned_area_cells" in cols, "manual.grade" in cols
+    (True, True, False)
+    """
+    out = [s.key(d) for d in DEFINITIONS for s in METRICS if s.name != "grade"]
+    return out + [f"outcome.{s.name}" for s in OUTCOMES]
+
+
+def check_metric(name: str) -> str:
+    """``name`` if it is a :func:`metric_columns` entry, else a one-line :class:`FcplanError`.
+
+    Examples
+    --------
+    >>> check_metric("manual.perception")
+    'manual.perception'
+    """
+    cols = metric_columns()
+    if name not in cols:
+        raise FcplanError(f"metric {name!r} is not a numeric metric; use one of {', '.join(cols)}")
+    return name

@@ -21,8 +21,9 @@ from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-from fcplan.errors import FcplanError
+from fcplan.errors import FcplanError, install_hint
 from fcplan.game.screens import WINDOW, App
+from fcplan.recording.reader import read_bytes
 
 __all__ = ["run_app", "GameError", "require_display", "load_script"]
 
@@ -36,7 +37,7 @@ def _import_pygame() -> Any:
     try:
         import pygame
     except ImportError:
-        raise GameError('the game needs pygame: pip install "fcplan[game]"') from None
+        raise GameError(f"the game needs pygame: {install_hint('game')}") from None
     return pygame
 
 
@@ -54,20 +55,42 @@ def require_display() -> None:
         )
 
 
+#: Bound on an input script file (a 10-minute game with an input every tick is about 2 MB).
+MAX_SCRIPT_BYTES = 64 * 2**20
+
+
 def load_script(path: str | os.PathLike) -> list[dict[str, Any]]:
-    """Read a JSON list of input dicts, each with an integer ``"tick"`` and a ``"type"``."""
+    """Read a JSON list of input dicts, each with an integer ``"tick"`` and a ``"type"``.
+
+    Only a regular file of at most :data:`MAX_SCRIPT_BYTES` is read (a FIFO or device is
+    refused without blocking); every failure is one :class:`GameError` line naming the file.
+    """
+    raw = read_bytes(os.fspath(path), GameError, MAX_SCRIPT_BYTES)
     try:
-        data = json.loads(Path(path).read_text())
-    except OSError as exc:
-        raise GameError(f"{path}: cannot read the input script: {exc.strerror or exc}") from None
+        data = json.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise GameError(f"{path}: not valid JSON: not UTF-8 text") from None
     except json.JSONDecodeError as exc:
         raise GameError(f"{path}: not valid JSON: {exc.msg} (line {exc.lineno})") from None
+    except RecursionError:
+        raise GameError(f"{path}: not valid JSON: nested too deeply") from None
     if not isinstance(data, list):
         raise GameError(f"{path}: expected a JSON list of input events")
     for k, ev in enumerate(data):
         if not (isinstance(ev, dict) and isinstance(ev.get("tick"), int) and "type" in ev):
             raise GameError(f"{path}: event [{k}] needs an integer 'tick' and a 'type'")
     return data
+
+
+def _save(pygame: Any, surf: Any, path: str | os.PathLike[str]) -> None:
+    """Save the window as PNG at ``path``; a one-line GameError if that cannot be done."""
+    if os.path.exists(path) and not os.path.isfile(path):  # a folder, device or FIFO
+        raise GameError(f"--screenshot {str(path)!r}: not a regular file")
+    try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        pygame.image.save(surf, str(path))
+    except (OSError, pygame.error) as exc:
+        raise GameError(f"--screenshot {str(path)!r}: cannot save the window: {exc}") from None
 
 
 def _translate(pygame: Any, ev: Any) -> dict[str, Any] | None:
@@ -144,11 +167,11 @@ def run_app(
                 break
             draw(surf, app)
             pygame.display.flip()
-            if screenshot is not None and not shot_done and app.screen == "game" and s is not None:
-                due = screenshot_at_s is None or s.world.time_s >= screenshot_at_s
-                if due:
-                    Path(screenshot).parent.mkdir(parents=True, exist_ok=True)
-                    pygame.image.save(surf, str(screenshot))
+            if screenshot is not None and not shot_done and s is not None:
+                # due at its time, or when the game ended before it (else nothing would quit)
+                due = screenshot_at_s is None or s.world.time_s >= screenshot_at_s or s.done
+                if due and (app.screen == "game" or s.done):
+                    _save(pygame, surf, screenshot)
                     shot_done = True
                     if quit_after_screenshot:
                         app.quit()

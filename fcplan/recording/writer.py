@@ -378,6 +378,8 @@ class Recording:
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write this recording to ``path`` (``.npz``; written to a temporary file, then renamed)."""
         path = os.fspath(path)
+        if os.path.exists(path) and not os.path.isfile(path):  # never replace a device or FIFO
+            raise RecordingError(f"{path}: not a regular file; recordings are written to files")
         entries: dict[str, Any] = dict(self.arrays)
         for name, value in zip(JSON_ENTRIES, (self.header, self.replans, self.inputs), strict=True):
             entries[name] = np.array(json.dumps(jsonable(value), allow_nan=False))

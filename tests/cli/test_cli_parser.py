@@ -3,6 +3,7 @@ entry points (console script, python -m fcplan, python -m fcplan.cli)."""
 
 from __future__ import annotations
 
+import argparse
 import ast
 import inspect
 import json
@@ -48,7 +49,7 @@ def test_every_command_has_its_module_in_help_order(capsys):
     in COMMAND_MODULES order."""
     sub = parser.build_parser()._subparsers._group_actions[0]
     assert list(sub.choices) == [
-        "scenarios", "scenario", "run", "compare", "play", "sweep", "report", "replay",
+        "scenarios", "scenario", "schedulers", "run", "compare", "play", "sweep", "report", "replay",
         "import-legacy",
     ]  # fmt: skip
     assert tuple(m.__name__ for m in parser.COMMANDS) == COMMAND_MODULES
@@ -63,6 +64,7 @@ def test_run_defaults_point_at_the_command_modules():
     cases = {
         ("scenarios",): "fcplan.cli.scenarios",
         ("scenario", "validate", "1"): "fcplan.cli.scenario",
+        ("schedulers",): "fcplan.cli.schedulers",
         ("run", "1"): "fcplan.cli.run",
         ("compare", "--schedulers", "greedy"): "fcplan.cli.compare",
         ("play",): "fcplan.cli.play",
@@ -104,11 +106,12 @@ def test_old_import_paths_export_the_same_objects():
 
 
 def test_library_modules_hold_no_argparse_code():
-    """No module of fcplan.legacy, fcplan.experiments or fcplan.game imports argparse or builds
-    an argument parser: the commands live in fcplan.cli."""
+    """No module of fcplan.legacy, fcplan.experiments, fcplan.game, nor fcplan.replay and
+    fcplan.video, imports argparse or builds an argument parser: the commands live in
+    fcplan.cli."""
     root = Path(fcplan.__file__).parent
     files = [*(root / "legacy").glob("*.py"), *(root / "experiments").glob("*.py")]
-    files += (root / "game").glob("*.py")
+    files += [*(root / "game").glob("*.py"), root / "replay.py", root / "video.py"]
     for path in files:
         tree = ast.parse(path.read_text(encoding="utf-8"))
         names = {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
@@ -123,3 +126,78 @@ def test_fcplan_cli_init_only_exposes_main():
 
     assert fcplan.cli.main is parser.main and inspect.isfunction(main)
     assert set(fcplan.cli.__all__) == {"COMMAND_MODULES", "main"}
+
+
+def _parsers(p):
+    """``p`` and every sub-parser below it."""
+    yield p
+    for action in p._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child in action.choices.values():
+                yield from _parsers(child)
+
+
+def test_no_parser_abbreviates_options(capsys):
+    """No parser takes a prefix of an option for the option (``compare --seed 3`` used to fill
+    every cell with nan as ``--seeds 3``); the error names the command and the option meant."""
+    assert all(not q.allow_abbrev for q in _parsers(parser.build_parser()))
+    one_line_error(
+        ["compare", "--seed", "3", "--schedulers", "greedy"],
+        capsys,
+        "fcplan compare: error: unrecognized arguments: --seed 3",
+        "did you mean --seeds?",
+    )
+    one_line_error(["run", "1", "--sed", "2"], capsys, "fcplan run: error:", "--seed")
+
+
+def test_errors_name_the_command_once(capsys):
+    """An argument error reads ``fcplan run: error: argument --seed: ...``: the command, then
+    the problem, without a doubled ``fcplan: error: fcplan run:``."""
+    assert main(["run", "1", "--seed", "-1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("fcplan run: error: argument --seed: expected an integer >= 0")
+    assert err.count("fcplan") == 1
+
+
+def test_bare_fcplan_prints_help_and_a_hint(capsys):
+    """A bare ``fcplan`` prints the help (every command) on stdout and one hint line on stderr,
+    exit 2."""
+    assert main([]) == 2
+    out, err = capsys.readouterr()
+    assert out.startswith("usage: fcplan")
+    for command in parser.build_parser()._subparsers._group_actions[0].choices:
+        assert command in out
+    assert err == "fcplan: error: a command is needed (see above, or: fcplan run 12)\n"
+
+
+def test_version_matches_the_distribution(capsys):
+    """``fcplan --version`` prints fcplan.__version__, the version pyproject.toml declares."""
+    import tomllib
+
+    meta = tomllib.loads((Path(fcplan.__file__).parents[1] / "pyproject.toml").read_text())
+    assert fcplan.__version__ == meta["project"]["version"]
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.startswith(f"fcplan {fcplan.__version__} (Python ")
+
+
+def test_help_returns_zero_and_run_help_lists_the_schedulers(capsys):
+    """``--help`` returns 0 (no SystemExit out of main); ``fcplan run --help`` names every
+    registered scheduler and points at ``fcplan schedulers``."""
+    from fcplan.scheduling import available_schedulers
+
+    assert main(["--help"]) == 0
+    assert main(["run", "--help"]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    for name in available_schedulers():
+        assert name in out, name
+    assert "fcplan schedulers" in out
+
+
+def test_scenario_zero_is_refused(capsys):
+    """``fcplan run 0`` (and ``#0``, ``00``, a 0 in --scenarios) is an error naming the allowed
+    scenarios instead of quietly playing practice; ``practice`` by name still works."""
+    for text in ("0", "#0", "00"):
+        one_line_error(["run", text], capsys, f"no scenario '{text}'", "practice and 1..24")
+    one_line_error(["compare", "--schedulers", "idle", "--scenarios", "0-2"], capsys, "'0'")
+    one_line_error(["play", "--scenario", "0"], capsys, "no scenario '0'")
+    assert parser.build_parser().parse_args(["run", "practice"]).scenario == "practice"

@@ -33,3 +33,31 @@ def test_run_json_is_machine_readable(capsys):
     assert main(["run", "3", "-s", "idle", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["ticks"] == 1800 and set(doc["metrics"]) == {"manual", "reference2020"}
+
+
+def test_progress_bar_counts_simulated_seconds_and_changes_no_result(capsys, monkeypatch):
+    """``fcplan run`` moves a bar to the episode's length in simulated seconds; the results
+    printed on stdout are those of a run without a bar."""
+    import io
+
+    import fcplan.cli.progress as progress
+
+    real = progress.progress_bar
+    monkeypatch.setattr(
+        progress, "progress_bar", lambda total, **kw: real(total, **kw, disable=True)
+    )
+    assert main(["run", "1", "-s", "idle", "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    bars = []
+
+    def shown_bar(total, **kwargs):
+        bars.append(real(total, **{**kwargs, "file": io.StringIO()}))
+        return bars[-1]
+
+    monkeypatch.setattr(progress, "progress_bar", shown_bar)
+    assert main(["run", "1", "-s", "idle", "--json"]) == 0
+    with_bar = json.loads(capsys.readouterr().out)
+    assert len(bars) == 1 and bars[0].n == bars[0].total == 180
+    for doc in (plain, with_bar):
+        doc.pop("wall_time_s")
+    assert with_bar == plain

@@ -15,7 +15,6 @@ from fcplan.errors import FcplanError, UnknownNameError
 from fcplan.experiments.compare import (
     METRICS,
     ComparisonResult,
-    ProgressPrinter,
     compare,
 )
 from fcplan.scenario import load_scenario
@@ -139,14 +138,17 @@ def test_per_difficulty_breakdown(base):
 
 
 def test_format_is_a_fixed_width_table(base):
-    """format() prints a header line, a column line and one aligned line per scheduler."""
-    lines = base.format().splitlines()
+    """format() prints a header line, a column line and one aligned line per scheduler, then
+    (unless statistics=False) the paired and ranking tables after a blank line."""
+    lines = base.format(statistics=False).splitlines()
     assert lines[0].startswith("8 episodes: 2 scenario(s) x 2 scheduler(s) x 2 seed(s)")
     assert lines[1].split()[:3] == ["scheduler", "n", "err"]
     assert [ln.split()[0] for ln in lines[2:]] == ["greedy", "idle"]
     assert all("±" in ln for ln in lines[2:])
     assert len({len(ln) for ln in lines[1:]}) <= 2  # right-aligned columns
-    assert str(base) == base.format()
+    full = base.format()
+    assert str(base) == full and full.startswith(base.format(statistics=False) + "\n\n")
+    assert "Paired differences: final score." in full and "Ranking per metric." in full
 
 
 def test_paired_difference(base):
@@ -276,17 +278,6 @@ def test_csv_round_trip(base, tmp_path):
                 assert got[k] == ("" if v is None else str(v))
             else:
                 assert float(got[k]) == pytest.approx(v, rel=1e-12, nan_ok=True), k
-
-
-def test_progress_printer_throttles(capsys):
-    """ProgressPrinter prints done/total, rate and ETA, at most once per interval plus the end."""
-    p = ProgressPrinter(interval=3600.0)
-    for done in range(1, 6):
-        p(done, 5, {"error": "x" if done == 2 else ""})
-    lines = capsys.readouterr().err.strip().splitlines()
-    assert len(lines) == 2
-    assert lines[0].startswith("compare: 1/5 episodes (20%)") and "ETA" in lines[0]
-    assert lines[1].startswith("compare: 5/5 episodes (100%)") and "1 failed" in lines[1]
 
 
 def test_scheduler_specs_are_compared_as_separate_rows():

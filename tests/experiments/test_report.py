@@ -54,7 +54,7 @@ def test_report_cli_prints_markdown(results, tmp_path, capsys):
     """`fcplan report RESULTS --out DIR` prints the Markdown tables and exits 0."""
     assert main(["report", str(results), "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "## Per scheduler" in out and "## Paired comparisons" in out
+    assert "## Per scheduler" in out and "## Paired differences: final score" in out
     assert (tmp_path / "report.md").read_text(encoding="utf-8") == out
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from fcplan.experiments.tables import (
+    OUTCOME_COLUMNS,
     REPORT_COLUMNS,
     RUN_COLUMNS,
     SCORE_COLUMNS,
@@ -46,6 +47,12 @@ def test_old_module_tables_keep_their_contents():
         ("neg_reward", "manual.total_negative_reward", "neg. reward", 0),
         ("ref2020_final_score", "reference2020.final_score", "ref2020 final", 1),
     ]
+    outcomes = [
+        ("outcome.time_to_containment_s", "contain s", 1),
+        ("outcome.contained", "contained", 2),
+        ("outcome.burned_area_cells", "burned", 0),
+        ("outcome.facility_damage_cell_s", "damage cell s", 1),
+    ]
     runs = [
         ("solve_p50_ms", "solve p50 ms", 2),
         ("solve_p95_ms", "solve p95 ms", 2),
@@ -53,9 +60,10 @@ def test_old_module_tables_keep_their_contents():
         ("wall_time_s", "wall s", 2),
     ]
     assert list(compare_mod.METRICS.items()) == [(k, (n, lab)) for k, n, lab, _ in scores]
-    want = [(n, (lab, d)) for _, n, lab, d in scores] + [(n, (lab, d)) for n, lab, d in runs]
+    want = [(n, (lab, d)) for _, n, lab, d in scores]
+    want += [(n, (lab, d)) for n, lab, d in outcomes + runs]
     assert list(report_mod.METRICS.items()) == want
-    assert REPORT_COLUMNS == SCORE_COLUMNS + RUN_COLUMNS
+    assert REPORT_COLUMNS == SCORE_COLUMNS + OUTCOME_COLUMNS + RUN_COLUMNS
 
 
 @pytest.mark.parametrize(

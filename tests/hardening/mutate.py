@@ -2,8 +2,8 @@
 
 A mutant is a shipped scenario's TOML document with one change: a value replaced by a hostile one
 (zero, negative, tiny, huge, infinite, NaN, the wrong type, a deeply nested array), a key
-deleted, or a list grown. :func:`mutant` makes one from a seeded generator, :func:`to_toml`
-writes any document as TOML, and :func:`classify` sorts what a command did with it.
+deleted, or a list grown. :func:`mutant` makes one from a seeded generator and :func:`to_toml`
+writes any document as TOML (:mod:`tests.hardening.runner` classifies what a command did with it).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from typing import Any
 
 from fcplan.scenario import list_scenarios, load_scenario
 
-__all__ = ["EVIL", "Outcome", "classify", "leaves", "mutant", "to_toml"]
+__all__ = ["EVIL", "leaves", "mutant", "to_toml"]
 
 #: Replacement values: numbers at and far beyond every range, special floats, wrong types.
 EVIL: tuple[Any, ...] = (
@@ -115,32 +115,3 @@ def _value(v: Any) -> str:
 def to_toml(doc: dict[str, Any]) -> str:
     """``doc`` as TOML: one ``key = value`` line per top-level key, tables inline."""
     return "".join(f"{_key(k)} = {_value(v)}\n" for k, v in doc.items())
-
-
-class Outcome:
-    """Categories of what a command did with a bad input (the audit's columns)."""
-
-    CLEAN = "clean error"  # exit 2, one line on stderr, no traceback
-    RAN = "ran"  # exit 0
-    TRACEBACK = "traceback"  # anything else that printed a traceback or exited otherwise
-    HANG = "hang"  # over the time bound
-    OOM = "OOM"  # out of memory (a MemoryError, or killed by the memory limit)
-    ORPHAN = "orphan"  # a child process outlived its parent
-    ALL = (CLEAN, RAN, TRACEBACK, HANG, OOM, ORPHAN)
-
-
-def classify(status: int | None, stderr: str) -> str:
-    """The :class:`Outcome` of a command that exited with ``status`` (None: killed for taking
-    too long) and wrote ``stderr``."""
-    if status is None:
-        return Outcome.HANG
-    if "MemoryError" in stderr or "out of memory" in stderr or status in (-9, 137):
-        return Outcome.OOM
-    if "Traceback" in stderr:
-        return Outcome.TRACEBACK
-    lines = [ln for ln in stderr.splitlines() if ln.strip()]
-    if status == 2 and len(lines) == 1 and lines[0].startswith("fcplan: error: "):
-        return Outcome.CLEAN
-    if status == 0:
-        return Outcome.RAN
-    return Outcome.TRACEBACK

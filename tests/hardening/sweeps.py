@@ -5,6 +5,7 @@ disk. Each function returns a :class:`Trial` (what happened) for the tests to as
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -171,3 +172,70 @@ def two_sweeps(folder: Path) -> tuple[Trial, Trial]:
     t1 = _finish(Trial(status=first.returncode, stderr=err1), config, results, workers)
     t2 = Trial(status=second.returncode, stderr=err2, rows=t1.rows)
     return t1, t2
+
+
+def outcome(t: Trial) -> str:
+    """The audit's :class:`~tests.hardening.runner.Outcome` of a trial: orphan if a worker
+    outlived the bound; traceback if one was printed or a row was lost (the resume did not
+    complete the grid, or left a temporary file); else clean error (exit 2 or 143 with one
+    line) or ran (exit 0, or killed by the trial and completed by the resume)."""
+    from tests.hardening.runner import Outcome
+
+    if t.orphans:
+        return Outcome.ORPHAN
+    lost = t.resume_status is not None and (
+        t.resume_status != 0 or t.resumed_rows != EPISODES or t.stray_temporaries
+    )
+    if "Traceback" in t.stderr or lost:
+        return Outcome.TRACEBACK
+    lines = [ln for ln in t.stderr.splitlines() if ln.strip()]
+    if t.status == 2 and lines and lines[0].startswith("fcplan: error: "):
+        return Outcome.CLEAN
+    if t.status == 143 and lines and lines[0] == "fcplan: terminated":
+        return Outcome.CLEAN
+    if t.status == 0 or (t.status is not None and t.status < 0 and t.resume_status == 0):
+        return Outcome.RAN
+    return Outcome.TRACEBACK
+
+
+def can_mount_tmpfs() -> bool:
+    """Whether a tmpfs can be mounted in a new user and mount namespace (``unshare -rm``)."""
+    if not shutil.which("unshare") or not shutil.which("mount"):
+        return False
+    probe = "d=$(mktemp -d) && mount -t tmpfs -o size=64k tmpfs $d && umount $d; rmdir $d"
+    try:
+        done = subprocess.run(["unshare", "-rm", "sh", "-c", probe], capture_output=True,
+                              timeout=30)  # fmt: skip
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return done.returncode == 0
+
+
+def full_tmpfs(folder: Path) -> Trial | None:
+    """A sweep into a 64 KiB tmpfs (a real full disk): mounted in a private user and mount
+    namespace, so nothing outside sees it. Inside (:mod:`tests.hardening.full_disk`): the sweep
+    fills it, then the tmpfs grows to 16 MiB and the same command resumes. None when no tmpfs can
+    be mounted here."""
+    import json
+
+    from tests.hardening.runner import session_members
+
+    if not can_mount_tmpfs():
+        return None
+    config = write_config(folder, duration=5.0)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    cmd = ["unshare", "-rm", sys.executable, "-m", "tests.hardening.full_disk", str(config),
+           str(folder / "mnt")]  # fmt: skip
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)  # fmt: skip
+    out, err = proc.communicate(timeout=600)
+    if proc.returncode != 0:
+        return Trial(status=proc.returncode, stderr=err)
+    wait_until(lambda: not session_members(proc.pid), ORPHAN_BOUND_S)
+    orphans = session_members(proc.pid)
+    for pid in orphans:
+        os.kill(pid, signal.SIGKILL)
+    r = json.loads(out)
+    return Trial(status=r["status"], stderr=r["stderr"], rows=r["rows"],
+                 resumed_rows=r["resumed_rows"], resume_status=r["resume_status"],
+                 orphans=orphans, stray_temporaries=r["stray"])  # fmt: skip

@@ -81,6 +81,20 @@ def test_a_full_disk_is_one_line_with_the_rows_intact(tmp_path, monkeypatch, cap
     assert len(load_results(out)) == sweeps.EPISODES
 
 
+@pytest.mark.skipif(not sweeps.can_mount_tmpfs(), reason="cannot mount a tmpfs (unshare -rm)")
+def test_a_real_full_disk_is_one_line_and_resumes(tmp_path):
+    """A sweep (two workers) into a 64 KiB tmpfs mounted in a private namespace: the disk fills,
+    the sweep exits 2 with one line saying so, every row stored reads back, no temporary file
+    and no worker is left; with the tmpfs grown, the same command completes the grid."""
+    t = sweeps.full_tmpfs(tmp_path)
+    assert t is not None
+    lines = t.stderr.strip().splitlines()
+    assert t.status == 2 and len(lines) == 1, t.stderr
+    assert "No space left on device" in lines[0] and "disk is full" in lines[0]
+    assert t.rows < sweeps.EPISODES and t.stray_temporaries == [] and t.orphans == []
+    assert (t.resume_status, t.resumed_rows) == (0, sweeps.EPISODES)
+
+
 def test_stale_temporaries_go_and_live_ones_stay(tmp_path):
     """remove_stale_temporaries deletes the temporary files of dead writers (and of the old
     pid-only format) but neither a live process's nor another host's."""

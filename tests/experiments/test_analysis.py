@@ -1,0 +1,115 @@
+"""A study's statistics (:mod:`fcplan.experiments.analysis`, :mod:`fcplan.experiments.statblocks`):
+pairs by instance, fractions of the oracle, rankings per metric, and their tables."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fcplan.experiments.analysis import (
+    RANKING_METRICS,
+    metric_rankings,
+    oracle_fractions,
+    paired_table,
+    results_pair_key,
+    separation,
+    study_stats,
+)
+from fcplan.experiments.statblocks import blocks, fixed_width
+
+
+def _rows(values: dict[str, list[float]], metric: str = "manual.final_score") -> list[dict]:
+    return [
+        {"scheduler": s, "scenario": "#1", "seed": k, metric: v}
+        for s, vals in values.items()
+        for k, v in enumerate(vals)
+    ]
+
+
+def _seed(row):
+    return row["seed"]
+
+
+def test_paired_table_uses_the_metric_direction():
+    """For a lower-is-better metric (burned area) the scheduler with the smaller values is the
+    better one; Holm runs over the pairs of that metric."""
+    rng = np.random.default_rng(1)
+    base = rng.normal(500, 50, 20)
+    metric = "outcome.burned_area_cells"
+    rows = _rows({"a": base - 40 + rng.normal(0, 5, 20), "b": base, "c": base + 1}, metric)
+    ab, ac, bc = paired_table(rows, ["a", "b", "c"], metric, _seed)
+    assert ab.verdict() == "a better" and ac.verdict() == "a better"
+    assert not ab.higher_is_better and ab.family == 3
+    assert bc.verdict() == "b better"  # b is 1 cell smaller on every pair
+
+
+def test_oracle_fraction_per_instance_and_exclusions():
+    """The fraction is the mean of x_i / oracle_i over instances where the oracle's value is
+    positive; others are counted as excluded; 'above' counts instances beating the oracle."""
+    rows = _rows({"oracle": [200.0, 100.0, 0.0, 50.0], "g": [100.0, 100.0, -5.0, 60.0]})
+    (f,) = oracle_fractions(rows, ["oracle", "g"], "oracle", "manual.final_score", _seed)
+    assert f.fraction.n == 3 and f.excluded == 1 and f.above == 1
+    assert f.fraction.mean == pytest.approx((0.5 + 1.0 + 1.2) / 3)
+    assert f.ratio_of_means == pytest.approx(260 / 350)
+
+
+def test_rankings_order_by_direction_and_name_the_separating_metric():
+    """Schedulers are ordered best first in each metric's direction; the sentence names the
+    metric with most differing pairs, and the headline's count when another metric wins."""
+    rng = np.random.default_rng(9)
+    n = 30
+    noise = rng.normal(0, 30, (3, n))
+    rows = []
+    for i, s in enumerate(["a", "b", "c"]):
+        for k in range(n):
+            rows.append(
+                {
+                    "scheduler": s,
+                    "seed": k,
+                    "manual.final_score": 250 + noise[i, k],  # no real difference
+                    "outcome.burned_area_cells": 300 + 100 * i + rng.normal(0, 5),
+                }
+            )
+    ranked = metric_rankings(rows, ["c", "a", "b"], RANKING_METRICS, _seed)
+    assert [r.metric for r in ranked] == ["manual.final_score", "outcome.burned_area_cells"]
+    burned = ranked[1]
+    assert burned.order == ("a", "b", "c") and burned.chain() == "a > b > c"
+    assert burned.significant == 3 and burned.friedman.p < 1e-6
+    assert burned.friedman.w == pytest.approx(1.0)
+    text = separation(ranked)
+    assert text.startswith("burned separates the schedulers best: 3 of 3 pair(s) differ")
+    assert "the headline final score separates" in text
+
+
+def test_study_stats_leaves_the_oracle_out_of_pairs_and_rankings():
+    """The reference scheduler is not compared or ranked; it is the denominator of the
+    fractions; the blocks are the paired table, the fractions and the ranking."""
+    rows = _rows(
+        {
+            "oracle": [280.0, 270.0, 275.0, 290.0, 285.0, 278.0],
+            "a": [250.0, 240.0, 260.0, 255.0, 245.0, 252.0],
+            "b": [200.0, 190.0, 210.0, 205.0, 199.0, 201.0],
+        }
+    )
+    st = study_stats(
+        rows, ["oracle", "a", "b"], ["manual.final_score"], _seed, references=["oracle"]
+    )
+    assert st.policies == ("a", "b") and st.oracle == "oracle"
+    assert [(c.a, c.b) for c in st.paired["manual.final_score"]] == [("a", "b")]
+    assert [f.scheduler for f in st.fractions] == ["a", "b"]
+    assert all("oracle" not in r.order for r in st.rankings)
+    titles = [b.title for b in blocks(st)]
+    assert titles == ["Paired differences: final score", "Fraction of oracle", "Ranking per metric"]
+    text = fixed_width(*blocks(st)[1].cells)
+    assert text.splitlines()[1].startswith("a ")
+    records = st.paired_records()
+    assert records[0]["verdict"] == "a better" and records[0]["pairs"] == 6
+
+
+def test_results_pair_key_reads_missing_and_nan_as_none():
+    """Rows before study hashes and rows without a time limit pair with each other."""
+    a = {"scenario": "#1", "seed": 0, "overrides": "{}", "replan_period": 1.0}
+    b = {**a, "study_hash": float("nan"), "time_limit": math.nan}
+    assert results_pair_key(a) == results_pair_key(b)

@@ -1,0 +1,308 @@
+"""Run one ``fcplan`` command as an attacker's case: bounded, classified, orphans counted.
+
+:func:`run_cli` runs ``fcplan argv`` in a child process of its own session (so every process it
+starts, pool workers included, can be found afterwards by session id), with an address-space
+limit (``RLIMIT_AS``) and a wall-clock bound, and returns a :class:`Case`: the exit status, the
+stderr text, the child's peak resident memory (``wait4``'s ``ru_maxrss``), the seconds it took,
+the processes of its session still alive :data:`ORPHAN_GRACE_S` after it ended (killed, then
+counted as orphans) and its :class:`Outcome`.
+
+Two ways to start the child: ``fork=True`` forks this process and calls
+:func:`fcplan.cli.main` (no interpreter start-up: for the audit script, a single-threaded
+process), else a fresh ``python -m fcplan`` (for the test suite, whose workers have threads).
+:func:`run_in_process` runs :func:`fcplan.cli.main` in this process instead (fast, for the many
+small cases of the test suite): the time bound is a ``SIGALRM``, the memory measured is the peak
+of ``tracemalloc`` (Python and numpy allocations), orphans are this process's new children.
+
+Examples
+--------
+>>> import tempfile
+>>> case = run_cli(["run", "nosuch"], cwd=tempfile.mkdtemp(), timeout=120)
+>>> case.outcome, case.orphans
+('clean error', [])
+>>> case.first_line  # doctest: +ELLIPSIS
+"fcplan: error: ...nosuch..."
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import resource
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = [
+    "MEMORY_LIMIT",
+    "ORPHAN_GRACE_S",
+    "Case",
+    "Outcome",
+    "classify",
+    "run_cli",
+    "run_in_process",
+    "session_members",
+]
+
+ROOT = Path(__file__).resolve().parents[2]
+#: Address-space limit of a case's main process (bytes): far above any sane run, low enough
+#: that a runaway allocation fails in the child instead of swapping the machine.
+MEMORY_LIMIT = 6 * 2**30
+#: Seconds the processes a case started may outlive it (pool workers notice their parent's
+#: death within the watchdog period, 1 s) before they count as orphans.
+ORPHAN_GRACE_S = 5.0
+
+
+class Outcome:
+    """Categories of what a command did with a bad input (the audit's columns)."""
+
+    CLEAN = "clean error"  # exit 2, one line on stderr, no traceback
+    RAN = "ran"  # exit 0
+    TRACEBACK = "traceback"  # anything else that printed a traceback or exited otherwise
+    HANG = "hang"  # over the time bound
+    OOM = "OOM"  # out of memory (a MemoryError, or killed by the memory limit)
+    ORPHAN = "orphan"  # a child process outlived its parent
+    ALL = (CLEAN, RAN, TRACEBACK, HANG, OOM, ORPHAN)
+
+
+def classify(status: int | None, stderr: str) -> str:
+    """The :class:`Outcome` of a command that exited with ``status`` (None: killed for taking
+    too long) and wrote ``stderr``.
+
+    Examples
+    --------
+    >>> classify(2, "fcplan: error: x.toml: world_size must be ...\\n")
+    'clean error'
+    >>> classify(1, "Traceback (most recent call last):\\n ...")
+    'traceback'
+    >>> classify(None, ""), classify(0, "progress\\n")
+    ('hang', 'ran')
+    """
+    if status is None:
+        return Outcome.HANG
+    if "MemoryError" in stderr or "out of memory" in stderr or status in (-9, 137):
+        return Outcome.OOM
+    if "Traceback" in stderr:
+        return Outcome.TRACEBACK
+    lines = [ln for ln in stderr.splitlines() if ln.strip()]
+    if status == 2 and len(lines) == 1 and lines[0].startswith("fcplan: error: "):
+        return Outcome.CLEAN
+    if status == 0:
+        return Outcome.RAN
+    return Outcome.TRACEBACK
+
+
+@dataclass
+class Case:
+    """What one command did: see the module docstring."""
+
+    argv: list[str]
+    outcome: str
+    status: int | None
+    stderr: str
+    seconds: float
+    peak_mb: float
+    orphans: list[int] = field(default_factory=list)
+
+    @property
+    def first_line(self) -> str:
+        """The first non-blank stderr line (cut to 200 characters)."""
+        return next((ln for ln in self.stderr.splitlines() if ln.strip()), "")[:200]
+
+    @property
+    def error_lines(self) -> list[str]:
+        """The non-blank stderr lines that are not progress lines."""
+        lines = [ln for ln in self.stderr.splitlines() if ln.strip()]
+        return [ln for ln in lines if not ln.startswith(("compare: ", "sweep: "))]
+
+
+def _stat(pid: int) -> list[str] | None:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return None
+
+
+def session_members(sid: int) -> list[int]:
+    """Pids of the live (non-zombie) processes in session ``sid`` (Linux ``/proc``)."""
+    out = []
+    for d in Path("/proc").iterdir():
+        fields = _stat(int(d.name)) if d.name.isdigit() else None
+        if fields is not None and fields[0] != "Z" and int(fields[3]) == sid:
+            out.append(int(d.name))
+    return out
+
+
+def _orphans(sid: int, grace: float) -> list[int]:
+    """The processes of session ``sid`` alive ``grace`` seconds from now (then killed)."""
+    deadline = time.monotonic() + grace
+    while (left := session_members(sid)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    for pid in left:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+    return left
+
+
+def _limit(memory: int) -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+
+
+def _forked(
+    argv: list[str], memory: int, err: int, prepare: Callable[[], None] | None, cwd: str
+) -> int:
+    """Start ``fcplan argv`` in a forked child (its own session, in ``cwd``); its pid."""
+    pid = os.fork()
+    if pid:
+        return pid
+    code = 1
+    try:  # the child: never returns
+        os.setsid()
+        os.chdir(cwd)
+        with contextlib.suppress(OSError):  # peak RSS from now on, not the parent's (Linux)
+            Path("/proc/self/clear_refs").write_text("5")
+        _limit(memory)
+        os.dup2(err, 2)
+        os.dup2(os.open(os.devnull, os.O_RDWR), 1)
+        os.dup2(os.open(os.devnull, os.O_RDONLY), 0)
+        if prepare is not None:
+            prepare()
+        from fcplan.cli import main
+
+        code = main(argv)
+    except BaseException:  # noqa: BLE001 - anything escaping main is the finding
+        traceback.print_exc()
+    finally:
+        sys.stderr.flush()
+        os._exit(code)
+
+
+def _spawned(argv: list[str], memory: int, err: int, env: dict[str, str] | None, cwd: str) -> int:
+    """Start ``python -m fcplan argv`` (its own session, in ``cwd``); its pid."""
+    full = {**os.environ, **(env or {})}
+    full["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), full.get("PYTHONPATH", "")) if p)
+    proc = subprocess.Popen(  # noqa: S603 - our own interpreter and module
+        [sys.executable, "-m", "fcplan", *argv],
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=err,
+        env=full,
+        cwd=cwd,
+        start_new_session=True,
+        preexec_fn=lambda: _limit(memory),  # noqa: PLW1509 - only setrlimit
+    )
+    proc.returncode = 0  # reaped below with wait4; Popen must not wait for it again
+    return proc.pid
+
+
+def run_cli(
+    argv: list[str],
+    *,
+    cwd: str | os.PathLike[str],
+    timeout: float,
+    memory: int = MEMORY_LIMIT,
+    fork: bool = False,
+    prepare: Callable[[], None] | None = None,
+    env: dict[str, str] | None = None,
+    grace: float = ORPHAN_GRACE_S,
+) -> Case:
+    """Run ``fcplan argv`` in the folder ``cwd`` as a bounded case (see the module docstring).
+
+    ``cwd`` should be a scratch folder: relative paths in hostile arguments (an output named
+    ``nan`` or ``-1``) land there. ``prepare`` runs in a forked child before the command (``fork=True`` only), e.g. to inject a
+    fault; ``env`` adds environment variables (spawned children only). A case over ``timeout``
+    seconds is killed with its whole process group and is a hang.
+    """
+    if (prepare is not None and not fork) or (env is not None and fork):
+        raise ValueError("prepare needs fork=True and env needs fork=False")
+    with tempfile.TemporaryFile() as err:
+        t0 = time.monotonic()
+        if fork:
+            pid = _forked(argv, memory, err.fileno(), prepare, os.fspath(cwd))
+        else:
+            pid = _spawned(argv, memory, err.fileno(), env, os.fspath(cwd))
+        status, rss_kb = None, 0
+        while time.monotonic() - t0 < timeout:
+            done, raw, usage = os.wait4(pid, os.WNOHANG)
+            if done:
+                status, rss_kb = os.waitstatus_to_exitcode(raw), usage.ru_maxrss
+                break
+            time.sleep(0.02)
+        else:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(pid, signal.SIGKILL)
+            rss_kb = os.wait4(pid, 0)[2].ru_maxrss
+        seconds = time.monotonic() - t0
+        orphans = _orphans(pid, grace)
+        err.seek(0)
+        text = err.read().decode("utf-8", "replace")
+    outcome = Outcome.ORPHAN if orphans else classify(status, text)
+    return Case(list(argv), outcome, status, text, seconds, rss_kb / 1024, orphans)
+
+
+class _HangError(Exception):
+    pass
+
+
+def _children() -> set[int]:
+    """Live (non-zombie) child processes of this process."""
+    me = os.getpid()
+    out = set()
+    for d in Path("/proc").iterdir():
+        fields = _stat(int(d.name)) if d.name.isdigit() else None
+        if fields is not None and fields[0] != "Z" and int(fields[1]) == me:
+            out.add(int(d.name))
+    return out
+
+
+def run_in_process(argv: list[str], *, timeout: int, grace: float = ORPHAN_GRACE_S) -> Case:
+    """Run :func:`fcplan.cli.main` on ``argv`` here (main thread only; see the module docstring).
+
+    Examples
+    --------
+    >>> run_in_process(["run", "nosuch"], timeout=60).outcome
+    'clean error'
+    """
+    import io
+    import tracemalloc
+
+    from fcplan.cli import main
+
+    def stop(signum, frame):
+        raise _HangError()
+
+    before = _children()
+    err, status = io.StringIO(), None
+    previous = signal.signal(signal.SIGALRM, stop)
+    tracemalloc.start()
+    t0 = time.monotonic()
+    signal.alarm(timeout)
+    try:
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            status = main(argv)
+    except _HangError:
+        status = None
+    except BaseException:  # noqa: BLE001 - anything escaping main is the finding
+        err.write(traceback.format_exc())
+        status = 1
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+        seconds = time.monotonic() - t0
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+    deadline = time.monotonic() + grace
+    while (left := _children() - before) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    for pid in left:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+    text = err.getvalue()
+    outcome = Outcome.ORPHAN if left else classify(status, text)
+    return Case(list(argv), outcome, status, text, seconds, peak / 2**20, sorted(left))
