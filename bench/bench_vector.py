@@ -135,16 +135,18 @@ def _batched(env: Any, n_steps: int, parts: list, seed: int) -> tuple[int, Clock
     return env.num_envs * n_steps, clock
 
 
-def memory_per_world(sc: Any, small: int, large: int) -> tuple[float, float]:
+def memory_per_world(sc: Any, small: int, large: int, level: str = "motion") -> tuple[float, float]:
     """(bytes per added world, bytes of the rest) of a stepped batched env, by tracemalloc."""
     sizes = []
+    make = VectorMotionEnv if level == "motion" else VectorTaskEnv
     for num in (small, large):
         gc.collect()
         tracemalloc.start()
-        env = VectorMotionEnv(sc, num)
+        env = make(sc, num)
         obs, _ = env.reset(seed=0)
         for _ in range(5):
-            obs, *_ = env.step(np.zeros((num, len(env.agent_ids)), dtype=np.int64))
+            m = obs["action_mask"]
+            obs, *_ = env.step((m * np.arange(m.shape[2])).argmax(axis=2))
         sizes.append(tracemalloc.get_traced_memory()[0])
         tracemalloc.stop()
         del env, obs
