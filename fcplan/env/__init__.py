@@ -12,6 +12,11 @@ Two levels of control over the same simulator:
     The 2020 MARL package's grid environments (``base``, ``cmplx1``, ``cmplx2``) are its presets
     (:mod:`fcplan.env.presets`).
 
+Batched: :func:`vector_env` (:mod:`fcplan.env.vector`) runs ``B`` worlds per call on
+:class:`fcplan.batch.BatchWorld` as a ``gymnasium.vector.VectorEnv``, world ``i`` bit-identical
+to the single env with seed ``s + i``; ``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B)``
+makes it too.
+
 Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with a centralised
 joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any
 registered scheduler, stored as npz without pickle) and :mod:`fcplan.env.bc` (a small numpy
@@ -64,6 +69,9 @@ __all__ = [
     "replay_actions",
     "PlanFollower",
     "VERSIONED",
+    "vector_env",
+    "VectorMotionEnv",
+    "VectorTaskEnv",
 ]
 
 #: Environment levels accepted by :func:`parallel_env`.
@@ -79,6 +87,9 @@ _LAZY = {
     "Demonstrations": "fcplan.env.demonstrations",
     "replay_actions": "fcplan.env.demonstrations",
     "PlanFollower": "fcplan.env.motion_expert",
+    "vector_env": "fcplan.env.vector",
+    "VectorMotionEnv": "fcplan.env.vector_motion",
+    "VectorTaskEnv": "fcplan.env.vector_task",
 }
 
 

@@ -63,12 +63,20 @@ from typing import Any
 
 import numpy as np
 
+from fcplan.env.demo_episodes import (
+    EpisodeRecord,
+    batched_rollouts,
+    env_kwargs_from_metadata,
+    recording_episode,
+    rollout_episode,
+    scenario_from_metadata,
+)
 from fcplan.env.task import TaskEnv
-from fcplan.env.task_actions import MappingCounts, plan_to_actions
+from fcplan.env.task_actions import MappingCounts
 from fcplan.env.task_candidates import AGENT_FEATURES, TASK_FEATURES
 from fcplan.errors import FcplanError
 from fcplan.mission import ScenarioLike, as_scenario
-from fcplan.scheduling import Scheduler, make_scheduler, parse_scheduler_spec, solve
+from fcplan.scheduling import Scheduler, make_scheduler, parse_scheduler_spec
 
 __all__ = [
     "Demonstrations",
@@ -204,7 +212,11 @@ def demonstrations(
     *,
     time_limit: float | None = None,
     env_kwargs: dict[str, Any] | None = None,
-) -> Demonstrations:
+    recordings: Iterable[Any] = (),
+    format: str = "npz",
+    dataset_id: str | None = None,
+    num_envs: int = 1,
+) -> Any:
     """Roll ``scheduler`` out through the task-level env on every (scenario, seed).
 
     Parameters
@@ -214,16 +226,32 @@ def demonstrations(
     scenarios : iterable of Scenario, str or int
     seeds : iterable of int
     path : str or Path, optional
-        Also save the dataset there (``.npz``).
+        Also save the dataset there: the ``.npz`` file, or with ``format="minari"`` the Minari
+        datasets root (default: Minari's own, ``MINARI_DATASETS_PATH`` or ``~/.minari/datasets``).
     time_limit : float, optional
         Seconds per scheduler call (passed to the scheduler).
     env_kwargs : dict, optional
         :class:`TaskEnv` keyword arguments (``k``, ``replan_period``, ``max_steps`` ...).
+    recordings : iterable of fcplan.recording.Recording
+        Recorded games (a human's: ``source="human"``) added as episodes of the same dataset
+        (:func:`fcplan.env.demo_episodes.recording_episode`), after the scheduler's.
+    format : {"npz", "minari"}
+        ``"npz"``: the :class:`Demonstrations` rows (module docstring); ``"minari"``: a Minari
+        dataset (:mod:`fcplan.env.demo_minari`; needs ``pip install fcplan[minari]``).
+    dataset_id : str, optional
+        The Minari dataset id (``format="minari"``; default ``"fcplan/task/<scheduler>-v0"``).
+    num_envs : int
+        Roll up to this many seeds of a scenario out at once in a batched task env
+        (:func:`fcplan.env.demo_episodes.batched_rollouts`, one scheduler instance per world);
+        the dataset is the one ``num_envs=1`` gives, for schedulers that keep no state between
+        episodes.
 
     Returns
     -------
-    Demonstrations
+    Demonstrations, or minari.MinariDataset with ``format="minari"``
     """
+    if format not in ("npz", "minari"):
+        raise DemonstrationError(f"format: must be 'npz' or 'minari' (got {format!r})")
     sched, name, settings = _scheduler(scheduler)
     env_kwargs = dict(env_kwargs or {})
     env_kwargs.pop("render_mode", None)
@@ -232,14 +260,18 @@ def demonstrations(
     scen_docs: dict[str, dict[str, Any]] = {}
     for sc in scenarios:
         scenario = as_scenario(sc)
-        doc = scenario.to_dict()
-        key = scenario.name
-        while key in scen_docs and scen_docs[key] != doc:  # same name, other content
-            key += "'"
-        scen_docs[key] = doc
+        key = _scenario_key(scen_docs, scenario)
+        if num_envs > 1:
+            rollouts.add_batched(scenario, scheduler, key, seeds, int(num_envs), env_kwargs)
+            continue
         env = TaskEnv(scenario, **env_kwargs)
         for seed in seeds:
-            rollouts.play(env, key, seed)
+            rollouts.add(rollout_episode(env, sched, key, seed, time_limit=time_limit,
+                                         counts=rollouts.counts))  # fmt: skip
+    for rec in recordings:
+        scenario = rec.scenario
+        key = _scenario_key(scen_docs, scenario)
+        rollouts.add(recording_episode(rec, TaskEnv(scenario, **env_kwargs), key))
     meta = {
         "format": "fcplan-demonstrations",
         "version": FORMAT_VERSION,
@@ -257,59 +289,80 @@ def demonstrations(
         "scenarios": scen_docs,
         "versions": _versions(),
     }
+    if format == "minari":
+        from fcplan.env.demo_minari import write_minari
+
+        return write_minari(rollouts.records, meta, dataset_id or f"fcplan/task/{name}-v0", path)
     demo = Demonstrations(rollouts.arrays(), meta)
     if path is not None:
         demo.save(path)
     return demo
 
 
+def _scenario_key(docs: dict[str, dict[str, Any]], scenario: Any) -> str:
+    """The dataset's key of ``scenario`` (its name, primed while another one holds it)."""
+    doc = scenario.to_dict()
+    key = scenario.name
+    while key in docs and docs[key] != doc:  # same name, other content
+        key += "'"
+    docs[key] = doc
+    return str(key)
+
+
 class _Rollouts:
-    """The rows, mapping counts and episode records of a scheduler's env rollouts."""
+    """The rows, mapping counts and episode records of a dataset's episodes."""
 
     def __init__(self, scheduler: Scheduler, time_limit: float | None) -> None:
         self.scheduler, self.time_limit = scheduler, time_limit
         self.parts: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
         self.episodes: list[dict[str, Any]] = []
+        self.records: list[EpisodeRecord] = []
         self.counts = MappingCounts()
         self.fallbacks = self.conflicts = 0
 
-    def play(self, env: TaskEnv, scenario_key: str, seed: int) -> None:
-        """One episode of ``env`` with ``seed``: the scheduler's plan on the env's graph at each
-        step, mapped to actions one to one (module docstring)."""
-        parts, ids = self.parts, env.possible_agents
-        env.reset(seed=seed)
-        rng = env.world.controller_rng
-        ep, n_a = len(self.episodes), env.n_agents
-        step = 0
-        first: dict[str, Any] = {}
-        while env.agents:
-            graph, cand = env.graph, env.candidates
-            assert graph is not None and cand is not None  # (built by reset and step)
-            plan = solve(self.scheduler, graph, time_limit=self.time_limit, rng=rng)
-            self.fallbacks += getattr(plan.stats, "status", None) == "fallback"
-            act = plan_to_actions(plan, graph, cand, self.counts)
-            parts["agent_obs"].append(env._agent_obs)
-            parts["task_obs"].append(env._task_obs)
-            parts["mask"].append(env._mask)
-            parts["action"].append(act)
-            _, rew, _, trunc, infos = env.step(dict(zip(ids, act.tolist(), strict=True)))
-            first = infos[ids[0]]
-            self.conflicts += sum(infos[a]["conflict"] for a in ids)
-            parts["reward"].append(np.full(n_a, rew[ids[0]]))
-            parts["done"].append(np.full(n_a, trunc[ids[0]]))
-            parts["episode"].append(np.full(n_a, ep))
-            parts["step"].append(np.full(n_a, step))
-            parts["agent"].append(np.arange(n_a))
-            step += 1
+    def add(self, rec: EpisodeRecord) -> None:
+        """Append one episode: its rows (one per step and agent) and its record."""
+        parts, ep = self.parts, len(self.episodes)
+        n, n_a = rec.steps, rec.actions.shape[1]
+        obs = rec.observations
+        parts["agent_obs"].append(obs["agents"][:n].reshape(n * n_a, -1))
+        parts["task_obs"].append(obs["tasks"][:n].reshape(n * n_a, *obs["tasks"].shape[2:]))
+        parts["mask"].append(obs["action_mask"][:n].reshape(n * n_a, -1))
+        parts["action"].append(rec.actions.reshape(-1))
+        parts["reward"].append(np.repeat(rec.rewards, n_a))
+        parts["done"].append(np.repeat(np.arange(n) == n - 1, n_a))
+        parts["episode"].append(np.full(n * n_a, ep))
+        parts["step"].append(np.repeat(np.arange(n), n_a))
+        parts["agent"].append(np.tile(np.arange(n_a), n))
+        self.conflicts += int(rec.conflict.sum())
+        self.fallbacks += rec.fallbacks
+        self.records.append(rec)
         self.episodes.append(
             {
-                "scenario": scenario_key,
-                "seed": seed,
-                "steps": step,
-                "metrics": first["metrics"],
-                "return": first["return"],
+                "scenario": rec.scenario,
+                "seed": rec.seed,
+                "steps": n,
+                "metrics": rec.metrics,
+                "return": rec.return_,
+                "source": rec.source,
             }
         )
+
+    def add_batched(self, scenario: Any, spec: Any, key: str, seeds: list[int], num: int,
+                    env_kwargs: dict[str, Any]) -> None:  # fmt: skip
+        """The episodes of ``seeds`` on ``scenario``, ``num`` at a time in a batched env."""
+        import copy
+
+        from fcplan.env.vector_task import VectorTaskEnv
+
+        for i in range(0, len(seeds), num):
+            chunk = seeds[i : i + num]
+            env = VectorTaskEnv(scenario, len(chunk), autoreset_mode="disabled", **env_kwargs)
+            scheds = [_scheduler(spec)[0] if isinstance(spec, str) else copy.deepcopy(spec)
+                      for _ in chunk]  # fmt: skip
+            for rec in batched_rollouts(env, scheds, key, chunk, time_limit=self.time_limit,
+                                        counts=self.counts):  # fmt: skip
+                self.add(rec)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The dataset's arrays (module docstring), rows of every episode in order."""
@@ -332,18 +385,9 @@ def _jsonable_kwargs(env_kwargs: dict[str, Any]) -> dict[str, Any]:
 def replay_actions(demo: Demonstrations, episode: int) -> dict[str, dict]:
     """Replay one episode's recorded actions through a fresh env; return its final metrics
     (``{"manual": {...}, "reference2020": {...}}``, as in ``infos[agent]["metrics"]``)."""
-    from fcplan.scenario import Scenario
-
     ep = demo.episodes[episode]
-    scenario = Scenario.from_dict(demo.metadata["scenarios"][ep["scenario"]])
-    kwargs = dict(demo.metadata["env_kwargs"])
-    if kwargs.get("graph_params") is not None:
-        from fcplan.taskgraph import TaskGraphParams
-
-        gp = dict(kwargs["graph_params"])
-        if gp.get("tile_px") is not None:
-            gp["tile_px"] = tuple(gp["tile_px"])
-        kwargs["graph_params"] = TaskGraphParams(**gp)
+    scenario = scenario_from_metadata(demo.metadata, ep["scenario"])
+    kwargs = env_kwargs_from_metadata(demo.metadata)
     env = TaskEnv(scenario, **kwargs)
     env.reset(seed=ep["seed"])
     rows = np.flatnonzero(demo.episode == episode)

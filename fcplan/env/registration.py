@@ -12,6 +12,11 @@ id                         environment                                     defau
 ``fcplan/MotionCmplx2-v0`` the ``cmplx2`` preset                            ``preset="cmplx2"``
 =========================  ==============================================  =====================
 
+``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` makes the batched env of
+:data:`VECTOR_ENTRY_POINTS` (:class:`fcplan.env.vector_motion.VectorMotionEnv`: ``B`` worlds in
+one call, each bit-identical to the single env with seed ``s + i``); ``vectorization_mode="sync"``
+gives Gymnasium's ``SyncVectorEnv`` of single envs instead.
+
 Any keyword of the environment goes through ``gymnasium.make``: ``gymnasium.make("fcplan/Task-v0",
 scenario=24, k=8)``, ``gymnasium.make("fcplan/MotionBase-v0", reward="rf1")``. Every id accepts
 ``render_mode="rgb_array"`` and ``render_mode="human"`` (:mod:`fcplan.env.human`).
@@ -37,7 +42,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["ENV_IDS", "register_envs"]
+__all__ = ["ENV_IDS", "VECTOR_ENTRY_POINTS", "register_envs"]
 
 _JOINT = "fcplan.env.joint_gym:JointGymEnv"
 
@@ -51,10 +56,23 @@ ENV_IDS: dict[str, tuple[str, dict[str, Any]]] = {
 }
 
 
+#: Gymnasium id -> the batched env ``gymnasium.make_vec`` makes (:mod:`fcplan.env.vector`).
+VECTOR_ENTRY_POINTS: dict[str, str] = {
+    "fcplan/Motion-v0": "fcplan.env.vector_motion:VectorMotionEnv",
+    "fcplan/Task-v0": "fcplan.env.vector_task:VectorTaskEnv",
+}
+
+
 def register_envs() -> None:
-    """Register every id of :data:`ENV_IDS` with Gymnasium (ids already there are kept)."""
+    """Register every id of :data:`ENV_IDS` with Gymnasium (ids already there are kept), with
+    its :data:`VECTOR_ENTRY_POINTS` entry if it has one."""
     import gymnasium
 
     for env_id, (entry_point, kwargs) in ENV_IDS.items():
         if env_id not in gymnasium.registry:
-            gymnasium.register(env_id, entry_point=entry_point, kwargs=dict(kwargs))
+            gymnasium.register(
+                env_id,
+                entry_point=entry_point,
+                vector_entry_point=VECTOR_ENTRY_POINTS.get(env_id),
+                kwargs=dict(kwargs),
+            )

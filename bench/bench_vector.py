@@ -1,0 +1,309 @@
+"""Benchmark the batched motion level: world-steps per second against the single env, same run.
+
+For scenarios #1 and #24 it plays, with random legal actions (drawn from the action masks; the
+draw is not timed):
+
+* the single env (:class:`fcplan.env.motion.MotionEnv`), ``--episodes`` whole episodes, timing
+  ``env.step`` only (resets excluded), and inside it the simulator (``Mission.step``);
+* :class:`fcplan.env.vector_motion.VectorMotionEnv` with ``B`` worlds for every ``B`` of
+  ``--sizes`` (default 1, 16, 64, 256, 1024), one whole episode of every world (the worlds start
+  together: ``n_ticks`` steps, next-step autoreset of all of them at the end included), timing
+  ``env.step`` and inside it the batched simulator (``BatchWorld.step``).
+
+It prints world-steps per second (``B`` x steps / time) on the thread's CPU clock and on the wall
+clock with the load average (the machine may be shared: compare the CPU-time ratios), the ratio
+to the single env of the same scenario measured in the same run, the simulator alone (its ratio
+too), where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
+action decoding, rewards), and the memory per world (``tracemalloc``: the growth from the
+smallest to the largest ``B``, per added world; the tables every world shares are the rest).
+
+Usage::
+
+    python bench/bench_vector.py                       # about 4 minutes on a quiet 2-core machine
+    python bench/bench_vector.py --quick               # 30-s episodes, sizes 1, 16, 256
+    python bench/bench_vector.py --plot vector.png     # also plot throughput against B
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import gc
+import os
+import platform
+import time
+import tracemalloc
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+import fcplan.batch.fire as bfire
+import fcplan.batch.world as bworld
+import fcplan.env.vector_motion as vmotion
+import fcplan.env.vector_obs as vobs
+import fcplan.env.vector_task as vtask
+from fcplan.env.gym_view import TaskGymEnv
+from fcplan.env.motion import MotionEnv
+from fcplan.env.vector_motion import VectorMotionEnv
+from fcplan.env.vector_task import VectorTaskEnv
+from fcplan.scenario import load_scenario
+
+_CPU, _WALL = time.thread_time, time.perf_counter
+
+
+class Clock:
+    """CPU and wall seconds of timed sections."""
+
+    def __init__(self) -> None:
+        self.cpu: collections.Counter = collections.Counter()
+        self.wall: collections.Counter = collections.Counter()
+
+    def wrap(self, owner: Any, name: str, label: str) -> Callable[[], None]:
+        """Time every call of ``owner.name`` under ``label``; return the undo function."""
+        inner = getattr(owner, name)
+
+        def timed(*a: Any, **k: Any) -> Any:
+            c, w = _CPU(), _WALL()
+            out = inner(*a, **k)
+            self.cpu[label] += _CPU() - c
+            self.wall[label] += _WALL() - w
+            return out
+
+        setattr(owner, name, timed)
+        return lambda: setattr(owner, name, inner)
+
+    def step(self, fn: Callable[..., Any], *args: Any) -> Any:
+        """``fn(*args)``, timed under ``"step"``."""
+        c, w = _CPU(), _WALL()
+        out = fn(*args)
+        self.cpu["step"] += _CPU() - c
+        self.wall["step"] += _WALL() - w
+        return out
+
+
+def single_env(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
+    """Steps of ``episodes`` episodes of the single env with random legal actions, timed."""
+    env = MotionEnv(sc)
+    rng = np.random.default_rng(seed)
+    clock, steps = Clock(), 0
+    for ep in range(episodes):
+        obs, _ = env.reset(seed=seed + ep)
+        undo = clock.wrap(env.mission, "step", "sim")
+        while env.agents:
+            act = {a: int(rng.choice(np.flatnonzero(obs[a]["action_mask"]))) for a in env.agents}
+            obs, *_ = clock.step(env.step, act)
+            steps += 1
+        undo()
+    return steps, clock
+
+
+_PARTS = [
+    (bworld.BatchWorld, "step", "sim"),
+    (bworld.BatchWorld, "_fire_steps", "sim: fire"),
+    (bfire.BatchFire, "_refill", "sim: fire: wind blocks"),
+    (bfire.BatchFire, "_terrain", "sim: fire: terrain"),
+    (bfire.BatchFire, "ignite", "sim: fire: ignition"),
+    (bworld.BatchWorld, "_sense", "sim: sensing"),
+    (bworld.BatchWorld, "_prune", "sim: dumps"),
+    (bworld.BatchWorld, "_record", "sim: trace rows"),
+    (vobs.BatchMotionObs, "update", "obs: map updates"),
+    (vobs.BatchMotionObs, "observe", "obs: observe"),
+    (vobs.BatchMotionObs, "agent_arrays", "obs: observe: agent vectors, masks"),
+    (vmotion.VectorMotionEnv, "_decode", "actions"),
+    (vmotion.VectorMotionEnv, "_rewards", "rewards"),
+]
+
+
+def batched_env(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int, Clock]:
+    """World-steps of one whole motion-level episode of ``num`` worlds (and the autoreset
+    step), timed."""
+    return _batched(VectorMotionEnv(sc, num), sc.n_ticks + 1, _PARTS if parts else _PARTS[:1], seed)
+
+
+def _batched(env: Any, n_steps: int, parts: list, seed: int) -> tuple[int, Clock]:
+    """``n_steps`` steps of a batched env with random legal actions, ``parts`` timed too."""
+    rng = np.random.default_rng(seed)
+    clock = Clock()
+    undo = [clock.wrap(o, n, lab) for o, n, lab in parts]
+    obs, _ = env.reset(seed=seed)
+    for _ in range(n_steps):
+        m = obs["action_mask"]
+        obs, *_ = clock.step(env.step, (rng.random(m.shape) * m).argmax(axis=2))
+    for u in undo:
+        u()
+    return env.num_envs * n_steps, clock
+
+
+def memory_per_world(sc: Any, small: int, large: int, level: str = "motion") -> tuple[float, float]:
+    """(bytes per added world, bytes of the rest) of a stepped batched env, by tracemalloc."""
+    sizes = []
+    make = VectorMotionEnv if level == "motion" else VectorTaskEnv
+    for num in (small, large):
+        gc.collect()
+        tracemalloc.start()
+        env = make(sc, num)
+        obs, _ = env.reset(seed=0)
+        for _ in range(5):
+            m = obs["action_mask"]
+            obs, *_ = env.step((m * np.arange(m.shape[2])).argmax(axis=2))
+        sizes.append(tracemalloc.get_traced_memory()[0])
+        tracemalloc.stop()
+        del env, obs
+    per = (sizes[1] - sizes[0]) / (large - small)
+    return per, sizes[0] - small * per
+
+
+def single_task(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
+    """Steps of ``episodes`` episodes of ``fcplan/Task-v0`` with random legal actions, timed."""
+    env = TaskGymEnv(sc)
+    rng = np.random.default_rng(seed)
+    clock, steps = Clock(), 0
+    for ep in range(episodes):
+        obs, _ = env.reset(seed=seed + ep)
+        undo = clock.wrap(env.env.mission.world, "step", "sim")
+        done = False
+        while not done:
+            m = obs["action_mask"]
+            obs, _, _, done, _ = clock.step(env.step, (rng.random(m.shape) * m).argmax(axis=1))
+            steps += 1
+        undo()
+    return steps, clock
+
+
+_TASK_PARTS = [
+    (bworld.BatchWorld, "step", "sim"),
+    (vtask.VectorTaskEnv, "_beliefs", "beliefs (per world)"),
+    (vtask.VectorTaskEnv, "_observe", "graph, candidates, features (per world)"),
+    (vtask.VectorTaskEnv, "_command", "actions to commands (per world)"),
+    (vtask.VectorTaskEnv, "_rewards", "rewards"),
+]
+
+
+def batched_task(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int, Clock]:
+    """World-steps of one whole task-level episode of ``num`` worlds (and the autoreset step)."""
+    env = VectorTaskEnv(sc, num)
+    return _batched(env, env.one.max_steps + 1, _TASK_PARTS if parts else _TASK_PARTS[:1], seed)
+
+
+def mpe_rate(steps: int = 5000, seed: int = 0) -> float | None:
+    """Steps per CPU second of PettingZoo MPE ``simple_spread`` (3 agents, random actions,
+    25-step episodes), or None when ``mpe2`` is not installed (``pip install --no-deps mpe2``)."""
+    try:
+        from mpe2 import simple_spread_v3
+    except ImportError:
+        return None
+    env = simple_spread_v3.parallel_env(N=3, max_cycles=25)
+    rng = np.random.default_rng(seed)
+    obs, _ = env.reset(seed=seed)
+    busy, n = 0.0, 0
+    while n < steps:
+        if not env.agents:
+            env.reset()
+        act = {a: int(rng.integers(env.action_space(a).n)) for a in env.agents}
+        c = _CPU()
+        env.step(act)
+        busy += _CPU() - c
+        n += 1
+    return n / busy
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="30-s episodes, sizes 1, 16, 256")
+    ap.add_argument("--sizes", type=int, nargs="+", default=None, help="batch sizes B")
+    ap.add_argument("--episodes", type=int, default=2, help="single-env episodes")
+    ap.add_argument("--scenarios", nargs="+", default=["1", "24"])
+    ap.add_argument("--levels", nargs="+", default=["motion", "task"], choices=["motion", "task"])
+    ap.add_argument("--task-max", type=int, default=256, help="largest B at the task level")
+    ap.add_argument("--plot", default=None, help="write a plot of throughput against B here")
+    args = ap.parse_args(argv)
+    sizes = args.sizes or ([1, 16, 256] if args.quick else [1, 16, 64, 256, 1024])
+    print(f"# batched motion level, random legal actions; Python {platform.python_version()}, "
+          f"numpy {np.__version__}; load average at start {os.getloadavg()[0]:.2f}")  # fmt: skip
+    print("# world-steps/s on the thread CPU clock (wall clock); ratio = CPU-time world-steps/s "
+          "over the single env's in this run")  # fmt: skip
+    results: dict[str, list[tuple[int, float]]] = {}
+    for level in args.levels:
+        for name in args.scenarios:
+            sc = load_scenario(name)
+            if args.quick:
+                sc = sc.replace(duration_s=30)
+            sizes_l = [n for n in sizes if level == "motion" or n <= args.task_max]
+            results[f"{level} #{name}"] = _level(level, sc, name, sizes_l, args.episodes)
+    sc = load_scenario(args.scenarios[0])
+    per, rest = memory_per_world(sc, 16, 64 if args.quick else 256)
+    print(
+        f"\nmemory, motion level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
+        f"{rest / 1e6:.1f} MB shared (terrain jump tables, maps, team constants)"
+    )
+    mpe = mpe_rate()
+    if mpe is None:
+        print("MPE simple_spread: skipped (pip install --no-deps mpe2)")
+    else:
+        print(
+            f"MPE simple_spread (PettingZoo, 3 agents, random actions): {mpe:.0f} steps per "
+            f"CPU second (load {os.getloadavg()[0]:.2f})"
+        )
+        for key, rows in results.items():
+            num, rate = rows[-1]
+            print(f"  {key}: single env {rows[0][1] / mpe:.2f}x MPE, B={num} {rate / mpe:.1f}x MPE")
+    if args.plot:
+        _plot(results, args.plot)
+        print(f"plot: {args.plot}")
+    return 0
+
+
+def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int) -> list:
+    """Print one level's table on one scenario; return ``[(0, single rate), (B, rate), ...]``."""
+    single, batched, parts = (
+        (single_env, batched_env, _PARTS)
+        if level == "motion"
+        else (single_task, batched_task, _TASK_PARTS)
+    )
+    steps, clock = single(sc, episodes)
+    base, base_sim = steps / clock.cpu["step"], steps / clock.cpu["sim"]
+    print(f"\n## {level} level, #{name}  (load {os.getloadavg()[0]:.2f})")
+    print(f"{'env':14s} {'world-steps/s':>22s} {'ratio':>7s} {'sim world-steps/s':>19s} "
+          f"{'sim ratio':>9s} {'us/world-step':>13s}")  # fmt: skip
+    print(f"{'single':14s} {base:10.0f} ({steps / clock.wall['step']:9.0f}) {1.0:7.2f} "
+          f"{base_sim:19.0f} {1.0:9.2f} {1e6 / base:13.2f}")  # fmt: skip
+    rows = [(0, base)]
+    for num in sizes:
+        ws, clock = batched(sc, num, parts=num == sizes[-1])
+        rate, sim = ws / clock.cpu["step"], ws / clock.cpu["sim"]
+        print(f"{'B=' + str(num):14s} {rate:10.0f} ({ws / clock.wall['step']:9.0f}) "
+              f"{rate / base:7.2f} {sim:19.0f} {sim / base_sim:9.2f} {1e6 / rate:13.2f}")  # fmt: skip
+        rows.append((num, rate))
+    n_steps = ws // sizes[-1]
+    print(f"where a step goes at B={sizes[-1]} (CPU ms per step; % of env.step):")
+    for label in [lab for _, _, lab in parts]:
+        ms = clock.cpu[label] / n_steps * 1e3
+        print(f"  {label:40s} {ms:9.3f}  {100 * clock.cpu[label] / clock.cpu['step']:5.1f}%")
+    return rows
+
+
+def _plot(results: dict[str, list[tuple[int, float]]], path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for k, (name, rows) in enumerate(results.items()):
+        xs = [b for b, _ in rows[1:]]
+        ax.plot(xs, [r for _, r in rows[1:]], "o-", color=f"C{k}", label=f"batched, {name}")
+        ax.axhline(rows[0][1], color=f"C{k}", ls="--", label=f"single env, {name}")
+    ax.set_xscale("log", base=2)
+    ax.set_yscale("log")
+    ax.set_xlabel("worlds per batch B")
+    ax.set_ylabel("world-steps per CPU second")
+    ax.set_title("fcplan: batched vs single env (world-steps per CPU second)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

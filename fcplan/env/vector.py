@@ -1,0 +1,74 @@
+"""Batched environments: ``B`` worlds per call, for learners that need 10^7-10^9 steps.
+
+:func:`vector_env` makes a ``gymnasium.vector.VectorEnv`` whose worlds all run in one
+:class:`fcplan.batch.BatchWorld` (every per-tick array has a leading batch axis; no Python loop
+over worlds on the per-tick path):
+
+``mode="motion"`` (:class:`fcplan.env.vector_motion.VectorMotionEnv`)
+    One step is one tick of every world; actions ``(B, N)``, observations ``(B, N, ...)`` with
+    action masks. World ``i`` is bit for bit ``fcplan/Motion-v0`` (the centralised view of
+    :class:`fcplan.env.motion.MotionEnv`) with seed ``s + i``.
+
+``mode="task"`` (:class:`fcplan.env.vector_task.VectorTaskEnv`)
+    One step is one replan period of every world; actions ``(B, A)`` candidate slots,
+    observations ``(B, A, ...)``; world ``i`` is ``fcplan/Task-v0`` with seed ``s + i``. The
+    ticks are batched; the belief, task graph, candidates and features stay per world (that
+    module says why and ``bench/README.md`` measures it).
+
+``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` (and ``"fcplan/Task-v0"``)
+return the same classes (the ids' ``vector_entry_point``); ``vectorization_mode="sync"`` still
+gives Gymnasium's ``SyncVectorEnv`` of single envs, which the batched ones match step for step.
+
+Examples
+--------
+>>> import numpy as np
+>>> from fcplan.env import vector_env
+>>> env = vector_env("practice", mode="motion", num_envs=8)
+>>> obs, infos = env.reset(seed=0)
+>>> actions = env.action_space.sample()  # (8, 4): one action per world and agent
+>>> obs, rewards, terminations, truncations, infos = env.step(actions)
+>>> obs["fov"].shape, rewards.shape
+((8, 4, 7, 15, 15), (8,))
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fcplan.errors import EnvError
+
+__all__ = ["vector_env", "VECTOR_MODES"]
+
+#: levels :func:`vector_env` batches
+VECTOR_MODES = ("motion", "task")
+
+
+def vector_env(scenario: Any, mode: str = "motion", num_envs: int = 1, **kwargs: Any) -> Any:
+    """Make a batched ``gymnasium.vector.VectorEnv`` of ``num_envs`` worlds of ``scenario``.
+
+    Parameters
+    ----------
+    scenario : Scenario, str or int
+        A scenario or a name/path for :func:`fcplan.load_scenario`.
+    mode : {"motion", "task"}
+        The level (module docstring).
+    num_envs : int
+        Worlds ``B``.
+    **kwargs
+        The level's options (``autoreset_mode``; ``cell_px``, ``view``, ... at the motion level;
+        ``k``, ``replan_period``, ... at the task level).
+
+    Raises
+    ------
+    EnvError
+        For an unknown ``mode`` or a bad option.
+    """
+    if mode == "motion":
+        from fcplan.env.vector_motion import VectorMotionEnv
+
+        return VectorMotionEnv(scenario, num_envs, **kwargs)
+    if mode == "task":
+        from fcplan.env.vector_task import VectorTaskEnv
+
+        return VectorTaskEnv(scenario, num_envs, **kwargs)
+    raise EnvError(f"mode: must be one of {', '.join(VECTOR_MODES)} (got {mode!r})")

@@ -1,0 +1,359 @@
+"""Batched task level: ``B`` worlds of :class:`fcplan.env.task.TaskEnv` per call.
+
+:class:`VectorTaskEnv` is a ``gymnasium.vector.VectorEnv``: one step is one replan period of
+every world. World ``i`` is, observation for observation, reward for reward and episode for
+episode, ``fcplan/Task-v0`` (:class:`fcplan.env.gym_view.TaskGymEnv`) reset with seed ``s + i``
+and then reset without a seed at each episode end (the task env's own seed sequence), what
+``gymnasium.vector.SyncVectorEnv`` of that env gives, whatever ``B``.
+
+==================  ============================================================================
+Actions             ``(B, A)`` int: per world and agent a candidate slot ``0..k-1`` or ``k`` (the
+                    no-op), batched ``MultiDiscrete``; masked slots act as the no-op
+Observations        ``{"agents": (B, A, 17), "tasks": (B, A, k, 17), "action_mask":
+                    (B, A, k + 1) int8}``, the task env's features stacked
+Rewards             ``(B,)``: minus the manual's negative reward accrued during the step (plus
+                    ``prune_bonus`` per cell put out)
+Truncations         at the scenario's duration or ``max_steps``; ``terminations`` always False
+Infos               ``tick`` ``(B,)``, ``illegal`` and ``conflict`` ``(B, A)``; at an episode's end
+                    ``metrics`` and ``return`` (object arrays, ``_metrics``/``_return`` masks)
+Autoreset           as :class:`fcplan.env.vector_motion.VectorMotionEnv`: ``"next_step"``
+                    (default), ``"same_step"``, ``"disabled"`` (finished worlds held)
+==================  ============================================================================
+
+What is batched and what is not. The ticks of every world run in one
+:class:`fcplan.batch.BatchWorld` (team, fire, sensing, dumps, facility counts and the reward's
+counts: every per-tick array with a batch axis). Per world and per step, in a loop over the
+worlds, remain: the team's :class:`fcplan.belief.Belief` (updated every tick from the world's
+slice of the batch's tick, an exact :class:`fcplan.world.StepInfo`), the task graph
+(:class:`fcplan.taskgraph.TaskGraphBuilder`: clustering of known fire cells, a ``networkx`` view,
+per-graph distance tables), the ranked candidates and the feature tables
+(:mod:`fcplan.env.task_candidates`) and the decoding of actions into commands
+(:mod:`fcplan.env.task_actions`). These work on ragged per-world sets (clusters, tasks) through
+about a hundred small numpy calls per graph; ``bench/README.md`` measures their share.
+
+Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
+``watch_altitude``, ``search_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
+(masked actions always act as the no-op, as in ``fcplan/Task-v0``).
+
+Examples
+--------
+>>> import numpy as np
+>>> env = VectorTaskEnv("practice", num_envs=2, k=4)
+>>> obs, infos = env.reset(seed=0)
+>>> obs["tasks"].shape, obs["action_mask"].shape
+((2, 4, 4, 17), (2, 4, 5))
+>>> obs, rewards, terms, truncs, infos = env.step(np.full((2, 4), 4))  # everyone holds course
+>>> infos["tick"].tolist()
+[10, 10]
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
+
+from fcplan.batch import BatchStepInfo, BatchWorld
+from fcplan.belief import Belief
+from fcplan.env.task import TaskEnv
+from fcplan.env.task_actions import (
+    MappingCounts,
+    actions_plan,
+    decode_actions,
+    plan_to_actions,
+    rows_commands,
+)
+from fcplan.env.task_candidates import agent_features, rank_candidates, task_features
+from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows
+from fcplan.errors import EnvError
+from fcplan.metrics import facility_penalty, penalty_rate
+from fcplan.mission import ScenarioLike
+from fcplan.plan import validate_plan
+from fcplan.scheduling import Scheduler, solve
+from fcplan.taskgraph import TaskGraphBuilder
+from fcplan.team import Team
+from fcplan.world import StepInfo
+
+__all__ = ["VectorTaskEnv", "TeamView"]
+
+
+class TeamView:
+    """World ``b``'s team of a :class:`fcplan.batch.team.BatchTeam`, read as a
+    :class:`fcplan.team.Team` (what the task graph builder reads)."""
+
+    range_px = Team.range_px
+
+    def __init__(self, team: Any, b: int) -> None:
+        self._team, self._b = team, b
+        one = team.one
+        self.ids, self.home, self.role = one.ids, one.home, one.role
+        self.can_sense, self.can_act = one.can_sense, one.can_act
+        self.alt_lo, self.alt_hi, self.speed = one.alt_lo, one.alt_hi, one.speed
+        self.battery_capacity, self.tank_capacity = one.battery_capacity, one.tank_capacity
+
+    @property
+    def pos(self) -> np.ndarray:
+        return self._team.pos[self._b]
+
+    @property
+    def z(self) -> np.ndarray:
+        return self._team.z[self._b]
+
+    @property
+    def battery(self) -> np.ndarray:
+        return self._team.battery[self._b]
+
+    @property
+    def tank(self) -> np.ndarray:
+        return self._team.tank[self._b]
+
+    @property
+    def mode(self) -> np.ndarray:
+        return self._team.mode[self._b]
+
+
+class VectorTaskEnv(BatchedEnv):
+    """``num_envs`` task-level worlds of ``scenario`` stepped together (module docstring)."""
+
+    def __init__(
+        self,
+        scenario: ScenarioLike,
+        num_envs: int = 1,
+        *,
+        autoreset_mode: str | AutoresetMode = "next_step",
+        **kwargs: Any,
+    ) -> None:
+        self._setup(num_envs, autoreset_mode)
+        if kwargs.get("render_mode") is not None or kwargs.get("reward_fn") is not None:
+            raise EnvError("render_mode, reward_fn: not available in the batched task env")
+        kwargs["illegal_action"] = "noop"
+        #: the single env of the same options: its spaces and constants (it is never stepped)
+        self.one = one = TaskEnv(scenario, **kwargs)
+        self.scenario = sc = one.scenario
+        b, a, k = self.num_envs, one.n_agents, one.k
+        self.batch = BatchWorld(sc, b)
+        sub = one.observation_space(one.possible_agents[0])
+        lo, hi = float(sub["agent"].low.min()), float(sub["agent"].high.max())
+        self.single_observation_space = spaces.Dict(
+            {
+                "agents": spaces.Box(lo, hi, (a, *sub["agent"].shape), np.float32),
+                "tasks": spaces.Box(lo, hi, (a, *sub["tasks"].shape), np.float32),
+                "action_mask": spaces.Box(0, 1, (a, k + 1), np.int8),
+            }
+        )
+        self.single_action_space = spaces.MultiDiscrete(np.full(a, k + 1, dtype=np.int64))
+        self.observation_space = batch_space(self.single_observation_space, b)
+        self.action_space = batch_space(self.single_action_space, b)
+        self.teams = [TeamView(self.batch.team, i) for i in range(b)]
+        self._seed_seqs: list[np.random.SeedSequence | None] = [None] * b
+        self.beliefs: list[Belief] = [Belief(sc) for _ in range(b)]
+        self.builders = [TaskGraphBuilder(sc, one.graph_params) for _ in range(b)]
+        self.graphs: list[Any] = [None] * b
+        self.candidates: list[Any] = [None] * b
+        self.steps = np.zeros(b, dtype=np.int64)
+        self.returns = np.zeros(b)
+        self._goal = np.full((b, a, 2), np.nan)
+        self._obs = {
+            "agents": np.zeros((b, a, *sub["agent"].shape), np.float32),
+            "tasks": np.zeros((b, a, *sub["tasks"].shape), np.float32),
+            "action_mask": np.zeros((b, a, k + 1), np.int8),
+        }
+
+    # ------------------------------------------------------------------ episodes
+    def reset(
+        self, *, seed: int | list | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        """Start episodes in every world (``seed``: ``s`` for ``s, s + 1, ...``, a list, or None
+        to continue each world's seed sequence), or in ``options["reset_mask"]``'s worlds."""
+        rows = reset_rows(self.num_envs, seed, options)
+        if isinstance(seed, (int, np.integer)):
+            given: list[Any] = [int(seed) + int(i) for i in rows]
+        elif seed is None:
+            given = [None] * rows.size
+        else:
+            given = list(seed)
+            if len(given) != rows.size:
+                raise EnvError(
+                    f"seed: need {rows.size} seeds, one per world reset (got {len(given)})"
+                )
+        self._reset_worlds(rows, given)
+        self._started = True
+        return self._observation(), {"tick": self.batch.tick.copy()}
+
+    def _reset_worlds(self, rows: np.ndarray, seeds: list[Any]) -> None:
+        """New episodes in the worlds ``rows`` (the task env's seed rule, per world)."""
+        world_seeds = []
+        for b, s in zip(rows.tolist(), seeds, strict=True):
+            if s is not None:
+                self._seed_seqs[b] = np.random.SeedSequence(s)
+                world_seeds.append(s)
+            else:
+                if self._seed_seqs[b] is None:
+                    self._seed_seqs[b] = np.random.SeedSequence()
+                world_seeds.append(self._seed_seqs[b].spawn(1)[0])
+        mask = np.zeros(self.num_envs, dtype=bool)
+        mask[rows] = True
+        self.batch.reset(seeds=world_seeds, mask=mask)
+        self._goal[rows] = np.nan
+        for b in rows.tolist():
+            self.beliefs[b] = Belief(self.scenario)
+            self.builders[b] = TaskGraphBuilder(self.scenario, self.one.graph_params)
+            self._observe(b)
+        self.steps[rows] = 0
+        self.returns[rows] = 0.0
+        self._pending[rows] = False
+
+    def _observe(self, b: int) -> None:
+        """World ``b``'s graph, candidates and observation rows (``TaskEnv._observe``)."""
+        one = self.one
+        graph = self.builders[b].build(self.teams[b], self.beliefs[b])
+        cand = rank_candidates(graph, one.k)
+        self.graphs[b], self.candidates[b] = graph, cand
+        frac = int(self.batch.tick[b]) / max(self.scenario.n_ticks, 1)
+        self._obs["agents"][b] = agent_features(graph, cand, frac)
+        self._obs["tasks"][b] = task_features(graph, cand, self._goal[b])
+        self._obs["action_mask"][b] = cand.action_mask()
+
+    def _observation(self) -> dict[str, np.ndarray]:
+        return {k: v.copy() for k, v in self._obs.items()}
+
+    # ------------------------------------------------------------------ step
+    def step(
+        self, actions: Any
+    ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """One replan period of every world with ``actions`` ((B, A) ints)."""
+        batch = self.batch
+        run = self._stepping(batch.done | (self.steps >= self.one.max_steps))
+        a = self.one.n_agents
+        try:
+            act = np.asarray(actions, dtype=np.int64).reshape(self.num_envs, a)
+        except (TypeError, ValueError):
+            raise EnvError(f"actions: must be integers of shape ({self.num_envs}, {a})") from None
+        resets = ~run if self.autoreset_mode is AutoresetMode.NEXT_STEP else np.zeros_like(run)
+        if np.count_nonzero(resets):
+            self._reset_worlds(np.flatnonzero(resets), [None] * int(resets.sum()))
+        illegal = np.zeros((self.num_envs, a), dtype=bool)
+        conflict = np.zeros((self.num_envs, a), dtype=bool)
+        for b in np.flatnonzero(run).tolist():
+            self._command(b, act[b], illegal, conflict)
+        start, pruned = batch.tick.copy(), batch.fire.n_pruned.copy()
+        stop = np.where(run, np.minimum(start + self.one.period, batch.n_ticks), start)
+        for _ in range(int((stop - start).max(initial=0))):
+            info = batch.step(mask=batch.tick < stop)
+            self._beliefs(info)
+        rewards = self._rewards(run, start, stop, pruned)
+        self.steps += run
+        self.returns += rewards
+        done = run & (batch.done | (self.steps >= self.one.max_steps))
+        for b in np.flatnonzero(run).tolist():
+            self._observe(b)
+        infos: dict[str, Any] = {
+            "tick": batch.tick.copy(),
+            "illegal": illegal,
+            "conflict": conflict,
+        }
+        if np.count_nonzero(done):
+            self._finals(done, infos)
+        obs = self._observation()
+        if self.autoreset_mode is AutoresetMode.SAME_STEP and np.count_nonzero(done):
+            final, mask = per_world_info(done, lambda b: {k: v[b] for k, v in obs.items()})
+            infos.update(final_obs=final, _final_obs=mask)
+            self._reset_worlds(np.flatnonzero(done), [None] * int(done.sum()))
+            obs = self._observation()
+        self._ended(done)
+        return obs, rewards, np.zeros(self.num_envs, dtype=bool), done, infos
+
+    def _command(self, b: int, act: np.ndarray, illegal: np.ndarray, conflict: np.ndarray) -> None:
+        """Decode world ``b``'s actions into commands (``TaskEnv.step``) and apply them."""
+        one, graph, cand = self.one, self.graphs[b], self.candidates[b]
+        rows, ill, con = decode_actions(graph, cand, act.tolist(), illegal="noop")
+        illegal[b], conflict[b] = ill, con
+        rows_l = rows.tolist()
+        sent = [i for i, t in enumerate(rows_l) if t >= 0]
+        if sent and one.validate and not all(cand.legal[i, rows_l[i]] for i in sent):
+            alts = {"watch_altitude": one.watch_altitude, "search_altitude": one.search_altitude}
+            validate_plan(actions_plan(graph, rows, **alts), graph)
+        commands, pos = rows_commands(graph, rows_l, one.watch_altitude, one.search_altitude)
+        for i, p in zip(sent, pos, strict=True):
+            self._goal[b, i] = p
+        self.batch.team.apply(b, commands)
+
+    def _beliefs(self, info: BatchStepInfo) -> None:
+        """Fold the tick into the belief of every world that ran it (one exact
+        :class:`fcplan.world.StepInfo` per world: the part that is not batched)."""
+        b_all = np.arange(self.num_envs + 1)
+        cuts = [
+            np.searchsorted(part[0], b_all)
+            for part in (info.ignited, info.sensed, info.newly_sensed, info.pruned)
+        ]
+        rects = info.fov.tolist()
+        ticks = self.batch.tick.tolist()
+        tps = self.scenario.ticks_per_second
+        parts = (info.ignited[1], info.sensed[1], info.newly_sensed[1], info.pruned[1])
+        for b in np.flatnonzero(info.ran).tolist():
+            ig, se, ne, pr = (p[c[b] : c[b + 1]] for p, c in zip(parts, cuts, strict=True))
+            step = StepInfo(
+                ticks[b], ticks[b] / tps, ig, se, ne, pr, rects[b],
+                tuple(np.flatnonzero(info.dumped[b]).tolist()),
+                tuple(np.flatnonzero(info.arrived[b]).tolist()),
+            )  # fmt: skip
+            self.beliefs[b].update(step)
+
+    def _rewards(
+        self, run: np.ndarray, start: np.ndarray, stop: np.ndarray, pruned: np.ndarray
+    ) -> np.ndarray:
+        """(B,) reward of the step: ``PenaltyReward`` over the step's ticks, plus shaping."""
+        batch = self.batch
+        w, tps = self.scenario.scoring.propagation_weight, float(self.scenario.ticks_per_second)
+        out = np.zeros(self.num_envs)
+        pen = batch.facility_penalties
+        for b in np.flatnonzero(run).tolist():
+            s, e = int(start[b]), int(stop[b])
+            if e - s == 1:  # (the world's counts are the tick's trace row)
+                active, in_fac = int(batch.fire.n_burning[b]), batch.facility_burning[b]
+            else:
+                active = int(batch.trace_sum(b, "active", s, e))
+                in_fac = batch.trace_sum(b, "facility_burning", s, e)
+            rate = penalty_rate(active, facility_penalty(in_fac, pen), w)
+            out[b] = -rate / tps + self.one.prune_bonus * int(batch.fire.n_pruned[b] - pruned[b])
+        return out
+
+    def expert_actions(
+        self,
+        schedulers: Sequence[Scheduler],
+        *,
+        time_limit: float | None = None,
+        counts: MappingCounts | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(B, A) actions of a scheduler's plans on every world's current graph, and (B,) bool:
+        the plan came from the greedy fallback.
+
+        ``schedulers[b]`` plans world ``b`` (one instance per world: a scheduler that keeps state
+        between calls sees only its own world), through :func:`fcplan.scheduling.solve` with
+        the world's controller generator, as :func:`fcplan.env.demonstrations.demonstrations`
+        does on one env; the plan becomes actions by
+        :func:`fcplan.env.task_actions.plan_to_actions`. A loop over the worlds: the schedulers
+        work on one graph each.
+        """
+        a, k = self.one.n_agents, self.one.k
+        out = np.full((self.num_envs, a), k, dtype=np.int64)
+        fallback = np.zeros(self.num_envs, dtype=bool)
+        for b in range(self.num_envs):
+            graph, cand = self.graphs[b], self.candidates[b]
+            rng = self.batch.controller_rngs[b]
+            assert rng is not None  # (set by every reset)
+            plan = solve(schedulers[b], graph, time_limit=time_limit, rng=rng)
+            fallback[b] = getattr(plan.stats, "status", None) == "fallback"
+            out[b] = plan_to_actions(plan, graph, cand, counts)
+        return out, fallback
+
+    def _finals(self, done: np.ndarray, infos: dict[str, Any]) -> None:
+        def metrics(b: int) -> dict[str, Any]:
+            return {n: m.as_dict() for n, m in self.batch.metrics(b).items()}
+
+        infos["metrics"], infos["_metrics"] = per_world_info(done, metrics)
+        infos["return"], infos["_return"] = per_world_info(done, lambda b: float(self.returns[b]))

@@ -1,0 +1,113 @@
+"""Tests of fcplan.env.vector_task: world ``i`` of the batched task env is, observation for
+observation, reward for reward, info for info and episode for episode, ``fcplan/Task-v0`` with
+seed ``s + i`` (its own seed sequence after), in every autoreset mode."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+
+import fcplan.env  # noqa: F401  (registers the ids)
+from fcplan.env import vector_env
+from fcplan.env.gym_view import TaskGymEnv
+from fcplan.env.vector_task import VectorTaskEnv
+from fcplan.errors import EnvError
+from fcplan.scenario import load_scenario
+from tests._fast.bits import bits
+
+
+def compare(sc, num, steps, mode="next_step", seed=10, **kw):
+    """Step the batched env and ``num`` single envs with the same (partly masked) actions."""
+    venv = VectorTaskEnv(sc, num, autoreset_mode=mode, **kw)
+    singles = [TaskGymEnv(sc, **kw) for _ in range(num)]
+    obs, _ = venv.reset(seed=seed)
+    sobs = [e.reset(seed=seed + i)[0] for i, e in enumerate(singles)]
+    rng = np.random.default_rng(seed)
+    ended = np.zeros(num, dtype=bool)
+    n_act = venv.one.k + 1
+    for t in range(steps):
+        for i in range(num):
+            assert all(bits(obs[k][i]) == bits(sobs[i][k]) for k in sobs[i]), (t, i)
+        m = obs["action_mask"]
+        act = np.zeros(m.shape[:2], dtype=np.int64)
+        for i, j in np.ndindex(*act.shape):
+            legal = np.flatnonzero(m[i, j]) if rng.random() < 0.9 else np.arange(n_act)
+            act[i, j] = rng.choice(legal)
+        obs, rew, term, trunc, info = venv.step(act)
+        for i, e in enumerate(singles):
+            if ended[i] and mode == "next_step":
+                sobs[i], _ = e.reset()
+                sr, st = 0.0, False
+            else:
+                sobs[i], sr, _, st, si = e.step(act[i])
+                assert bits(info["illegal"][i]) == bits(si["illegal"])
+                assert bits(info["conflict"][i]) == bits(si["conflict"])
+                assert info["tick"][i] == si["tick"]
+                if st:
+                    assert info["metrics"][i] == si["metrics"]
+                    assert info["return"][i] == si["return"]
+                    if mode == "same_step":
+                        assert all(
+                            bits(info["final_obs"][i][k]) == bits(sobs[i][k]) for k in sobs[i]
+                        )
+                        sobs[i], _ = e.reset()
+            assert rew[i] == sr and trunc[i] == st and not term[i], (t, i)
+        ended = trunc.copy()
+
+
+@pytest.mark.parametrize("name", ["practice", 1, 24, "open_world_example"])
+@pytest.mark.parametrize("num", [1, 7])
+def test_equals_single_envs(name, num):
+    """Random (partly masked) actions over more than two short episodes."""
+    compare(load_scenario(name).replace(duration_s=6), num, 14, k=5)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["practice", 1, 24, "open_world_example"])
+def test_equals_single_envs_64(name):
+    """64 worlds over a whole episode and the first steps of the next."""
+    sc = load_scenario(name)
+    compare(sc, 64, sc.n_ticks // sc.ticks_per_second + 3)
+
+
+def test_other_modes_and_options():
+    """Same-step autoreset; ``max_steps`` truncation; a replan period of one tick and shaping."""
+    sc = load_scenario(24).replace(duration_s=4)
+    compare(sc, 3, 10, mode="same_step")
+    compare(sc, 2, 9, max_steps=3)
+    compare(sc, 2, 50, replan_period=0.1, prune_bonus=0.5, k=3)
+
+
+def test_held_worlds_and_make_vec():
+    """``disabled``: a finished world is held until reset by mask; ``make_vec`` builds the
+    batched env; observations lie in its space."""
+    sc = load_scenario("practice").replace(duration_s=2)
+    env = gymnasium.make_vec("fcplan/Task-v0", num_envs=2, scenario=sc, autoreset_mode="disabled")
+    assert isinstance(env, VectorTaskEnv)
+    obs, _ = env.reset(seed=3)
+    assert env.observation_space.contains(obs)
+    noop = np.full((2, 4), env.one.k)
+    for _ in range(2):
+        obs, rew, _, trunc, info = env.step(noop)
+    assert trunc.all() and set(info) >= {"metrics", "return"}
+    held, rew, _, trunc, info = env.step(noop)
+    assert not trunc.any() and (rew == 0).all() and (info["tick"] == 20).all()
+    obs, _ = env.reset(options={"reset_mask": [True, False]})
+    assert env.batch.tick.tolist() == [0, 20]
+
+
+def test_errors():
+    """Bad options and actions give one-line errors."""
+    with pytest.raises(EnvError, match="render_mode"):
+        vector_env("practice", "task", 2, render_mode="rgb_array")
+    with pytest.raises(EnvError, match="k:"):
+        vector_env("practice", "task", 2, k=0)
+    env = vector_env("practice", "task", 2)
+    with pytest.raises(EnvError, match="reset"):
+        env.step(np.zeros((2, 4), dtype=np.int64))
+    with pytest.raises(EnvError, match="need 2 seeds"):
+        env.reset(seed=[1, 2, 3])
+    env.reset(seed=0)
+    with pytest.raises(EnvError, match="shape"):
+        env.step(np.zeros(3, dtype=np.int64))
