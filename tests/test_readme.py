@@ -58,6 +58,15 @@ NOT_RUN = {
         "run, output checked, by tests/cli/test_compare_readme.py"
     ),
     "fcplan report results/study --html": "needs the study's results",
+    "fcplan sweep bench/suite_v1_hard.toml --results bench/results/bench-v1 --jobs 2": (
+        "the leaderboard's hard-tier study (720 episodes, hours of CPU)"
+    ),
+    "fcplan sweep bench/suite_v1_scale.toml --results bench/results/bench-v1 --jobs 2": (
+        "the leaderboard's scale-tier study (hours of CPU)"
+    ),
+    "fcplan leaderboard bench/results/bench-v1 -o docs/leaderboard.md": (
+        "needs the two studies' results; tests/experiments test the leaderboard on small ones"
+    ),
 }
 
 #: Commands that run but take more than a few seconds.

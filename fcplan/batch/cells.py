@@ -101,7 +101,9 @@ class CellGrid:
         ufunc = np.add if sign > 0 else np.subtract
         ufunc.at(self.flat_blocks, self.block_index(world, x, y), 1)
         ns = self.ns
-        ufunc.at(self.flat_supers, world * (ns * ns) + (x >> _SUPER_SHIFT) * ns + (y >> _SUPER_SHIFT), 1)
+        ufunc.at(
+            self.flat_supers, world * (ns * ns) + (x >> _SUPER_SHIFT) * ns + (y >> _SUPER_SHIFT), 1
+        )
 
     def touch(self, worlds: np.ndarray, lo: tuple, hi: tuple) -> None:
         """Note that cells of ``worlds`` (distinct) within ``[lo[0], hi[0]] x [lo[1], hi[1]]``

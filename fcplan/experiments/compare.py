@@ -63,7 +63,7 @@ from fcplan.experiments.config import short_hash
 from fcplan.experiments.progress import Progress, ProgressCallback, episode_progress
 from fcplan.experiments.ranges import RangeError, parse_range
 from fcplan.experiments.tables import SCORE_COLUMNS, check_metric, fallback_majority
-from fcplan.experiments.workers import default_jobs, runtime_factories
+from fcplan.experiments.workers import check_jobs, runtime_factories
 
 __all__ = [
     "compare",
@@ -373,11 +373,7 @@ def _auto(
 
 def _check_jobs(jobs: Any) -> int:
     """``jobs`` (default: the CPUs this process may use), or a one-line error."""
-    if jobs is None:
-        return default_jobs()
-    if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
-        raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
-    return int(jobs)
+    return check_jobs(jobs)
 
 
 def _is_auto(seeds: Any) -> bool:

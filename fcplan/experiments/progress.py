@@ -64,6 +64,8 @@ def _failed(row: dict[str, Any]) -> bool:
 class EpisodeBar:
     """A ``progress(done, total, row)`` callback that draws a :class:`tqdm.auto.tqdm` bar.
 
+    Use it as a context manager (or call :meth:`close`), which ends the bar's line.
+
     Parameters
     ----------
     label : str
@@ -72,8 +74,6 @@ class EpisodeBar:
         Where to draw (default ``sys.stderr``).
     initial : int
         Episodes already done before the first call (a resumed sweep's stored episodes).
-
-    Use it as a context manager (or call :meth:`close`), which ends the bar's line.
     """
 
     def __init__(self, label: str, *, file: IO[str] | None = None, initial: int = 0) -> None:

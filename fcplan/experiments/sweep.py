@@ -91,7 +91,7 @@ from fcplan.experiments.results import (
     write_row,
 )
 from fcplan.experiments.tables import check_metric
-from fcplan.experiments.workers import default_jobs, runtime_factories
+from fcplan.experiments.workers import check_jobs, default_jobs, runtime_factories
 
 __all__ = ["SweepSummary", "sweep"]
 
@@ -335,8 +335,8 @@ def _study_rows(out: Path, study: str, seeds: tuple[int, ...]) -> list[dict[str,
 
 def _check_backend_args(jobs: Any, dask: Any) -> None:
     """One-line errors for a bad ``jobs`` or ``dask`` argument."""
-    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1):
-        raise FcplanError(f"jobs must be an integer >= 1, got {jobs!r}")
+    if jobs is not None:
+        check_jobs(jobs)
     if dask is not None and (not isinstance(dask, str) or not dask.strip()):
         raise FcplanError(f"dask must be 'local' or a scheduler address, got {dask!r}")
 

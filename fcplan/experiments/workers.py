@@ -29,8 +29,14 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
+import numpy as np
+
+from fcplan.errors import FcplanError
+
 __all__ = [
+    "MAX_JOBS",
     "WATCHDOG_PERIOD_S",
+    "check_jobs",
     "default_jobs",
     "die_with_parent",
     "init_worker",
@@ -50,6 +56,26 @@ def default_jobs() -> int:
         return max(len(os.sched_getaffinity(0)), 1)
     except AttributeError:  # pragma: no cover - not Linux
         return os.cpu_count() or 1
+
+
+#: Most worker processes a local pool may start (each is a Python process of ~100 MB).
+MAX_JOBS = 1024
+
+
+def check_jobs(jobs: Any) -> int:
+    """``jobs`` (None: :func:`default_jobs`) as an int in ``1..MAX_JOBS``, or a one-line error.
+
+    Examples
+    --------
+    >>> check_jobs(2), check_jobs(None) >= 1
+    (2, True)
+    """
+    if jobs is None:
+        return default_jobs()
+    ok = not isinstance(jobs, bool) and isinstance(jobs, (int, np.integer))
+    if not ok or not 1 <= jobs <= MAX_JOBS:
+        raise FcplanError(f"jobs must be an integer in 1..{MAX_JOBS}, got {jobs!r:.40}")
+    return int(jobs)
 
 
 def runtime_factories(names: Sequence[str]) -> dict[str, Callable[..., Any]]:

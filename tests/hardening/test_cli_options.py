@@ -21,11 +21,23 @@ TIME_BOUND_S = 120
 MEMORY_BOUND_MB = 1024  # traced Python and numpy allocations of one case
 _KEYS = [(c.command, c.option, c.value) for c in option_cases(Fixtures.make("/fx", build=False))]
 _PAIRS = list(dict.fromkeys((c, o) for c, o, _ in _KEYS))
-DEFAULT = [
-    key
-    for i, (command, option) in enumerate(_PAIRS)
-    if (key := (command, option, HOSTILE[i % len(HOSTILE)])) in _KEYS
-]
+
+
+def _rotation() -> list[tuple[str, str, str]]:
+    """One hostile value per (command, option), rotating through HOSTILE and skipping the values
+    an option does not take (outputs are never given a FIFO or a device), so every value is used
+    whatever the number of options."""
+    keys, out, k = set(_KEYS), [], 0
+    for command, option in _PAIRS:
+        for _ in range(len(HOSTILE)):
+            value, k = HOSTILE[k % len(HOSTILE)], k + 1
+            if (command, option, value) in keys:
+                out.append((command, option, value))
+                break
+    return out
+
+
+DEFAULT = _rotation()
 
 
 #: Cases whose fix belongs to another branch, expected to fail here until the lead merges it.
