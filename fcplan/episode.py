@@ -61,6 +61,9 @@ def fell_back_mostly(fallbacks: int, replans: int) -> bool:
 class EpisodeResult:
     """Outcome of one episode.
 
+    :attr:`fallbacks` counts the replans where greedy stood in; :attr:`fallback_majority` flags
+    an episode where that happened on more than half of them.
+
     Attributes
     ----------
     scenario, scheduler : str
@@ -77,9 +80,6 @@ class EpisodeResult:
     wall_time_s : float
         Wall time of the whole episode.
     ticks : int
-
-    :attr:`fallbacks` counts the replans where greedy stood in; :attr:`fallback_majority` flags
-    an episode where that happened on more than half of them.
     """
 
     scenario: str
