@@ -190,6 +190,12 @@ def arguments(t: Tally, folder: Path) -> None:
 
     for argv in BAD_ARGUMENTS:
         t.run(list(argv))
+    grid = folder / "grid.toml"  # 240 episodes: --jobs is not capped by a small grid
+    grid.write_text('scenarios = ["1-24"]\nschedulers = ["idle"]\nseeds = "0-9"\n')
+    for jobs in ("99999999999999999999", "1000"):
+        t.run(["sweep", str(grid), "--results", str(folder / "grid"), "--jobs", jobs])
+        t.run(["compare", "--schedulers", "idle", "--scenarios", "1-24", "--seeds", "0-9",
+               "--jobs", jobs])  # fmt: skip
     fx = Fixtures.make(folder / "fx")
     for c in option_cases(fx):
         t.run(c.argv, f"{c.command} {c.option}={c.value!r}")

@@ -17,6 +17,10 @@ died, the cluster lost it). Lost episodes are not stored, so a re-run plays them
   (``tcp://host:8786``). Rows come back to this process, which alone writes results, so workers
   need no shared file system. An episode whose workers keep dying (``KilledWorker``) is lost.
 
+Local workers are bounded: at most :data:`WORKERS_PER_CPU` per CPU this process may use (more
+only add memory, about 150-600 MB each, to CPU-bound episodes: ``--jobs 99999999999999999999``
+on a 720-episode grid started 720 processes), refused in one line by :func:`select_backend`.
+
 Episodes are pure functions of their spec, so every backend gives the same metrics.
 :func:`select_backend` picks one the way :func:`~fcplan.experiments.sweep` and
 :func:`~fcplan.experiments.compare` both do. By default a backend plays each spec with
@@ -45,9 +49,12 @@ from typing import Any
 from fcplan.errors import FcplanError
 from fcplan.experiments.optional import require
 from fcplan.experiments.play import play_episode
-from fcplan.experiments.workers import init_worker, stop_workers
+from fcplan.experiments.workers import default_jobs, init_worker, stop_workers
 
-__all__ = ["iter_dask", "iter_pool", "iter_serial", "select_backend"]
+__all__ = ["WORKERS_PER_CPU", "iter_dask", "iter_pool", "iter_serial", "max_jobs", "select_backend"]
+
+#: Local worker processes allowed per CPU this process may use (:func:`max_jobs`).
+WORKERS_PER_CPU = 4
 
 Outcome = tuple[Any, Any, str | None]
 """``(spec, result, lost)``: the result of ``play(spec)``, or None and why it was lost."""
@@ -172,6 +179,12 @@ def iter_dask(
                 cluster.close()
 
 
+def max_jobs() -> int:
+    """The most local worker processes a sweep or comparison may start here:
+    :data:`WORKERS_PER_CPU` per CPU this process may use."""
+    return WORKERS_PER_CPU * default_jobs()
+
+
 def select_backend(
     specs: Sequence[Any],
     jobs: int,
@@ -190,12 +203,23 @@ def select_backend(
     outcomes : generator of Outcome
         Close it when done early: that stops the workers.
 
+    Raises
+    ------
+    FcplanError
+        ``jobs`` above :func:`max_jobs` for local workers (a pool or a local Dask cluster).
+
     Examples
     --------
     >>> name, outcomes = select_backend([], jobs=4)
     >>> name, list(outcomes)
     ('serial', [])
     """
+    workers = jobs if dask == "local" else min(jobs, len(specs)) if dask is None else 1
+    if workers > max_jobs():
+        raise FcplanError(
+            f"--jobs asks for {workers} worker processes; at most {max_jobs()} may run here "
+            f"({WORKERS_PER_CPU} per CPU this process may use)"
+        )
     if dask is not None:
         name = f"dask:{dask}"
         if not specs:  # no cluster for nothing to do

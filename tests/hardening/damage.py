@@ -39,6 +39,7 @@ from pathlib import Path
 from tests.fuzz.cases import (
     EDIT_KINDS,
     ODD_VALUES,
+    _legacy_with,
     adversarial_cases,
     make_npz,
     mutate_bytes,
@@ -237,5 +238,20 @@ def legacy_folders(folder: str, valid: str, recording: str, n: int, rng: random.
             elif special == "sparse 1 GiB":
                 _sparse(path, 2**30)
             cases.append((f"{file}: {special}", str(d)))
-    seed = Path(recording).read_bytes()
-    return cases + _adversarial(Path(folder) / "adv", valid, seed, "legacy")
+    adv = Path(folder) / "adv"
+    adv.mkdir()
+    for name, (target, path) in adversarial_cases(
+        str(adv), valid, Path(recording).read_bytes()
+    ).items():
+        if target == "legacy":
+            cases.append((name, path))
+        elif target == "pickle":  # the hostile pickles as a folder's Agent_States.pkl
+            where = str(adv / f"pkl-{len(cases)}")
+            data = Path(path).read_bytes()
+            cases.append(
+                (
+                    f"{name} as Agent_States.pkl",
+                    _legacy_with(where, valid, "Agent_States.pkl", data),
+                )
+            )
+    return cases

@@ -114,3 +114,21 @@ def test_stale_temporaries_go_and_live_ones_stay(tmp_path):
         (tmp_path / name).write_bytes(b"")
     assert results.remove_stale_temporaries(tmp_path) == 3
     assert {p.name for p in tmp_path.iterdir()} == {n for n, keep in names.items() if keep}
+
+
+def test_a_huge_jobs_count_is_refused_before_any_worker_starts(tmp_path, capsys):
+    """--jobs far above the CPUs (a 240-episode grid with --jobs 10**20 started 240 workers):
+    sweep and compare exit 2 with one line naming the bound, no worker started, no row."""
+    from fcplan.experiments.backends import max_jobs
+
+    config = tmp_path / "grid.toml"
+    config.write_text('scenarios = ["1-24"]\nschedulers = ["idle"]\nseeds = "0-9"\n')
+    huge = "99999999999999999999"
+    for argv in (
+        ["sweep", str(config), "--results", str(tmp_path / "r"), "--jobs", huge],
+        ["compare", "--schedulers", "idle", "--scenarios", "1-24", "--seeds", "0-9", "-j", huge],
+    ):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert "\n" not in err and f"at most {max_jobs()} may run here" in err
+    assert load_results(tmp_path / "r").empty
