@@ -78,6 +78,8 @@ class EpisodeResult:
         Wall time of the whole episode.
     ticks : int
 
+    Notes
+    -----
     :attr:`fallbacks` counts the replans where greedy stood in; :attr:`fallback_majority` flags
     an episode where that happened on more than half of them.
     """
