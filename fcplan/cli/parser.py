@@ -4,8 +4,10 @@
 the chosen command and turns every :class:`~fcplan.errors.FcplanError` into one line on stderr and
 exit status 2 (``--debug`` shows the traceback instead); so are the failures the environment
 causes rather than a bug (an :class:`OSError` such as a full disk, and :class:`MemoryError`).
-A message is cut to :data:`MAX_MESSAGE` characters; a bad argument reads ``fcplan run: error:
-argument --seed: ...`` (the command, then the problem). Ctrl-C exits 130; SIGTERM is handled the
+Every such line starts with ``fcplan: error:`` (what scripts and the hardening audit match),
+then the command a bad argument belongs to, once, and the problem: ``fcplan: error: run:
+argument --seed: expected an integer >= 0, got '-1'``; a message is cut to :data:`MAX_MESSAGE`
+characters. Ctrl-C exits 130; SIGTERM is handled the
 same way (the command stops its workers and keeps what it stored) and exits 143; a closed pipe
 (``fcplan scenarios | head``) ends quietly. A bare ``fcplan`` prints the help on stdout and a
 one-line hint on stderr (exit 2); ``--help`` and ``--version`` return 0.
@@ -120,7 +122,7 @@ def _unrecognized(
     parser: argparse.ArgumentParser, args: argparse.Namespace, extras: list[str]
 ) -> CliError:
     """The error for arguments no parser took, naming the command and the closest options
-    (``fcplan compare: unrecognized arguments: --seed 3 (did you mean --seeds?)``)."""
+    (``fcplan: error: compare: unrecognized arguments: --seed 3 (did you mean --seeds?)``)."""
     import difflib
 
     command = parser
@@ -143,7 +145,9 @@ def _unrecognized(
 
 
 def _error(message: str, prog: str = "fcplan") -> int:
-    text = " ".join(f"{prog}: error: {message}".split())
+    """Print ``fcplan: error: [COMMAND: ]MESSAGE`` on one line of stderr; return 2."""
+    command = prog.removeprefix("fcplan").strip()
+    text = " ".join(f"fcplan: error: {command + ': ' if command else ''}{message}".split())
     if len(text) > MAX_MESSAGE:
         text = text[: MAX_MESSAGE - 3] + "..."
     print(text, file=sys.stderr)

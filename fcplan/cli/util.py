@@ -70,7 +70,7 @@ class CliError(FcplanError):
         What is wrong and what is allowed.
     prog : str, optional
         The command the argument belongs to (``"fcplan run"``); the printed line then reads
-        ``fcplan run: error: MESSAGE`` and ``str()`` is ``"fcplan run: MESSAGE"``.
+        ``fcplan: error: run: MESSAGE`` and ``str()`` is ``"fcplan run: MESSAGE"``.
     """
 
     def __init__(self, message: str, *, prog: str | None = None) -> None:

@@ -144,18 +144,18 @@ def test_no_parser_abbreviates_options(capsys):
     one_line_error(
         ["compare", "--seed", "3", "--schedulers", "greedy"],
         capsys,
-        "fcplan compare: error: unrecognized arguments: --seed 3",
+        "fcplan: error: compare: unrecognized arguments: --seed 3",
         "did you mean --seeds?",
     )
-    one_line_error(["run", "1", "--sed", "2"], capsys, "fcplan run: error:", "--seed")
+    one_line_error(["run", "1", "--sed", "2"], capsys, "fcplan: error: run:", "--seed")
 
 
 def test_errors_name_the_command_once(capsys):
-    """An argument error reads ``fcplan run: error: argument --seed: ...``: the command, then
+    """An argument error reads ``fcplan: error: run: argument --seed: ...``: the command, then
     the problem, without a doubled ``fcplan: error: fcplan run:``."""
     assert main(["run", "1", "--seed", "-1"]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("fcplan run: error: argument --seed: expected an integer >= 0")
+    assert err.startswith("fcplan: error: run: argument --seed: expected an integer >= 0")
     assert err.count("fcplan") == 1
 
 
