@@ -22,6 +22,7 @@ Usage::
     python bench/bench_vector.py                       # about 4 minutes on a quiet 2-core machine
     python bench/bench_vector.py --quick               # 30-s episodes, sizes 1, 16, 256
     python bench/bench_vector.py --plot vector.png     # also plot throughput against B
+    python bench/bench_vector.py --duration 60         # 60-s episodes (a loaded machine)
 """
 
 from __future__ import annotations
@@ -211,6 +212,7 @@ def mpe_rate(steps: int = 5000, seed: int = 0) -> float | None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="30-s episodes, sizes 1, 16, 256")
+    ap.add_argument("--duration", type=float, default=None, help="episode length (s)")
     ap.add_argument("--sizes", type=int, nargs="+", default=None, help="batch sizes B")
     ap.add_argument("--episodes", type=int, default=2, help="single-env episodes")
     ap.add_argument("--scenarios", nargs="+", default=["1", "24"])
@@ -227,8 +229,8 @@ def main(argv: list[str] | None = None) -> int:
     for level in args.levels:
         for name in args.scenarios:
             sc = load_scenario(name)
-            if args.quick:
-                sc = sc.replace(duration_s=30)
+            if args.quick or args.duration:
+                sc = sc.replace(duration_s=args.duration or 30)
             sizes_l = [n for n in sizes if level == "motion" or n <= args.task_max]
             results[f"{level} #{name}"] = _level(level, sc, name, sizes_l, args.episodes)
     sc = load_scenario(args.scenarios[0])
