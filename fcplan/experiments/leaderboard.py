@@ -12,20 +12,24 @@ the tier ``other``) and computes, per tier and scheduler:
 * the **fraction of the oracle**: ``F = sum_i (s_i - idle_i) / sum_i (oracle_i - idle_i)`` over
   the (scenario, seed) pairs ``i`` where the scheduler, the clairvoyant ``oracle`` and the
   ``idle`` team all completed: the share of the oracle's improvement over doing nothing that the
-  scheduler achieved on the same pairs (1 = as good as the oracle, 0 = no better than idle). A
-  ratio of raw scores would mean nothing (final scores are often negative). It is a **ratio of
-  means**, not a mean of per-pair ratios: a pair where the oracle barely beats idle (nothing was
-  at stake) would give a huge or undefined per-pair ratio, while the ratio of means weights each
-  pair by what was achievable there. Its 95 % interval is a percentile bootstrap (2,000 draws,
-  seed 0) that resamples seeds within each scenario: the suite's scenarios are fixed, seeds are
-  the random part;
+  scheduler achieved on the same pairs (1 = as good as the oracle, 0 = no better than idle). It
+  is a **ratio of means**, not a mean of per-pair ratios: a pair where the oracle barely beats
+  idle (nothing was at stake) would give a huge or undefined per-pair ratio, while the ratio of
+  means weights each pair by what was achievable there. Normalising by idle makes it independent
+  of the score's zero: final scores are often negative on this suite, where the raw ratio
+  ``s_i / oracle_i`` of ``fcplan compare``
+  (:func:`~fcplan.experiments.analysis.oracle_fractions`, defined only where the oracle's score
+  is positive) would drop the hardest instances; the two agree when idle scores 0. Its 95 %
+  interval is a percentile bootstrap (2,000 draws, seed 0) that resamples seeds within each
+  scenario: the suite's scenarios are fixed, seeds are the random part;
 * OFS, time to containment and burned area (means), the scenarios *cleared* (OFS 100 % on every
   seed), the solve time per replan (p50 and p95 over every replan of the tier), and the replans
   that fell back to greedy;
 * **paired comparisons** of the policies (every scheduler except the oracle references and the
-  ``idle`` and ``random`` baselines) on the pairs they all completed: mean difference and its
-  interval, Wilcoxon p-value, Holm-adjusted over the tier's pairs of policies, Cohen's d_z
-  (:func:`~fcplan.experiments.stats.paired_comparisons`);
+  ``idle`` and ``random`` baselines), each pair on the (scenario, seed) instances both completed:
+  mean difference and its interval, Wilcoxon p-value Holm-adjusted over the tier's pairs of
+  policies, Cohen's d_z and a verdict (:func:`~fcplan.experiments.analysis.paired_table`, the
+  statistics of ``fcplan compare`` and ``fcplan report``);
 * the **tier check** of issue 12: a tier separates the schedulers when the policies are not all
   within each other's 95 % intervals and no scheduler clears every scenario; its acceptance
   asks that at least half of the policy pairs differ with Holm p < 0.01 and that the oracle's mean
@@ -54,7 +58,7 @@ import datetime as _dt
 import json
 import math
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -62,8 +66,10 @@ from typing import Any
 import numpy as np
 
 from fcplan.errors import FcplanError
-from fcplan.experiments.stats import MeanCI, PairedComparison, mean_ci, paired_comparisons
-from fcplan.experiments.tables import higher_is_better
+from fcplan.experiments.analysis import metric_label, paired_table
+from fcplan.experiments.stats import MeanCI, PairedComparison, mean_ci
+from fcplan.experiments.tables import REPORT_COLUMNS, higher_is_better
+from fcplan.metrics import metric_spec
 from fcplan.scenario.suite import suite_of
 
 __all__ = [
@@ -95,24 +101,20 @@ _BURNED = "outcome.burned_area_cells"
 
 
 def metric_direction(metric: str) -> tuple[str, int, bool]:
-    """Label, decimals and whether higher is better for a result column: a metric
-    (``manual.final_score``), an outcome (``outcome.burned_area_cells``) or another column.
+    """Label, decimals and whether higher is better for a result column.
 
     Examples
     --------
     >>> metric_direction("outcome.burned_area_cells"), metric_direction("manual.final_score")
-    (('burned area', 0, False), ('final score', 1, True))
+    (('burned', 0, False), ('final score', 1, True))
     """
-    from fcplan.metrics import metric_spec
-
-    prefix, _, name = metric.partition(".")
-    if prefix in ("outcome", "manual", "reference2020"):
+    decimals = next((c.decimals for c in REPORT_COLUMNS if c.name == metric), None)
+    if decimals is None:
         try:
-            spec = metric_spec(name)
-            return spec.label, spec.decimals, spec.higher_is_better
+            decimals = metric_spec(metric.partition(".")[2]).decimals
         except FcplanError:
-            pass
-    return metric, 2, higher_is_better(metric)
+            decimals = 2
+    return metric_label(metric), decimals, higher_is_better(metric)
 
 
 def is_policy(label: str) -> bool:
@@ -469,14 +471,7 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
     policies = sorted((k for k in stats if is_policy(k)), key=lambda k: -sign * stats[k].mean.mean)
     others = [k for k in stats if not is_policy(k)]
     order = policies + sorted(others, key=lambda k: (k != ORACLE, not k.startswith(ORACLE), k))
-    common = set.intersection(
-        *({(r["scenario"], int(r["seed"])) for r in by[k]} for k in policies)
-    ) if policies else set()  # fmt: skip
-    keys = sorted(common)
-    values = {
-        k: {(r["scenario"], int(r["seed"])): float(r[metric]) for r in by[k]} for k in policies
-    }
-    pairs = paired_comparisons({k: [values[k][x] for x in keys] for k in policies}) if keys else []
+    pairs = paired_table(ok, policies, metric, _instance) if len(policies) > 1 else []
     return TierResult(
         suite=suite,
         tier=tier,
@@ -489,6 +484,11 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
         check=_check(stats, pairs, scenarios, sign),
         settings={k: _settings(by[k]) for k in order if _settings(by[k])},
     )
+
+
+def _instance(row: Mapping[str, Any]) -> tuple[str, int]:
+    """The (scenario, seed) an episode played: the pair key of the comparisons."""
+    return str(row["scenario"]), int(row["seed"])
 
 
 def _settings(rows: list[dict[str, Any]]) -> str:

@@ -109,19 +109,18 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
         text = "; ".join(f"{k}: {v}" for k, v in t.settings.items())
         out += ["", f"Scheduler settings: {text}."]
     if t.pairs:
-        n = t.pairs[0].diff.n
         out += [
             "",
-            f"Paired differences of the {label} on the {n} (scenario, seed) pairs that every "
-            f"policy completed (Wilcoxon signed-rank p, Holm-adjusted over the {len(t.pairs)} "
-            "pairs; d_z = mean / sd of the differences):",
+            f"Paired differences of the {label} between policies, each pair on the (scenario, "
+            f"seed) instances both completed (Wilcoxon signed-rank p, Holm-adjusted over the "
+            f"{len(t.pairs)} pairs; d_z = mean / sd of the differences):",
             "",
-            "| a - b | mean ± 95 % CI | p | p Holm | d_z | Holm p < 0.01 |",
-            "|---|---|---|---|---|---|",
+            "| a - b | n | mean ± 95 % CI | p | p Holm | d_z | Holm p < 0.01 | verdict |",
+            "|---|---|---|---|---|---|---|---|",
         ]
         out += [
-            f"| {c.a} - {c.b} | {c.diff.format(digits)} | {c.p:.2g} | {c.p_holm:.2g} "
-            f"| {c.effect:+.2f} | {'yes' if c.p_holm < HOLM_LEVEL else 'no'} |"
+            f"| {c.a} - {c.b} | {c.n} | {c.diff.format(digits)} | {c.p:.2g} | {c.p_holm:.2g} "
+            f"| {c.effect:+.2f} | {'yes' if c.p_holm < HOLM_LEVEL else 'no'} | {c.verdict()} |"
             for c in t.pairs
         ]
     c = t.check

@@ -53,7 +53,7 @@ def test_another_metric_heads_the_page(results, capsys):
     """--metric ranks by another column (here the burned area, lower is better)."""
     assert main(["leaderboard", str(results), "--metric", "outcome.burned_area_cells"]) == 0
     out = capsys.readouterr().out
-    assert "headline metric **burned area**" in out and "lower is better" in out
+    assert "headline metric **burned**" in out and "lower is better" in out
 
 
 def test_bad_inputs_fail_in_one_line(tmp_path, capsys):
