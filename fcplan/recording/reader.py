@@ -125,11 +125,23 @@ def read_bytes(
 ) -> bytes:
     """The bytes of ``path`` if it is a regular file (of at most ``max_bytes`` bytes), opened
     with :func:`open_regular` and read up to one byte past the bound (a file that grows while
-    read is refused too). Failures raise ``error`` naming the file."""
+    read is refused too). Failures raise ``error`` naming the file.
+
+    The first read asks for the file's size plus one byte, not for the bound: a buffered read
+    allocates what it is asked for before reading, so asking for the bound would reserve it for
+    every small file. A file that grew while read is read on in chunks of at most 1 MiB.
+    """
     cap = math.inf if max_bytes is None else max_bytes
     with open_regular(path, error, cap) as fh:
         try:
-            data = fh.read() if max_bytes is None else fh.read(max_bytes + 1)
+            want = int(min(os.fstat(fh.fileno()).st_size, cap)) + 1
+            data = fh.read(want)
+            if len(data) == want:  # it grew while read: on, in bounded chunks, past the bound
+                parts, total = [data], len(data)
+                while total <= cap and (chunk := fh.read(int(min(1 << 20, cap + 1 - total)))):
+                    parts.append(chunk)
+                    total += len(chunk)
+                data = b"".join(parts)
         except OSError as exc:
             raise error(f"{path}: cannot read: {exc.strerror or exc}") from None
     if len(data) > cap:

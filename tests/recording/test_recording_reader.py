@@ -281,3 +281,38 @@ def test_check_recording_accepts_what_load_recording_loads(recorded):
     arrays["agent_xyz"][0, 0, 0] = np.nan
     with pytest.raises(RecordingError, match="^r: entry 'agent_xyz'"):
         check_recording(Recording(rec.header, arrays, rec.replans, rec.inputs), "r")
+
+
+def test_read_bytes_asks_for_the_file_not_the_bound(tmp_path):
+    """A small file read under a huge bound allocates what the file holds, not the bound (a
+    buffered read of the bound reserved it: 1 TiB here, a MemoryError under an address-space
+    limit), and a file over the bound is refused naming it."""
+    from fcplan.recording.reader import read_bytes
+
+    p = tmp_path / "small.bin"
+    p.write_bytes(b"0123456789")
+    assert read_bytes(str(p), max_bytes=2**40) == b"0123456789"
+    assert read_bytes(str(p)) == b"0123456789"
+    with pytest.raises(RecordingError, match="small.bin"):
+        read_bytes(str(p), max_bytes=9)
+
+
+def test_read_bytes_refuses_a_file_that_grows_past_the_bound(tmp_path, monkeypatch):
+    """A file that grows while it is read is read on in bounded chunks and refused once it is
+    past the bound; one that grows within the bound is read whole."""
+    import os as os_module
+
+    from fcplan.recording import reader
+
+    p = tmp_path / "grows.bin"
+    p.write_bytes(b"x" * 10)
+    real_fstat = os_module.fstat
+
+    def stale_fstat(fd):  # the size seen before the file grew to 10 bytes
+        st = real_fstat(fd)
+        return os_module.stat_result((st.st_mode, *st[1:6], 4, *st[7:]))
+
+    monkeypatch.setattr(reader.os, "fstat", stale_fstat)
+    assert reader.read_bytes(str(p), max_bytes=100) == b"x" * 10
+    with pytest.raises(RecordingError, match="grew past the bound"):
+        reader.read_bytes(str(p), max_bytes=7)
