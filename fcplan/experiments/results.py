@@ -329,7 +329,7 @@ def _read(path: Path, columns: list[str] | None = None) -> Any:
         pf = pq.ParquetFile(fh)
         _check_footer(pf, path)
         meta = pf.schema_arrow.metadata or {}
-        table = pf.read(columns=columns)
+        table = pf.read(columns=columns, use_threads=False)
     except ResultsError:
         raise
     except Exception as exc:  # noqa: BLE001 - any reader failure means a damaged file
@@ -399,7 +399,7 @@ def load_results(directory: str | os.PathLike[str]) -> Any:
         table = pa.concat_tables(
             [t.replace_schema_metadata(None) for t in tables], promote_options="permissive"
         )
-        df = table.to_pandas()
+        df = table.to_pandas(use_threads=False)
         order = [c for c in ("finished_at", "key") if c in df.columns]
         return df.sort_values(order, kind="stable").reset_index(drop=True)
     except (pa.ArrowException, TypeError, ValueError) as exc:
