@@ -3,7 +3,7 @@
 :func:`run_cli` runs ``fcplan argv`` in a child process of its own session (so every process it
 starts, pool workers included, can be found afterwards by session id), with an address-space
 limit (``RLIMIT_AS``) and a wall-clock bound, and returns a :class:`Case`: the exit status, the
-stderr text, the child's peak resident memory (``wait4``'s ``ru_maxrss``), the seconds it took,
+stderr text, the child's peak resident memory (``wait4``'s ``ru_maxrss``, see :data:`_LAUNCHER`), the seconds it took,
 the processes of its session still alive :data:`ORPHAN_GRACE_S` after it ended (killed, then
 counted as orphans) and its :class:`Outcome`.
 
@@ -192,19 +192,55 @@ def _forked(
         os._exit(code)
 
 
-def _spawned(argv: list[str], memory: int, err: int, env: dict[str, str] | None, cwd: str) -> int:
-    """Start ``python -m fcplan argv`` (its own session, in ``cwd``); its pid."""
+#: A small interpreter between this process and a spawned case: it forks the case, which sets
+#: its memory limit and execs ``python -m fcplan``, waits for it and writes its ``ru_maxrss`` (KiB)
+#: to a file. A process forked from a large one (a test worker of 1 GB) keeps that one's resident
+#: size as its peak across ``exec`` (Linux records the old memory's high-water mark), so the
+#: case's own peak is only measurable in a child of a small process. The launcher exits as its
+#: case did (the same code, or killed by the same signal).
+_LAUNCHER = """
+import os, resource, signal, sys
+out, memory, cmd = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
+pid = os.fork()
+if pid == 0:
+    resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+    os.execv(cmd[0], cmd)
+_, raw, usage = os.wait4(pid, 0)
+with open(out, "w") as f:
+    f.write(str(usage.ru_maxrss))
+if os.WIFSIGNALED(raw):
+    signal.signal(os.WTERMSIG(raw), signal.SIG_DFL)
+    os.kill(os.getpid(), os.WTERMSIG(raw))
+sys.exit(os.waitstatus_to_exitcode(raw))
+"""
+
+
+def _spawned(
+    argv: list[str], memory: int, err: int, env: dict[str, str] | None, cwd: str, peak: str
+) -> int:
+    """Start ``python -m fcplan argv`` (its own session, in ``cwd``) through :data:`_LAUNCHER`,
+    which writes the case's peak resident memory to ``peak``; the launcher's pid."""
     full = {**os.environ, **(env or {})}
     full["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), full.get("PYTHONPATH", "")) if p)
     proc = subprocess.Popen(  # noqa: S603 - our own interpreter and module
-        [sys.executable, "-m", "fcplan", *argv],
+        [
+            sys.executable,
+            "-S",
+            "-c",
+            _LAUNCHER,
+            peak,
+            str(memory),
+            sys.executable,
+            "-m",
+            "fcplan",
+            *argv,
+        ],  # fmt: skip
         stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL,
         stderr=err,
         env=full,
         cwd=cwd,
         start_new_session=True,
-        preexec_fn=lambda: _limit(memory),  # noqa: PLW1509 - only setrlimit
     )
     proc.returncode = 0  # reaped below with wait4; Popen must not wait for it again
     return proc.pid
@@ -230,12 +266,13 @@ def run_cli(
     """
     if (prepare is not None and not fork) or (env is not None and fork):
         raise ValueError("prepare needs fork=True and env needs fork=False")
-    with tempfile.TemporaryFile() as err:
+    with tempfile.TemporaryFile() as err, tempfile.TemporaryDirectory() as scratch:
+        peak = os.path.join(scratch, "peak")
         t0 = time.monotonic()
         if fork:
             pid = _forked(argv, memory, err.fileno(), prepare, os.fspath(cwd))
         else:
-            pid = _spawned(argv, memory, err.fileno(), env, os.fspath(cwd))
+            pid = _spawned(argv, memory, err.fileno(), env, os.fspath(cwd), peak)
         status, rss_kb = None, 0
         while time.monotonic() - t0 < timeout:
             done, raw, usage = os.wait4(pid, os.WNOHANG)
@@ -249,6 +286,9 @@ def run_cli(
             rss_kb = os.wait4(pid, 0)[2].ru_maxrss
         seconds = time.monotonic() - t0
         orphans = _orphans(pid, grace)
+        # the launcher's report of its case
+        with contextlib.suppress(OSError, ValueError), open(peak) as f:
+            rss_kb = int(f.read())
         err.seek(0)
         text = err.read().decode("utf-8", "replace")
     outcome = Outcome.ORPHAN if orphans else classify(status, text)
