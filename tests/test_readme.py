@@ -50,7 +50,6 @@ NOT_RUN = {
     "fcplan play --scenario 12 --seed 3": "the interactive game (a window)",
     "fcplan sweep study.toml": "the 1,500-episode study (hours)",
     "fcplan sweep study.toml --dask local": "the 1,500-episode study (hours)",
-    "fcplan sweep study.toml --seeds auto": "the 1,500-episode study (hours)",
     "fcplan compare --scenarios 1-3 --schedulers greedy,cbba,random --seeds 0-1": (
         "run, output checked, by tests/cli/test_compare_readme.py"
     ),

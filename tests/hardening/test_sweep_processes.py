@@ -118,17 +118,34 @@ def test_stale_temporaries_go_and_live_ones_stay(tmp_path):
 
 def test_a_huge_jobs_count_is_refused_before_any_worker_starts(tmp_path, capsys):
     """--jobs far above the CPUs (a 240-episode grid with --jobs 10**20 started 240 workers):
-    sweep and compare exit 2 with one line naming the bound, no worker started, no row."""
+    sweep and compare exit 2 with one line naming the bound, no worker started, no row. A count
+    beyond any machine (10**20) is refused by the range check of every --jobs (1..MAX_JOBS); one
+    within that range but above this machine's worker bound by the local backend's check."""
     from fcplan.experiments.backends import max_jobs
+    from fcplan.experiments.workers import MAX_JOBS
 
     config = tmp_path / "grid.toml"
     config.write_text('scenarios = ["1-24"]\nschedulers = ["idle"]\nseeds = "0-9"\n')
-    huge = "99999999999999999999"
-    for argv in (
-        ["sweep", str(config), "--results", str(tmp_path / "r"), "--jobs", huge],
-        ["compare", "--schedulers", "idle", "--scenarios", "1-24", "--seeds", "0-9", "-j", huge],
-    ):
-        assert main(argv) == 2
-        err = capsys.readouterr().err.strip()
-        assert "\n" not in err and f"at most {max_jobs()} may run here" in err
+    cases = {
+        "99999999999999999999": f"jobs must be an integer in 1..{MAX_JOBS}",
+        str(max_jobs() + 1): f"at most {max_jobs()} may run here",
+    }
+    for jobs, bound in cases.items():
+        for argv in (
+            ["sweep", str(config), "--results", str(tmp_path / "r"), "--jobs", jobs],
+            [
+                "compare",
+                "--schedulers",
+                "idle",
+                "--scenarios",
+                "1-24",
+                "--seeds",
+                "0-9",
+                "-j",
+                jobs,
+            ],
+        ):
+            assert main(argv) == 2
+            err = capsys.readouterr().err.strip()
+            assert "\n" not in err and bound in err, (argv, err)
     assert load_results(tmp_path / "r").empty

@@ -153,17 +153,23 @@ def _runtime_imports(module) -> set[str]:
 
 def test_scenario_modules_import_one_way():
     """The scenario package layers without cycles: parts and grid import no scenario module above
-    them, validate and document import only those, model builds on all four, and read, write and
-    catalogue sit on top; the package imports nothing of fcplan beyond fcplan.errors."""
+    them, validate and document import only those, model builds on all four, write on model; the
+    generator (knobs, placement, generate) builds on model, the frozen suites on the generator and
+    write, and catalogue (which knows the suites' names) and read sit on top; the package imports
+    nothing of fcplan beyond fcplan.errors."""
     from fcplan.scenario import (
         bounds,
         catalogue,
         document,
         fieldpaths,
+        generate,
         grid,
+        knobs,
         model,
         parts,
+        placement,
         read,
+        suite,
         validate,
         write,
     )
@@ -176,9 +182,13 @@ def test_scenario_modules_import_one_way():
         (validate, {"parts", "grid", "bounds", "fieldpaths"}),
         (document, {"parts", "grid", "validate"}),
         (model, {"parts", "validate", "document"}),
-        (catalogue, {"validate"}),
-        (read, {"catalogue", "model", "bounds"}),
         (write, {"document", "model"}),
+        (knobs, {"validate"}),
+        (placement, {"grid", "model"}),
+        (generate, {"grid", "knobs", "model", "placement", "validate"}),
+        (suite, {"generate", "model", "parts", "write"}),
+        (catalogue, {"validate", "suite"}),
+        (read, {"catalogue", "model", "bounds"}),
     ]
     for module, allowed in layers:
         fcplan_imports = {m for m in _runtime_imports(module) if m.startswith("fcplan")}

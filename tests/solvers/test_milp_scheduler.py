@@ -142,24 +142,27 @@ def test_tiny_time_limit_team_still_acts(name):
 
 
 @pytest.mark.parametrize("cls", [MilpScheduler, MilpCvxpyScheduler])
-def test_a_plan_cut_short_with_idle_agents_raises(cls, monkeypatch):
-    """A backend result that a limit stopped (status time_limit) and that leaves agents idle
-    with routes to fly raises IncompletePlanError; the same empty result proven optimal is a
-    decision and is returned."""
-    from fcplan.scheduling import SolveStats
+def test_a_plan_cut_short_is_completed_or_raises(cls, monkeypatch):
+    """A backend result that a limit stopped (status time_limit) with every agent idle is
+    completed with routes of positive gain, so no agent that has work is left idle and the
+    status says the limit stopped it; if the completion cannot run either (the deadline passed
+    before the warm start was complete), plan() raises IncompletePlanError naming the idle
+    agents, so solve() falls back."""
+    from solvers.milp_model import solve as solve_module
 
     g = episode_graphs(12)[1]
-    for status, raises in (("time_limit", True), ("optimal", False)):
+    monkeypatch.setattr(solve_module, "_solve_part", _empty_part)
+    plan = cls().plan(g)
+    assert plan.stats.status == "time_limit"
+    assert plan.routes and validate_plan(plan, g) is None
+    monkeypatch.setattr(solve_module, "complete", lambda model, x, deadline=None: x)
+    with pytest.raises(IncompletePlanError, match="idle"):
+        cls().plan(g)
 
-        def empty(self, model, *, limits, seed, hint, status=status):
-            return np.zeros(model.n_vars), SolveStats(status=status, objective=0.0)
 
-        monkeypatch.setattr(cls, "_solve", empty)
-        if raises:
-            with pytest.raises(IncompletePlanError, match="idle"):
-                cls().plan(g)
-        else:
-            assert cls().plan(g).routes == {}
+def _empty_part(sub, hint, positions, backend, limits, seed, settings):
+    """A part whose solve the clock stopped before anything was found, warm start discarded."""
+    return np.zeros_like(hint), "time_limit", 0.0, {}
 
 
 def test_model_building_past_the_limit_raises(monkeypatch):
