@@ -343,13 +343,16 @@ def test_recording_size(tmp_path):
     assert abs(path.stat().st_size / 1024 - shown) <= 0.25 * shown
 
 
-def test_benchmark_figures_are_recorded_in_bench_readme():
-    """Every figure of the README's Benchmarks section (100 or more: rates, counts) is within
-    1 % of a figure recorded in bench/README.md, so the README quotes measurements, not
-    memories."""
+def _section(title: str, level: str = "## ") -> str:
+    """The README's section under the heading ``title`` (up to the next heading of its level)."""
     text = README.read_text(encoding="utf-8")
-    section = text[text.index("\n## Benchmarks") :]
-    section = section[: section.index("\n## ", 1)]
+    section = text[text.index(f"\n{level}{title}") :]
+    return section[: section.index(f"\n{level}", 1)]
+
+
+def _assert_recorded(section: str) -> None:
+    """Every figure of 100 or more in ``section`` (code aside) is within 1 % of a figure of
+    bench/README.md."""
     section = re.sub(r"```.*?```|`[^`]*`", "", section, flags=re.DOTALL)
     recorded = [
         float(n.replace(",", ""))
@@ -362,6 +365,32 @@ def test_benchmark_figures_are_recorded_in_bench_readme():
         if 2000 <= value <= 2100:  # a year
             continue
         assert any(abs(value - r) <= 0.01 * r for r in recorded), n
+
+
+def test_benchmark_figures_are_recorded_in_bench_readme():
+    """Every figure of the README's Benchmarks section (100 or more: rates, counts) is within
+    1 % of a figure recorded in bench/README.md, so the README quotes measurements, not
+    memories."""
+    _assert_recorded(_section("Benchmarks"))
+
+
+def test_batched_figures_are_recorded_in_bench_readme():
+    """The batched environments' throughput table of the learning section quotes figures that
+    bench/bench_vector.py printed into bench/README.md (world-steps per CPU second and MPE's
+    steps in the same run)."""
+    section = _section("Batched environments: many worlds per step", "### ")
+    assert "| motion level, #1 |" in section
+    _assert_recorded(section)
+
+
+@pytest.mark.parametrize("path", ["README.md", "bench/README.md", *sorted(
+    str(p.relative_to(ROOT)) for p in (ROOT / "docs").rglob("*.md"))])  # fmt: skip
+def test_no_placeholder_is_left(path):
+    """No line of the README, bench/README.md or the docs pages is a bare upper-case
+    placeholder (``BATCHED_FIGURES``) waiting for a figure that was never filled in."""
+    lines = (ROOT / path).read_text(encoding="utf-8").splitlines()
+    left = [line for line in lines if re.fullmatch(r"[A-Z][A-Z0-9]*_[A-Z0-9_]+", line.strip())]
+    assert not left, left
 
 
 def test_study_example_is_as_large_as_the_readme_says(tmp_path):
