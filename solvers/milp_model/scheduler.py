@@ -75,6 +75,9 @@ class MilpSchedulerBase:
 
     name = "milp-base"
     solver_name = "none"
+    #: the ``deterministic`` parameter sits beside ``**model_settings``, which hides it from the
+    #: signature check of :func:`fcplan.scheduling.supports_deterministic`
+    supports_deterministic = True
     default_work_limit: float = 1.0
     work_limit_kind: type = float
     #: share of the wall-clock limit kept back for decoding and validation

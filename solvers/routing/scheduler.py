@@ -108,7 +108,13 @@ from typing import Any
 import numpy as np
 
 from fcplan.plan import Plan
-from fcplan.scheduling import SolveStats
+from fcplan.scheduling import (
+    SolveStats,
+    bool_setting,
+    choice_setting,
+    float_setting,
+    int_setting,
+)
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
 from solvers.routing.core import BACKENDS, RoutesResult
@@ -211,41 +217,35 @@ class RoutingScheduler:
         scale: float = 10.0,
         warm_start: str | bool = "fallback",
     ) -> None:
-        if isinstance(warm_start, bool):
+        if isinstance(warm_start, (bool, np.bool_)):
             warm_start = "search" if warm_start else "off"
-        if warm_start not in WARM_STARTS:
-            raise ValueError(f"unknown warm_start {warm_start!r}; one of {', '.join(WARM_STARTS)}")
-        if backend not in BACKENDS:
-            raise ValueError(f"unknown backend {backend!r}; one of {', '.join(BACKENDS)}")
-        if not time_limit > 0:
-            raise ValueError(f"time_limit must be > 0 s, got {time_limit!r}")
-        self.time_limit = float(time_limit)
-        self.deterministic = bool(deterministic)
-        self.backend = backend
-        self.solution_limit = int(solution_limit)
-        self.branch_limit = None if branch_limit is None else int(branch_limit)
-        self.iterations = int(iterations)
-        self.seed = int(seed)
-        self.max_visits = int(max_visits)
-        self.max_nodes = int(max_nodes)
-        self.nodes_per_vehicle = int(nodes_per_vehicle)
-        if not (isinstance(group_vehicles, int) and group_vehicles >= 0):
-            raise ValueError(f"group_vehicles must be an integer >= 0, got {group_vehicles!r}")
-        self.group_vehicles = group_vehicles
-        self.fire_base_px = float(fire_base_px)
-        self.fire_value_px = float(fire_value_px)
-        self.watch_value_px = float(watch_value_px)
-        self.search_value_px = float(search_value_px)
-        self.search_horizon_s = float(search_horizon_s)
-        self.fresh_s = float(fresh_s)
-        self.watch_altitude = float(watch_altitude)
-        self.search_altitude = float(search_altitude)
-        self.max_watch_fraction = float(max_watch_fraction)
-        self.charge_return = bool(charge_return)
+        self.warm_start = choice_setting("warm_start", warm_start, WARM_STARTS)
+        self.backend = choice_setting("backend", backend, BACKENDS)
+        self.time_limit = float_setting("time_limit", time_limit, 0, lo_open=True, unit=" s")
+        self.deterministic = bool_setting("deterministic", deterministic)
+        self.solution_limit = int_setting("solution_limit", solution_limit, 1)
+        self.branch_limit = (
+            None if branch_limit is None else int_setting("branch_limit", branch_limit, 1)
+        )
+        self.iterations = int_setting("iterations", iterations, 1)
+        self.seed = int_setting("seed", seed, 0)
+        self.max_visits = int_setting("max_visits", max_visits, 0)
+        self.max_nodes = int_setting("max_nodes", max_nodes, 0)
+        self.nodes_per_vehicle = int_setting("nodes_per_vehicle", nodes_per_vehicle, 1)
+        self.group_vehicles = int_setting("group_vehicles", group_vehicles, 0)
+        self.fire_base_px = float_setting("fire_base_px", fire_base_px, 0)
+        self.fire_value_px = float_setting("fire_value_px", fire_value_px, 0)
+        self.watch_value_px = float_setting("watch_value_px", watch_value_px, 0)
+        self.search_value_px = float_setting("search_value_px", search_value_px, 0)
+        self.search_horizon_s = float_setting("search_horizon_s", search_horizon_s, 0, unit=" s")
+        self.fresh_s = float_setting("fresh_s", fresh_s, 0, unit=" s")
+        self.watch_altitude = float_setting("watch_altitude", watch_altitude, 0, lo_open=True)
+        self.search_altitude = float_setting("search_altitude", search_altitude, 0, lo_open=True)
+        self.max_watch_fraction = float_setting("max_watch_fraction", max_watch_fraction, 0, 1)
+        self.charge_return = bool_setting("charge_return", charge_return)
         self.first_solution = first_solution
         self.metaheuristic = metaheuristic
-        self.scale = float(scale)
-        self.warm_start = warm_start
+        self.scale = float_setting("scale", scale, 0, lo_open=True)
         # the search settings, checked now (unknown OR-Tools names raise ValueError)
         self._options: OrToolsOptions | PyVRPOptions = (
             OrToolsOptions(
@@ -536,6 +536,9 @@ class PyVRPRoutingScheduler(RoutingScheduler):
     ``routing-pyvrp``; takes the same settings."""
 
     name = "routing-pyvrp"
+    #: takes ``deterministic`` through ``**settings`` (PyVRP stops on iterations then), so
+    #: comparisons and sweeps run it deterministically like ``routing``
+    supports_deterministic = True
 
     def __init__(self, **settings: Any) -> None:
         settings.setdefault("backend", "pyvrp")

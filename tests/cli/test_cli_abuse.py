@@ -32,12 +32,10 @@ BAD_SPECS = [
     ("greedy:=1", "name:key=value"),
     ("cbba:search_altitude=nan", "search_altitude"),
 ]
-# Settings these schedulers accept today; their own branches add the checks (issue 17).
-# (routing:max_visits=0 is no longer one: it lifts the cap, the tour mode of solvers.routing.)
-PENDING = [
-    pytest.param(spec, marks=pytest.mark.xfail(reason="checked by the solver's own branch"))
-    for spec in ("routing:max_visits=-1",)
-] + ["milp-cvxpy:time_limit=-1"]
+# Settings that make a scheduler meaningless (routing:max_visits=0 is not one: it lifts the cap,
+# the tour mode of solvers.routing).
+MEANINGLESS = ["routing:max_visits=-1", "routing:time_limit=0", "routing-pyvrp:iterations=0",
+               "milp-cvxpy:time_limit=-1"]  # fmt: skip
 
 
 def _sweep_file(folder: Path, spec: str) -> str:
@@ -60,7 +58,7 @@ def test_bad_scheduler_specs_are_one_line_for_every_command(command, spec, named
     assert not (tmp_path / "r").exists() or not list((tmp_path / "r").glob("*.parquet"))
 
 
-@pytest.mark.parametrize("spec", PENDING)
+@pytest.mark.parametrize("spec", MEANINGLESS)
 def test_meaningless_settings_of_other_schedulers_are_refused(spec, capsys):
     """Settings that make routing, cbba or milp-cvxpy meaningless are refused in one line."""
     one_line_error(["run", "practice", "-s", spec], capsys, spec.split(":")[1].split("=")[0])

@@ -92,22 +92,8 @@ def test_unknown_names_and_broken_plugins(capsys, monkeypatch):
 #: Phrases of Python's own errors that a user should never read instead of "must be ...".
 LEAKS = ("not supported between", "invalid literal", "could not convert", "unexpected keyword")
 
-#: Schedulers whose factories still leak a Python error for a mistyped setting on this branch;
-#: their own branches validate every setting at construction (issue 17).
-PENDING = {
-    "milp": "milp's settings are validated on the milp branch",
-    "milp-cvxpy": "milp's settings are validated on the milp branch",
-    "routing": "routing's settings are validated on the sched branch",
-}
 
-
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(reason=PENDING[n])) if n in PENDING else n
-        for n in available_schedulers()
-    ],
-)
+@pytest.mark.parametrize("name", available_schedulers())
 def test_a_mistyped_setting_is_named_with_what_is_allowed(name, capsys):
     """``fcplan run 1 -s NAME:KEY=x`` for every numeric setting of every scheduler is one line
     naming the setting and its value, never a Python error's text (``-s milp:slots=x`` used to

@@ -27,21 +27,6 @@ OPTIMISING = ("routing", "routing-pyvrp", "cbba", "milp", "milp-cvxpy")
 #: Columns that measure time, not the episode: they may differ between two runs.
 TIMING = frozenset({"wall_time_s", "solve_p50_ms", "solve_p95_ms"})
 SECONDS = 12.0  # simulated seconds per episode: 12-25 replans each
-#: Schedulers whose default compare mode still reads the wall clock on main; their owners'
-#: branches add a deterministic mode (issue 17). The test runs and reports them either way.
-NOT_YET = {
-    "routing-pyvrp": "no deterministic mode yet: PyVRP stops on the wall clock (scheduler owner)",
-    "milp": "no deterministic mode on this branch yet (the milp branch adds it)",
-    "milp-cvxpy": "no deterministic mode on this branch yet (the milp branch adds it)",
-}
-
-
-def _param(name: str):
-    if name in NOT_YET:
-        return pytest.param(name, marks=pytest.mark.xfail(reason=NOT_YET[name], strict=False))
-    return name
-
-
 @contextlib.contextmanager
 def busy(n: int = os.cpu_count() or 2) -> Iterator[None]:
     """``n`` processes spinning on the CPU for as long as the block runs."""
@@ -66,7 +51,7 @@ def test_every_built_in_scheduler_is_covered():
     assert set(OPTIMISING) <= set(BUILT_IN)
 
 
-@pytest.mark.parametrize("scheduler", [_param(n) for n in BUILT_IN])
+@pytest.mark.parametrize("scheduler", BUILT_IN)
 def test_compare_gives_the_same_scores_with_one_and_two_jobs(scheduler):
     """compare(..., jobs=1) and compare(..., jobs=2) under extra load give identical episode
     rows (every score, outcome, replan and fallback count; timing columns aside) on 2 scenarios
@@ -96,7 +81,7 @@ def _trace_digest(spec: str, loaded: bool) -> tuple[str, list[str]]:
     return h.hexdigest(), [s.status for s in res.solves]
 
 
-@pytest.mark.parametrize("scheduler", [_param(n) for n in OPTIMISING])
+@pytest.mark.parametrize("scheduler", OPTIMISING)
 def test_an_optimising_scheduler_gives_the_same_trace_under_load(scheduler):
     """An optimisation scheduler in its default compare mode plays the same episode twice, once
     alone and once beside a busy loop on every core: the traces are equal byte for byte and
