@@ -216,6 +216,7 @@ def demonstrations(
     format: str = "npz",
     dataset_id: str | None = None,
     num_envs: int = 1,
+    progress: Any = True,
 ) -> Any:
     """Roll ``scheduler`` out through the task-level env on every (scenario, seed).
 
@@ -245,6 +246,10 @@ def demonstrations(
         (:func:`fcplan.env.demo_episodes.batched_rollouts`, one scheduler instance per world);
         the dataset is the one ``num_envs=1`` gives, for schedulers that keep no state between
         episodes.
+    progress : bool or callable
+        ``True`` (default): a progress bar on stderr counted in episodes, the one of ``compare``
+        and ``sweep`` (:mod:`fcplan.experiments.progress`; in place in Jupyter); ``False``:
+        silent; or a ``progress(done, total, row)`` callback.
 
     Returns
     -------
@@ -255,23 +260,17 @@ def demonstrations(
     sched, name, settings = _scheduler(scheduler)
     env_kwargs = dict(env_kwargs or {})
     env_kwargs.pop("render_mode", None)
+    from fcplan.experiments.progress import episode_progress
+
     seeds = [int(s) for s in seeds]
-    rollouts = _Rollouts(sched, time_limit)
-    scen_docs: dict[str, dict[str, Any]] = {}
-    for sc in scenarios:
-        scenario = as_scenario(sc)
-        key = _scenario_key(scen_docs, scenario)
-        if num_envs > 1:
-            rollouts.add_batched(scenario, scheduler, key, seeds, int(num_envs), env_kwargs)
-            continue
-        env = TaskEnv(scenario, **env_kwargs)
-        for seed in seeds:
-            rollouts.add(rollout_episode(env, sched, key, seed, time_limit=time_limit,
-                                         counts=rollouts.counts))  # fmt: skip
-    for rec in recordings:
-        scenario = rec.scenario
-        key = _scenario_key(scen_docs, scenario)
-        rollouts.add(recording_episode(rec, TaskEnv(scenario, **env_kwargs), key))
+    scenarios, recordings = list(scenarios), list(recordings)
+    bar = episode_progress(progress, "demonstrations")
+    rollouts = _Rollouts(sched, time_limit, bar, len(scenarios) * len(seeds) + len(recordings))
+    try:
+        scen_docs = _roll_out(rollouts, sched, scheduler, scenarios, seeds, recordings, env_kwargs,
+                              time_limit, num_envs)  # fmt: skip
+    finally:
+        getattr(bar, "close", lambda: None)()
     meta = {
         "format": "fcplan-demonstrations",
         "version": FORMAT_VERSION,
@@ -299,6 +298,37 @@ def demonstrations(
     return demo
 
 
+def _roll_out(
+    rollouts: _Rollouts,
+    sched: Scheduler,
+    spec: str | Scheduler,
+    scenarios: list[ScenarioLike],
+    seeds: list[int],
+    recordings: list[Any],
+    env_kwargs: dict[str, Any],
+    time_limit: float | None,
+    num_envs: int,
+) -> dict[str, dict[str, Any]]:
+    """Add every (scenario, seed) episode and every recording to ``rollouts``; the scenario
+    documents by dataset key."""
+    scen_docs: dict[str, dict[str, Any]] = {}
+    for sc in scenarios:
+        scenario = as_scenario(sc)
+        key = _scenario_key(scen_docs, scenario)
+        if num_envs > 1:
+            rollouts.add_batched(scenario, spec, key, seeds, int(num_envs), env_kwargs)
+            continue
+        env = TaskEnv(scenario, **env_kwargs)
+        for seed in seeds:
+            rollouts.add(rollout_episode(env, sched, key, seed, time_limit=time_limit,
+                                         counts=rollouts.counts))  # fmt: skip
+    for rec in recordings:
+        scenario = rec.scenario
+        key = _scenario_key(scen_docs, scenario)
+        rollouts.add(recording_episode(rec, TaskEnv(scenario, **env_kwargs), key))
+    return scen_docs
+
+
 def _scenario_key(docs: dict[str, dict[str, Any]], scenario: Any) -> str:
     """The dataset's key of ``scenario`` (its name, primed while another one holds it)."""
     doc = scenario.to_dict()
@@ -312,8 +342,11 @@ def _scenario_key(docs: dict[str, dict[str, Any]], scenario: Any) -> str:
 class _Rollouts:
     """The rows, mapping counts and episode records of a dataset's episodes."""
 
-    def __init__(self, scheduler: Scheduler, time_limit: float | None) -> None:
+    def __init__(
+        self, scheduler: Scheduler, time_limit: float | None, progress: Any = None, total: int = 0
+    ) -> None:
         self.scheduler, self.time_limit = scheduler, time_limit
+        self.progress, self.total = progress, total
         self.parts: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
         self.episodes: list[dict[str, Any]] = []
         self.records: list[EpisodeRecord] = []
@@ -322,6 +355,11 @@ class _Rollouts:
 
     def add(self, rec: EpisodeRecord) -> None:
         """Append one episode: its rows (one per step and agent) and its record."""
+        self._append(rec)
+        if self.progress is not None:
+            self.progress(len(self.episodes), self.total, {})
+
+    def _append(self, rec: EpisodeRecord) -> None:
         parts, ep = self.parts, len(self.episodes)
         n, n_a = rec.steps, rec.actions.shape[1]
         obs = rec.observations

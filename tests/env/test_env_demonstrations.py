@@ -126,3 +126,16 @@ def test_batched_rollouts_equal_sequential_ones():
         assert many.arrays[name].dtype == arr.dtype and np.array_equal(many.arrays[name], arr)
     for key in ("episodes", "mapping", "conflicts", "fallbacks"):
         assert many.metadata[key] == one.metadata[key]
+
+
+def test_demonstrations_report_progress_per_episode():
+    """demonstrations() counts its episodes through the progress callback of compare and sweep
+    (scheduler episodes, then recorded games), ending at the total; progress=False is silent."""
+    calls = []
+    demo = demonstrations(
+        "greedy", ["practice"], [0, 1], env_kwargs={"max_steps": 3},
+        progress=lambda done, total, row: calls.append((done, total)),
+    )  # fmt: skip
+    assert calls == [(1, 2), (2, 2)]
+    assert demo.n_episodes == 2
+    demonstrations("greedy", ["practice"], [0], env_kwargs={"max_steps": 3}, progress=False)
