@@ -181,7 +181,7 @@ class RoutingScheduler:
         OR-Tools ``FirstSolutionStrategy`` (or ``"auto"``, see
         :mod:`solvers.routing.ortools_backend`) / ``LocalSearchMetaheuristic`` names.
     scale : float
-        Integer units per px in the models (10: decimetres).
+        Integer units per px in the models (10: decimetres), in 0.01..1000.
     warm_start : {"fallback", "search", "off"}
         How the last plan's routes are used (see the module docstring); ``True`` / ``False``
         mean ``"search"`` / ``"off"``.
@@ -228,7 +228,7 @@ class RoutingScheduler:
             None if branch_limit is None else int_setting("branch_limit", branch_limit, 1)
         )
         self.iterations = int_setting("iterations", iterations, 1)
-        self.seed = int_setting("seed", seed, 0)
+        self.seed = int_setting("seed", seed, 0, 2**31 - 1)  # PyVRP and OR-Tools take 32 bits
         self.max_visits = int_setting("max_visits", max_visits, 0)
         self.max_nodes = int_setting("max_nodes", max_nodes, 0)
         self.nodes_per_vehicle = int_setting("nodes_per_vehicle", nodes_per_vehicle, 1)
@@ -245,7 +245,8 @@ class RoutingScheduler:
         self.charge_return = bool_setting("charge_return", charge_return)
         self.first_solution = first_solution
         self.metaheuristic = metaheuristic
-        self.scale = float_setting("scale", scale, 0, lo_open=True)
+        # integer units per px: 10,000 px x 1,000 stays far inside the solvers' 64-bit costs
+        self.scale = float_setting("scale", scale, 0.01, 1000.0)
         # the search settings, checked now (unknown OR-Tools names raise ValueError)
         self._options: OrToolsOptions | PyVRPOptions = (
             OrToolsOptions(

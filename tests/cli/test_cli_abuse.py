@@ -35,6 +35,7 @@ BAD_SPECS = [
 # Settings that make a scheduler meaningless (routing:max_visits=0 is not one: it lifts the cap,
 # the tour mode of solvers.routing).
 MEANINGLESS = ["routing:max_visits=-1", "routing:time_limit=0", "routing-pyvrp:iterations=0",
+               "routing:scale=1e300", "routing-pyvrp:seed=99999999999999999999",
                "milp-cvxpy:time_limit=-1"]  # fmt: skip
 
 
