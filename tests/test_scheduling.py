@@ -522,3 +522,13 @@ def test_no_time_out_leaves_a_role_with_work_idle(seed, keep, status):
     assert (out.stats.status == "fallback") == (
         not routes and bool(scheduling.idle_team(Plan(), g))
     )
+
+
+@pytest.mark.parametrize("name", ["idle", "random", "greedy"])
+def test_solve_records_the_graph_size_of_every_scheduler(name):
+    """solve() records every replan's graph size (agents, tasks) whatever the scheduler reports,
+    so schedulers that report none (idle, random) are drawn on the solve-time plots too."""
+    g = _synthetic(3, n_agents=5, n_tasks=20)
+    stats = solve(make_scheduler(name), g, time_limit=None, rng=rng()).stats
+    assert stats.size["agents"] == g.n_agents == 5
+    assert stats.size["tasks"] == g.n_tasks == 20
