@@ -257,11 +257,11 @@ def demonstrations(
     """
     if format not in ("npz", "minari"):
         raise DemonstrationError(f"format: must be 'npz' or 'minari' (got {format!r})")
+    from fcplan.experiments.progress import episode_progress
+
     sched, name, settings = _scheduler(scheduler)
     env_kwargs = dict(env_kwargs or {})
     env_kwargs.pop("render_mode", None)
-    from fcplan.experiments.progress import episode_progress
-
     seeds = [int(s) for s in seeds]
     scenarios, recordings = list(scenarios), list(recordings)
     bar = episode_progress(progress, "demonstrations")
@@ -354,12 +354,8 @@ class _Rollouts:
         self.fallbacks = self.conflicts = 0
 
     def add(self, rec: EpisodeRecord) -> None:
-        """Append one episode: its rows (one per step and agent) and its record."""
-        self._append(rec)
-        if self.progress is not None:
-            self.progress(len(self.episodes), self.total, {})
-
-    def _append(self, rec: EpisodeRecord) -> None:
+        """Append one episode: its rows (one per step and agent) and its record; count it on
+        the progress callback."""
         parts, ep = self.parts, len(self.episodes)
         n, n_a = rec.steps, rec.actions.shape[1]
         obs = rec.observations
@@ -385,6 +381,8 @@ class _Rollouts:
                 "source": rec.source,
             }
         )
+        if self.progress is not None:
+            self.progress(len(self.episodes), self.total, {})
 
     def add_batched(self, scenario: Any, spec: Any, key: str, seeds: list[int], num: int,
                     env_kwargs: dict[str, Any]) -> None:  # fmt: skip
