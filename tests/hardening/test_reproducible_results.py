@@ -27,6 +27,8 @@ OPTIMISING = ("routing", "routing-pyvrp", "cbba", "milp", "milp-cvxpy")
 #: Columns that measure time, not the episode: they may differ between two runs.
 TIMING = frozenset({"wall_time_s", "solve_p50_ms", "solve_p95_ms"})
 SECONDS = 12.0  # simulated seconds per episode: 12-25 replans each
+
+
 @contextlib.contextmanager
 def busy(n: int = os.cpu_count() or 2) -> Iterator[None]:
     """``n`` processes spinning on the CPU for as long as the block runs."""
