@@ -14,10 +14,12 @@ from fcplan.testing import check_scheduler, episode_graphs
 
 #: a spread of shipped scenarios for the default suite (all of them: the slow test below)
 SUBSET = ("practice", "1", "12", "24", "open_world_example", "scale_example")
-BUILTIN = ("greedy", "idle", "random", "routing", "milp", "milp-cvxpy", "cbba", "oracle")
+BUILTIN = ("greedy", "idle", "random", "routing", "routing-pyvrp", "milp", "milp-cvxpy", "cbba",
+           "oracle")  # fmt: skip
 #: settings that make a scheduler's plans independent of wall time and load
 DETERMINISTIC = {
     "routing": {"deterministic": True},
+    "routing-pyvrp": {"deterministic": True},
     # wall-clock solvers: a limit far above their solve times (ms) keeps the run load-proof
     "milp": {"time_limit": 30.0},
     "milp-cvxpy": {"time_limit": 30.0},
@@ -27,6 +29,13 @@ DETERMINISTIC = {
 def _factory(name: str, **extra: Any):
     settings = {**DETERMINISTIC.get(name, {}), **extra}
     return lambda: make_scheduler(name, **settings)
+
+
+def test_the_kit_runs_on_every_registered_scheduler():
+    """BUILTIN names every scheduler the package registers (a new one is added to the kit)."""
+    from fcplan.scheduling import available_schedulers
+
+    assert set(BUILTIN) == set(available_schedulers())
 
 
 @pytest.mark.parametrize("name", BUILTIN)
