@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 from fcplan import Plan
-from fcplan.scheduling import make_scheduler
+from fcplan.scheduling import available_schedulers, make_scheduler
 from fcplan.testing import check_scheduler, episode_graphs
 
 #: a spread of shipped scenarios for the default suite (all of them: the slow test below)
@@ -33,8 +33,6 @@ def _factory(name: str, **extra: Any):
 
 def test_the_kit_runs_on_every_registered_scheduler():
     """BUILTIN names every scheduler the package registers (a new one is added to the kit)."""
-    from fcplan.scheduling import available_schedulers
-
     assert set(BUILTIN) == set(available_schedulers())
 
 
