@@ -3,8 +3,8 @@
 :func:`run_cli` runs ``fcplan argv`` in a child process of its own session (so every process it
 starts, pool workers included, can be found afterwards by session id), with an address-space
 limit (``RLIMIT_AS``) and a wall-clock bound, and returns a :class:`Case`: the exit status, the
-stderr text, the child's peak resident memory (``wait4``'s ``ru_maxrss``, see :data:`_LAUNCHER`), the seconds it took,
-the processes of its session still alive :data:`ORPHAN_GRACE_S` after it ended (killed, then
+stderr text, the child's peak resident memory (``wait4``'s ``ru_maxrss``, see :data:`_LAUNCHER`),
+the seconds it took, the processes of its session still alive :data:`ORPHAN_GRACE_S` after it ended (killed, then
 counted as orphans) and its :class:`Outcome`.
 
 Two ways to start the child: ``fork=True`` forks this process and calls
@@ -234,7 +234,7 @@ def _spawned(
             "-m",
             "fcplan",
             *argv,
-        ],  # fmt: skip
+        ],
         stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL,
         stderr=err,
