@@ -23,6 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fcplan.taskgraph import TaskGraph, TaskKind
+from fcplan.taskgraph.types import pairwise_distance
 from solvers.milp_model.constraints import model_rows
 from solvers.milp_model.objective import (
     CELL_RATE,
@@ -162,7 +163,9 @@ def _given_routes(
             continue
         first_fire = bool(ctx.fire[rows[0]])
         kind = DUMP if first_fire and roles.dumper[a] else WATCH if first_fire else SEARCH
-        legs = np.r_[g.start_task_distance[a, rows[0]], g.task_distance[rows[:-1], rows[1:]]]
+        pos = g.task_pos[rows]
+        between = pairwise_distance(pos, pos)[np.arange(rows.size - 1), np.arange(1, rows.size)]
+        legs = np.r_[g.start_task_distance[a, rows[0]], between]
         flown = np.cumsum(legs)
         arrival = float(roles.t0[a]) + flown / max(float(g.agent_speed[a]), 1e-9)
         px = float(flown[-1] + g.task_home_distance[a, rows[-1]])

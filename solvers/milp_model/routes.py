@@ -34,6 +34,7 @@ from functools import lru_cache
 import numpy as np
 
 from fcplan.taskgraph import TaskGraph, TaskKind
+from fcplan.taskgraph.types import pairwise_distance
 from fcplan.team import Mode
 
 __all__ = ["AgentRoles", "agent_roles", "enumerate_routes", "top_candidates"]
@@ -120,7 +121,10 @@ def enumerate_routes(
         order = order[np.asarray(first, dtype=bool)[order[:, 0]]]
     d_start = graph.start_task_distance[agent, cands]
     d_home = graph.task_home_distance[agent, cands]
-    d_between = graph.task_distance[np.ix_(cands, cands)]
+    # only the candidates' distances: the graph's (K, K) table costs O(K^2) time and memory
+    # (2,000 tasks: 32 MB and tens of ms), of which a model reads a few hundred entries
+    pos = graph.task_pos[cands]
+    d_between = pairwise_distance(pos, pos)
     valid = order >= 0
     idx = np.where(valid, order, 0)
     leg = np.zeros(order.shape)
