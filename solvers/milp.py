@@ -16,8 +16,8 @@ Limits and determinism
   seconds, a count of work, not of wall time), never on the wall clock: the same graph (and the
   same previous plan, the warm start) gives the same plan in any process and under any load.
 * **Wall-clock mode** (a ``time_limit`` given to :meth:`plan`, or ``deterministic=False`` with
-  the ``time_limit`` setting): the limit covers the whole call. About 5 % of it is kept back for
-  decoding; CP-SAT gets what is left after building the model and its own arrays
+  the ``time_limit`` setting): the limit covers the whole call. About 15 % of it is kept back
+  for what follows the solve (completing, checking and decoding the plan); CP-SAT gets what is left after building the model and its own arrays
   (``max_time_in_seconds``). If building used it all, :meth:`plan` raises ``TimeoutError``.
 * **No idle team**: the search starts from a complete first solution (the previous plan's
   routes still in the model, then routes of largest gain, :mod:`solvers.milp_model.start`) given

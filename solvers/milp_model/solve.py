@@ -120,6 +120,10 @@ def _solve_part(
             x, st = backend(sub, limits=limits, seed=seed, hint=hint)
         except IncompletePlanError as exc:
             return hint, "time_limit", gain_bound(sub), {"message": str(exc)}
+        if st.status != "optimal" and sub.objective(x) < sub.objective(hint):
+            # a limit stopped a backend that takes no hint (HiGHS through cvxpy) at a worse
+            # point than the warm start: keep the better of the two (an anytime incumbent)
+            x = hint
         work = float(st.size.get("deterministic_time", 0.0))
         bound = float(st.bound) if np.isfinite(st.bound) else gain_bound(sub)
         return x, st.status, bound, {"work": work}

@@ -161,9 +161,12 @@ class Gains:
         rows = self.routes.indices[pos].astype(np.int64)
         self.slack[rows] -= self.routes.data[pos]
         z = self.row_aux[rows]
-        exact_rows = np.r_[rows[z < 0], self.aux_rows[z[z >= 0]][self._freeze[z[z >= 0]]].ravel()]
+        aux = z >= 0
+        frozen = self._freeze[z[aux]]  # (indexed only where there is an auxiliary: a model
+        # may have none, and then this array is empty)
+        exact_rows = np.r_[rows[~aux], self.aux_rows[z[aux]][frozen].ravel()]
         exact_rows = np.unique(exact_rows[exact_rows >= 0])
-        cover_rows = rows[(z >= 0) & ~self._freeze[np.maximum(z, 0)]]
+        cover_rows = rows[aux][~frozen]
         exact = np.unique(np.r_[self._routes_in(exact_rows), route])
         self._stale[self._routes_in(cover_rows)] = True
         self._stale[exact] = False
