@@ -98,6 +98,13 @@ class EpisodeResult:
         return np.array([s.wall_time_s for s in self.solves], dtype=np.float64)
 
     @property
+    def solve_gaps(self) -> np.ndarray:
+        """(R,) each replan's relative optimality gap, ``(bound - objective) / |objective|``,
+        where its scheduler proved a bound on its own model (0: solved to optimality); NaN where
+        it proved none (heuristics, auctions, fallbacks)."""
+        return np.array([s.gap for s in self.solves], dtype=np.float64)
+
+    @property
     def outcomes(self) -> Outcomes:
         """Time to containment, burned area and facility damage (:mod:`fcplan.metrics.outcomes`)."""
         return compute_outcomes(self.trace)
@@ -128,6 +135,8 @@ class EpisodeResult:
             out[f"outcome.{k}"] = v
         st = self.solve_times_s
         statuses = [s.status for s in self.solves]
+        gaps = self.solve_gaps
+        bounded = gaps[np.isfinite(gaps)]
         rounds = [s.size["rounds"] for s in self.solves if "rounds" in s.size]
         messages = [s.size["messages"] for s in self.solves if "messages" in s.size]
         out.update(
@@ -140,6 +149,9 @@ class EpisodeResult:
             time_limit_replans=statuses.count("time_limit"),
             solve_p50_ms=float(np.median(st) * 1e3) if st.size else 0.0,
             solve_p95_ms=float(np.percentile(st, 95) * 1e3) if st.size else 0.0,
+            bounded_replans=int(bounded.size),
+            gap_p50=float(np.median(bounded)) if bounded.size else float("nan"),
+            gap_max=float(bounded.max()) if bounded.size else float("nan"),
             rounds_per_replan=float(np.mean(rounds)) if rounds else float("nan"),
             messages_per_replan=float(np.mean(messages)) if messages else float("nan"),
         )

@@ -58,7 +58,7 @@ NOT_RUN = {
     ),
     "fcplan report results/study --html": "needs the study's results",
     "fcplan sweep bench/suite_v1_hard.toml --results bench/results/bench-v1 --jobs 2": (
-        "the leaderboard's hard-tier study (720 episodes, hours of CPU)"
+        "the leaderboard's hard-tier study (960 episodes, hours of CPU)"
     ),
     "fcplan sweep bench/suite_v1_scale.toml --results bench/results/bench-v1 --jobs 2": (
         "the leaderboard's scale-tier study (hours of CPU)"

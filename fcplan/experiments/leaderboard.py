@@ -10,8 +10,9 @@ the tier ``other``) and computes, per tier and scheduler:
   ``fcplan report`` prints (the interval includes the spread between scenarios, so it is wide;
   compare schedulers with the paired table instead);
 * the **fraction of the oracle**: ``F = sum_i (s_i - idle_i) / sum_i (oracle_i - idle_i)`` over
-  the (scenario, seed) pairs ``i`` where the scheduler, the clairvoyant ``oracle`` and the
-  ``idle`` team all completed: the share of the oracle's improvement over doing nothing that the
+  the (scenario, seed) pairs ``i`` where the scheduler, the clairvoyant reference and the
+  ``idle`` team all completed (the reference ``oracle_i`` is the best of the oracle variants run
+  on the pair, ``oracle``, ``oracle[routing]``, ...: :func:`reference_scores`): the share of the oracle's improvement over doing nothing that the
   scheduler achieved on the same pairs (1 = as good as the oracle, 0 = no better than idle). It
   is a **ratio of means**, not a mean of per-pair ratios: a pair where the oracle barely beats
   idle (nothing was at stake) would give a huge or undefined per-pair ratio, while the ratio of
@@ -23,8 +24,9 @@ the tier ``other``) and computes, per tier and scheduler:
   interval is a percentile bootstrap (2,000 draws, seed 0) that resamples seeds within each
   scenario: the suite's scenarios are fixed, seeds are the random part;
 * OFS, time to containment and burned area (means), the scenarios *cleared* (OFS 100 % on every
-  seed), the solve time per replan (p50 and p95 over every replan of the tier), and the replans
-  that fell back to greedy;
+  seed), the solve time per replan (p50 and p95 over every replan of the tier), the proven
+  optimality gap per replan of the schedulers that prove a bound on their own model (p50 and p95
+  over the replans that have one), and the replans that fell back to greedy;
 * **paired comparisons** of the policies (every scheduler except the oracle references and the
   ``idle`` and ``random`` baselines), each pair on the (scenario, seed) instances both completed:
   mean difference and its interval, Wilcoxon p-value Holm-adjusted over the tier's pairs of
@@ -84,6 +86,7 @@ __all__ = [
     "leaderboard",
     "metric_direction",
     "read_episodes",
+    "reference_scores",
     "tier_of",
 ]
 
@@ -158,6 +161,9 @@ class SchedulerStats:
     cleared: int = 0
     solve_p50_ms: float = math.nan
     solve_p95_ms: float = math.nan
+    bounded_replans: int = 0
+    gap_p50: float = math.nan
+    gap_p95: float = math.nan
     fallbacks: int = 0
     replans: int = 0
     deterministic: bool | None = None
@@ -176,7 +182,9 @@ class TierCheck:
     """Policy pairs with Holm-adjusted p < 0.01."""
     pairs: int
     oracle_top: bool | None
-    """The oracle's mean is at least as good as every policy's (None without oracle episodes)."""
+    """The clairvoyant reference's mean (the best oracle variant per pair,
+    :func:`reference_scores`) is at least as good as every policy's (None without oracle
+    episodes)."""
 
     @property
     def keep(self) -> bool:
@@ -364,6 +372,27 @@ def _pooled_percentiles(rows: list[dict[str, Any]]) -> tuple[float, float]:
     return float(np.percentile(a, 50)), float(np.percentile(a, 95))
 
 
+def _pooled_gaps(rows: list[dict[str, Any]]) -> tuple[int, float, float]:
+    """(replans with a proven bound, p50, p95 of their relative gaps) over every replan of
+    ``rows`` (``replan_gap`` lists; rows of ``fcplan compare --json``, which have none, give
+    the median of their ``gap_p50`` and no p95)."""
+    gaps: list[float] = []
+    listed = False
+    for r in rows:
+        g = r.get("replan_gap")
+        if g is not None:
+            listed = True
+            gaps.extend(float(x) for x in g if finite(x))
+    if gaps:
+        a = np.asarray(gaps)
+        return a.size, float(np.percentile(a, 50)), float(np.percentile(a, 95))
+    if listed:
+        return 0, math.nan, math.nan
+    p50 = [float(r["gap_p50"]) for r in rows if finite(r.get("gap_p50"))]
+    n = int(sum(int(r.get("bounded_replans") or 0) for r in rows))
+    return (n, float(np.median(p50)), math.nan) if p50 else (0, math.nan, math.nan)
+
+
 def finite(v: Any) -> bool:
     """Whether ``v`` is a finite number (not None, NaN or text)."""
     return isinstance(v, (int, float, np.integer, np.floating)) and math.isfinite(float(v))
@@ -391,6 +420,7 @@ def _scheduler_stats(
     refs: dict[str, dict[tuple[str, int], float]],
 ) -> SchedulerStats:
     p50, p95 = _pooled_percentiles(rows)
+    bounded, gap50, gap95 = _pooled_gaps(rows)
     frac: tuple[float, tuple[float, float], float] = (math.nan, (math.nan, math.nan), math.nan)
     if ORACLE in refs and IDLE in refs:
         keys = [
@@ -421,6 +451,9 @@ def _scheduler_stats(
         cleared=_cleared(rows, scenarios),
         solve_p50_ms=p50,
         solve_p95_ms=p95,
+        bounded_replans=bounded,
+        gap_p50=gap50,
+        gap_p95=gap95,
         fallbacks=int(sum(int(r.get("fallbacks") or 0) for r in rows)),
         replans=int(sum(int(r.get("replans") or 0) for r in rows)),
         deterministic=flags.pop() if len(flags) == 1 else None,
@@ -432,16 +465,17 @@ def _check(
     pairs: list[PairedComparison],
     scenarios: list[str],
     sign: float,
+    reference: Mapping[tuple[str, int], float] | None = None,
 ) -> TierCheck:
     policies = tuple(k for k in stats if is_policy(k))
     cis = {k: stats[k].mean for k in policies}
     inside = all(
         cis[b].low <= cis[a].mean <= cis[b].high for a in policies for b in policies if a != b
     )
-    oracles = [k for k in stats if k == ORACLE]
     top = None
-    if oracles and policies:
-        top = all(sign * (stats[ORACLE].mean.mean - cis[k].mean) >= 0 for k in policies)
+    if reference and policies:
+        ref_mean = float(np.mean(list(reference.values())))
+        top = all(sign * (ref_mean - cis[k].mean) >= 0 for k in policies)
     return TierCheck(
         policies=policies,
         separated=len(policies) > 1 and not inside,
@@ -457,17 +491,16 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
     labels = list(dict.fromkeys(str(r["scheduler"]) for r in rows))
     scenarios = sorted({str(r["scenario"]) for r in rows})
     by = {k: [r for r in ok if r["scheduler"] == k] for k in labels}
-    refs = {
-        k: {(r["scenario"], int(r["seed"])): float(r[metric]) for r in by[k]}
-        for k in (ORACLE, IDLE)
-        if by.get(k)
-    }
+    sign = 1.0 if metric_direction(metric)[2] else -1.0
+    refs = {IDLE: _scores(by[IDLE], metric)} if by.get(IDLE) else {}
+    oracles = [k for k in labels if k.startswith(ORACLE) and by[k]]
+    if oracles:
+        refs[ORACLE] = reference_scores([_scores(by[k], metric) for k in oracles], sign)
     stats = {
         k: _scheduler_stats(by[k], sum(r["scheduler"] == k for r in rows) - len(by[k]),
                             metric, scenarios, refs)
         for k in labels if by[k]
     }  # fmt: skip
-    sign = 1.0 if metric_direction(metric)[2] else -1.0
     policies = sorted((k for k in stats if is_policy(k)), key=lambda k: -sign * stats[k].mean.mean)
     others = [k for k in stats if not is_policy(k)]
     order = policies + sorted(others, key=lambda k: (k != ORACLE, not k.startswith(ORACLE), k))
@@ -481,9 +514,34 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
         stats=stats,
         order=order,
         pairs=pairs,
-        check=_check(stats, pairs, scenarios, sign),
+        check=_check(stats, pairs, scenarios, sign, refs.get(ORACLE)),
         settings={k: _settings(by[k]) for k in order if _settings(by[k])},
     )
+
+
+def _scores(rows: list[dict[str, Any]], metric: str) -> dict[tuple[str, int], float]:
+    return {(str(r["scenario"]), int(r["seed"])): float(r[metric]) for r in rows}
+
+
+def reference_scores(
+    variants: Sequence[Mapping[tuple[str, int], float]], sign: float = 1.0
+) -> dict[tuple[str, int], float]:
+    """The clairvoyant reference per (scenario, seed): the best score of the oracle variants
+    (``oracle``, ``oracle[routing]``, ...) over the pairs where every variant completed.
+
+    No single clairvoyant planner is best everywhere (a greedy inner planner can be distracted by
+    fire it cannot reach), so the reference is the best of those run, like a best-known solution.
+
+    Examples
+    --------
+    >>> reference_scores([{("h", 0): 1.0, ("h", 1): 5.0}, {("h", 0): 3.0}])
+    {('h', 0): 3.0}
+    >>> reference_scores([{("h", 0): 1.0}, {("h", 0): 3.0}], sign=-1.0)  # lower is better
+    {('h', 0): 1.0}
+    """
+    keys = set(variants[0]).intersection(*variants[1:]) if variants else set()
+    pick = max if sign > 0 else min
+    return {k: pick(v[k] for v in variants) for k in sorted(keys)}
 
 
 def _instance(row: Mapping[str, Any]) -> tuple[str, int]:

@@ -15,12 +15,14 @@ Row columns (one per episode; :func:`fcplan.experiments.load_results` reads them
   from :attr:`fcplan.SolveStats.size`);
 * every key of :meth:`fcplan.EpisodeResult.summary` (``manual.*`` and ``reference2020.*``
   metrics, ``ticks``, ``wall_time_s``, ``replans``, ``fallbacks``, ``optimal_replans``,
-  ``time_limit_replans``, ``solve_p50_ms``, ``solve_p95_ms``, ``rounds_per_replan``,
-  ``messages_per_replan``) plus ``solve_mean_ms``, ``solve_max_ms``;
+  ``time_limit_replans``, ``solve_p50_ms``, ``solve_p95_ms``, ``bounded_replans``, ``gap_p50``,
+  ``gap_max``, ``rounds_per_replan``, ``messages_per_replan``) plus ``solve_mean_ms``,
+  ``solve_max_ms``;
 * ``deterministic`` (the scheduler ran in a mode whose plans do not depend on the wall clock:
   its ``deterministic`` attribute) and ``fallback_majority`` (it fell back to greedy on more than
   half of its replans, so the scores are mostly greedy's);
-* per replan (lists): ``replan_solve_ms``, ``replan_tasks``, ``replan_agents``;
+* per replan (lists): ``replan_solve_ms``, ``replan_gap`` (the scheduler's proven relative
+  optimality gap on its own model, NaN where it proves none), ``replan_tasks``, ``replan_agents``;
 * ``status`` (``ok`` | ``failed``), ``error`` (``""`` or ``"ExcType: message"``),
   ``episode_wall_s`` (including scheduler construction), ``host``, ``finished_at`` (UTC ISO
   time), ``versions`` (JSON: fcplan, python, numpy and the solver libraries in this worker).
@@ -149,6 +151,7 @@ def play_episode(spec: Any, runtime: dict[str, Callable[..., Any]] | None = None
             tasks_mean=float(np.mean(known)) if known else math.nan,
             tasks_max=float(max(known)) if known else math.nan,
             replan_solve_ms=[float(x) for x in ms],
+            replan_gap=[float(x) for x in res.solve_gaps],
             replan_tasks=tasks,
             replan_agents=agents,
             status="ok",

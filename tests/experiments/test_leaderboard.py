@@ -121,6 +121,43 @@ def test_policies_ranked_references_apart_and_stats_computed():
     assert t.scenarios == [HARD.format(1), HARD.format(2)] and t.seeds == [0, 1, 2, 3]
 
 
+def test_proven_gaps_pool_every_bounded_replan_and_show_a_dash_without_one():
+    """The gap column pools the replans where a scheduler proved a bound (NaN: none) and says
+    on how many; a scheduler that proves no bound gets '-'."""
+    n = 8
+    rows = _rows({"milp": [10.0] * n, "greedy": [5.0] * n, "oracle": [30.0] * n,
+                  "idle": [-70.0] * n})  # fmt: skip
+    for r in rows:
+        r["replan_gap"] = (
+            [0.0, 0.0, 0.1, float("nan")] if r["scheduler"] == "milp" else [float("nan")] * 4
+        )
+    t = leaderboard(rows).tiers[0]
+    milp, greedy = t.stats["milp"], t.stats["greedy"]
+    assert milp.bounded_replans == 3 * n and milp.gap_p50 == 0.0
+    assert milp.gap_p95 == pytest.approx(np.percentile([0.0, 0.0, 0.1] * n, 95))
+    assert greedy.bounded_replans == 0 and math.isnan(greedy.gap_p50)
+    page = markdown(leaderboard(rows))
+    line = next(x for x in page.splitlines() if x.startswith("| 1 | milp"))
+    assert f"0.00 / {100 * milp.gap_p95:.2f} ({3 * n}/{10 * n})" in line
+    assert "| - |" in next(x for x in page.splitlines() if "| greedy" in x)
+
+
+def test_the_reference_is_the_best_oracle_variant_on_each_pair():
+    """With two oracle variants the fraction's reference and the tier check's oracle mean are
+    the better variant per (scenario, seed); with one, that variant."""
+    n = 8
+    rows = _rows({"greedy": [20.0] * n, "oracle": [30.0, 0.0] * 4,
+                  "oracle[routing]": [0.0, 30.0] * 4, "idle": [-70.0] * n})  # fmt: skip
+    t = leaderboard(rows).tiers[0]
+    assert t.stats["greedy"].fraction == pytest.approx(0.9)  # (20 + 70) / (30 + 70)
+    assert t.stats["oracle"].fraction == pytest.approx(680 / 800)
+    assert t.check.oracle_top is True  # the reference scores 30 on every pair
+    assert t.order[-3:] == ["oracle", "oracle[routing]", "idle"]
+    alone = leaderboard([r for r in rows if r["scheduler"] != "oracle[routing]"]).tiers[0]
+    assert alone.stats["greedy"].fraction == pytest.approx(720 / 680)
+    assert alone.check.oracle_top is False  # the oracle's mean 15 is below greedy's 20
+
+
 def test_tier_check_counts_resolved_pairs_and_cleared_scenarios():
     """Clearly different policies are separated with every pair resolved at Holm p < 0.01 and
     the tier accepted; identical ones are not separated; OFS 100 everywhere is reported."""
