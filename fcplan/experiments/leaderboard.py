@@ -379,8 +379,8 @@ def _pooled_gaps(rows: list[dict[str, Any]]) -> tuple[int, float, float]:
     gaps: list[float] = []
     listed = False
     for r in rows:
-        g = r.get("replan_gap")
-        if g is not None:
+        g = r.get("replan_gap")  # results of an older fcplan have none (None or NaN)
+        if isinstance(g, (list, tuple, np.ndarray)):
             listed = True
             gaps.extend(float(x) for x in g if finite(x))
     if gaps:
@@ -389,7 +389,7 @@ def _pooled_gaps(rows: list[dict[str, Any]]) -> tuple[int, float, float]:
     if listed:
         return 0, math.nan, math.nan
     p50 = [float(r["gap_p50"]) for r in rows if finite(r.get("gap_p50"))]
-    n = int(sum(int(r.get("bounded_replans") or 0) for r in rows))
+    n = int(sum(int(r["bounded_replans"]) for r in rows if finite(r.get("bounded_replans"))))
     return (n, float(np.median(p50)), math.nan) if p50 else (0, math.nan, math.nan)
 
 
@@ -466,6 +466,7 @@ def _check(
     scenarios: list[str],
     sign: float,
     reference: Mapping[tuple[str, int], float] | None = None,
+    scores: Mapping[str, Mapping[tuple[str, int], float]] | None = None,
 ) -> TierCheck:
     policies = tuple(k for k in stats if is_policy(k))
     cis = {k: stats[k].mean for k in policies}
@@ -474,8 +475,7 @@ def _check(
     )
     top = None
     if reference and policies:
-        ref_mean = float(np.mean(list(reference.values())))
-        top = all(sign * (ref_mean - cis[k].mean) >= 0 for k in policies)
+        top = all(_on_top(reference, (scores or {}).get(k), cis[k].mean, sign) for k in policies)
     return TierCheck(
         policies=policies,
         separated=len(policies) > 1 and not inside,
@@ -514,7 +514,14 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
         stats=stats,
         order=order,
         pairs=pairs,
-        check=_check(stats, pairs, scenarios, sign, refs.get(ORACLE)),
+        check=_check(
+            stats,
+            pairs,
+            scenarios,
+            sign,
+            refs.get(ORACLE),
+            {k: _scores(by[k], metric) for k in policies},
+        ),  # fmt: skip
         settings={k: _settings(by[k]) for k in order if _settings(by[k])},
     )
 
@@ -542,6 +549,21 @@ def reference_scores(
     keys = set(variants[0]).intersection(*variants[1:]) if variants else set()
     pick = max if sign > 0 else min
     return {k: pick(v[k] for v in variants) for k in sorted(keys)}
+
+
+def _on_top(
+    reference: Mapping[tuple[str, int], float],
+    mine: Mapping[tuple[str, int], float] | None,
+    mean: float,
+    sign: float,
+) -> bool:
+    """Whether the reference's mean is at least a policy's, over the (scenario, seed) pairs both
+    have (a study still running has them on different pairs); without per-pair scores, the
+    reference's mean against the policy's ``mean``."""
+    if mine is not None and (keys := [k for k in reference if k in mine]):
+        diff = np.mean([reference[k] for k in keys]) - np.mean([mine[k] for k in keys])
+        return bool(sign * diff >= 0)
+    return bool(sign * (float(np.mean(list(reference.values()))) - mean) >= 0)
 
 
 def _instance(row: Mapping[str, Any]) -> tuple[str, int]:

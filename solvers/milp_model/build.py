@@ -224,9 +224,24 @@ def _route_set(
     prune: bool,
 ) -> RouteSet:
     parts = []
-    for a in range(ctx.graph.n_agents):
-        if deadline is not None and time.perf_counter() > deadline:
-            raise TimeoutError(f"the wall-clock limit passed while enumerating routes (agent {a})")
+    n = ctx.graph.n_agents
+    start = time.perf_counter()
+    for a in range(n):
+        if deadline is not None and a:
+            now = time.perf_counter()
+            if now > deadline:
+                raise TimeoutError(
+                    f"the wall-clock limit passed while enumerating routes (agent {a})"
+                )
+            # give up as soon as even 80 % of the build's projected length (agents cost alike,
+            # within that margin) ends past the deadline, so that a fallback still has the time
+            # the rest of the build would have wasted
+            projected = start + (now - start) * n / a * 0.8
+            if projected > deadline:
+                raise TimeoutError(
+                    f"building the model was projected to take {(now - start) * n / a:.3f} s "
+                    f"({a} of {n} agents in {now - start:.3f} s), past the wall-clock limit"
+                )
         raw = _agent_routes(ctx, a) if given is None else _given_routes(ctx, a, given.get(a, ()))
         parts += [
             _valued(ctx, a, kind, (t, arr, px), prune and given is None)
@@ -307,7 +322,8 @@ def build_milp_model(
         The fire tasks of recent graphs (:func:`solvers.milp_model.objective.hidden_cells`);
         the schedulers pass those of the last ``recent_fire_s`` seconds.
     deadline : float, optional
-        A :func:`time.perf_counter` time: past it, building stops with ``TimeoutError``.
+        A :func:`time.perf_counter` time: building stops with ``TimeoutError`` once it has
+        passed, or once the build, projected from the agents done so far, would end past it.
     prune : bool
         Leave out dominated routes (:mod:`solvers.milp_model.prune`; the optimum is the same).
 
@@ -316,7 +332,7 @@ def build_milp_model(
     ValueError
         If the model would hold more than ``params.max_routes`` routes.
     TimeoutError
-        If ``deadline`` passed while the routes were being enumerated.
+        If ``deadline`` passed, or was projected to pass, while the routes were being enumerated.
     """
     p = params or MilpParams()
     ctx = _Context(graph, p, recent_fire)

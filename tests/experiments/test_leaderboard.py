@@ -136,10 +136,36 @@ def test_proven_gaps_pool_every_bounded_replan_and_show_a_dash_without_one():
     assert milp.bounded_replans == 3 * n and milp.gap_p50 == 0.0
     assert milp.gap_p95 == pytest.approx(np.percentile([0.0, 0.0, 0.1] * n, 95))
     assert greedy.bounded_replans == 0 and math.isnan(greedy.gap_p50)
-    page = markdown(leaderboard(rows))
+    page = markdown(t_board := leaderboard(rows))
+    assert t_board.tiers[0].stats["milp"].bounded_replans == 3 * n
     line = next(x for x in page.splitlines() if x.startswith("| 1 | milp"))
     assert f"0.00 / {100 * milp.gap_p95:.2f} ({3 * n}/{10 * n})" in line
     assert "| - |" in next(x for x in page.splitlines() if "| greedy" in x)
+
+
+def test_rows_of_an_older_fcplan_without_gaps_are_read():
+    """Results written before the gap columns existed (missing, or NaN after a table read)
+    mixed with newer rows: the gaps pool over the rows that have them."""
+    n = 8
+    rows = _rows({"milp": [10.0] * n, "greedy": [5.0] * n, "oracle": [30.0] * n,
+                  "idle": [-70.0] * n})  # fmt: skip
+    for i, r in enumerate(rows):
+        if r["scheduler"] == "milp" and i % 2:
+            r.update(replan_gap=[0.0, 0.2], bounded_replans=2, gap_p50=0.1)
+        else:
+            r.update(replan_gap=float("nan"), bounded_replans=float("nan"), gap_p50=float("nan"))
+    t = leaderboard(rows).tiers[0]
+    assert t.stats["milp"].bounded_replans == n and t.stats["milp"].gap_p50 == pytest.approx(0.1)
+    assert t.stats["greedy"].bounded_replans == 0
+    assert "| - |" in next(x for x in markdown(leaderboard(rows)).splitlines() if "| greedy" in x)
+
+
+def test_oracle_on_top_compares_the_pairs_both_have():
+    """While a study runs the oracle may have fewer (scenario, seed) pairs than a policy: the
+    tier check compares their means on the pairs both have, not over different pairs."""
+    rows = _rows({"greedy": [10.0, 10.0, 100.0, 100.0] * 2})
+    rows += _rows({"oracle": [30.0] * 4, "idle": [-70.0] * 4})  # seeds 0-1 of each scenario
+    assert leaderboard(rows).tiers[0].check.oracle_top is True
 
 
 def test_the_reference_is_the_best_oracle_variant_on_each_pair():
