@@ -22,8 +22,10 @@ optimality; HiGHS's default is 1e-4).
   bound stops after ``work_limit`` nodes (``mip_max_nodes``, default 5,000), never on the wall
   clock, so the same graph gives the same plan under any load.
 * **Wall-clock mode** (a ``time_limit`` given to :meth:`plan`, or ``deterministic=False``):
-  HiGHS's ``time_limit`` is what is left of the call's limit after building the model (about 15 %
-  kept back for completing, checking and decoding the plan). cvxpy's own canonicalisation runs inside that time.
+  cvxpy canonicalises the model first, and HiGHS's ``time_limit`` is what is left of the call's
+  limit after that (about 30 % kept back for completing, checking and decoding the plan: HiGHS
+  checks its clock less often than CP-SAT). A limited solve whose point is worse than the warm
+  start keeps the warm start (HiGHS takes no hint through cvxpy).
 * **No idle team**: HiGHS may stop at a limit with its trivial all-zero point; a solution that
   leaves agents idle with routes to fly, or none at all, raises
   :class:`solvers.milp_model.IncompletePlanError`, so :func:`fcplan.scheduling.solve` falls back
