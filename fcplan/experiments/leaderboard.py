@@ -69,6 +69,7 @@ import numpy as np
 
 from fcplan.errors import FcplanError
 from fcplan.experiments.analysis import metric_label, paired_table
+from fcplan.experiments.oracle_reference import fraction_of_oracle, on_top, reference_scores
 from fcplan.experiments.stats import MeanCI, PairedComparison, mean_ci
 from fcplan.experiments.tables import REPORT_COLUMNS, higher_is_better
 from fcplan.metrics import metric_spec
@@ -96,7 +97,6 @@ HEADLINE = "manual.final_score"
 ORACLE, IDLE = "oracle", "idle"
 BASELINES = ("idle", "random")
 HOLM_LEVEL = 0.01
-BOOTSTRAP_DRAWS = 2000
 
 _OFS = "manual.overall_firefighting"
 _TTC = "outcome.time_to_containment_s"
@@ -312,53 +312,6 @@ def read_episodes(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
 
 
 # ------------------------------------------------------------------------------------- numbers
-def fraction_of_oracle(
-    score: Sequence[float],
-    oracle: Sequence[float],
-    idle: Sequence[float],
-    strata: Sequence[Any] | None = None,
-    *,
-    draws: int = BOOTSTRAP_DRAWS,
-    seed: int = 0,
-) -> tuple[float, tuple[float, float], float]:
-    """Fraction of the oracle's improvement over idle, its bootstrap interval, and the median of
-    the per-pair ratios (see the module docstring).
-
-    The arrays hold one value per (scenario, seed) pair, in the same order; ``strata`` (the
-    scenario of each pair) makes the bootstrap resample within each scenario.
-
-    Examples
-    --------
-    >>> f, (lo, hi), med = fraction_of_oracle([5, 6, 7, 8], [10, 10, 10, 10], [0, 0, 0, 0])
-    >>> f, lo <= f <= hi, round(med, 3)
-    (0.65, True, 0.65)
-    """
-    s, o, z = (np.asarray(x, np.float64) for x in (score, oracle, idle))
-    gain, best = s - z, o - z
-    if s.size == 0 or not np.isfinite(gain).all() or not np.isfinite(best).all():
-        return math.nan, (math.nan, math.nan), math.nan
-    total = best.sum()
-    frac = float(gain.sum() / total) if total > 0 else math.nan
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratios = np.where(best > 0, gain / best, np.nan)
-    median = float(np.nanmedian(ratios)) if np.isfinite(ratios).any() else math.nan
-    groups = [np.arange(s.size)]
-    if strata is not None:
-        labels = np.asarray([str(x) for x in strata])
-        groups = [np.flatnonzero(labels == u) for u in dict.fromkeys(labels.tolist())]
-    rng = np.random.default_rng(seed)
-    picks = np.concatenate(
-        [g[rng.integers(0, g.size, size=(draws, g.size))] for g in groups], axis=1
-    )
-    num, den = gain[picks].sum(axis=1), best[picks].sum(axis=1)
-    boot = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
-    boot = boot[np.isfinite(boot)]
-    if boot.size < draws // 2:
-        return frac, (math.nan, math.nan), median
-    lo, hi = np.percentile(boot, [2.5, 97.5])
-    return frac, (float(lo), float(hi)), median
-
-
 def _pooled_percentiles(rows: list[dict[str, Any]]) -> tuple[float, float]:
     times: list[float] = []
     for r in rows:
@@ -475,7 +428,7 @@ def _check(
     )
     top = None
     if reference and policies:
-        top = all(_on_top(reference, (scores or {}).get(k), cis[k].mean, sign) for k in policies)
+        top = all(on_top(reference, (scores or {}).get(k), cis[k].mean, sign) for k in policies)
     return TierCheck(
         policies=policies,
         separated=len(policies) > 1 and not inside,
@@ -528,42 +481,6 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
 
 def _scores(rows: list[dict[str, Any]], metric: str) -> dict[tuple[str, int], float]:
     return {(str(r["scenario"]), int(r["seed"])): float(r[metric]) for r in rows}
-
-
-def reference_scores(
-    variants: Sequence[Mapping[tuple[str, int], float]], sign: float = 1.0
-) -> dict[tuple[str, int], float]:
-    """The clairvoyant reference per (scenario, seed): the best score of the oracle variants
-    (``oracle``, ``oracle[routing]``, ...) over the pairs where every variant completed.
-
-    No single clairvoyant planner is best everywhere (a greedy inner planner can be distracted by
-    fire it cannot reach), so the reference is the best of those run, like a best-known solution.
-
-    Examples
-    --------
-    >>> reference_scores([{("h", 0): 1.0, ("h", 1): 5.0}, {("h", 0): 3.0}])
-    {('h', 0): 3.0}
-    >>> reference_scores([{("h", 0): 1.0}, {("h", 0): 3.0}], sign=-1.0)  # lower is better
-    {('h', 0): 1.0}
-    """
-    keys = set(variants[0]).intersection(*variants[1:]) if variants else set()
-    pick = max if sign > 0 else min
-    return {k: pick(v[k] for v in variants) for k in sorted(keys)}
-
-
-def _on_top(
-    reference: Mapping[tuple[str, int], float],
-    mine: Mapping[tuple[str, int], float] | None,
-    mean: float,
-    sign: float,
-) -> bool:
-    """Whether the reference's mean is at least a policy's, over the (scenario, seed) pairs both
-    have (a study still running has them on different pairs); without per-pair scores, the
-    reference's mean against the policy's ``mean``."""
-    if mine is not None and (keys := [k for k in reference if k in mine]):
-        diff = np.mean([reference[k] for k in keys]) - np.mean([mine[k] for k in keys])
-        return bool(sign * diff >= 0)
-    return bool(sign * (float(np.mean(list(reference.values()))) - mean) >= 0)
 
 
 def _instance(row: Mapping[str, Any]) -> tuple[str, int]:

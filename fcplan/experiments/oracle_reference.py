@@ -1,0 +1,117 @@
+"""The clairvoyant reference of a benchmark tier, and each scheduler's fraction of it.
+
+A study runs one or more oracle variants (``oracle``: greedy planning on the true fire;
+``oracle[routing]``, ...) beside the policies. No single clairvoyant planner is best everywhere (a
+greedy inner planner can be distracted by fire it cannot reach), so the **reference** on each
+(scenario, seed) is the best score of the variants run on it (:func:`reference_scores`), as a
+best-known solution is in a routing benchmark.
+
+A scheduler's **fraction of the oracle** (:func:`fraction_of_oracle`) is ``F = sum_i (s_i -
+idle_i) / sum_i (oracle_i - idle_i)`` over the pairs ``i`` where it, the reference and the idle
+team all completed: a ratio of means, with a bootstrap interval that resamples seeds within each
+scenario (the module docstring of :mod:`fcplan.experiments.leaderboard` explains the choice).
+:func:`on_top` is the tier check's test that the reference is at least as good as a policy.
+
+Examples
+--------
+>>> ref = reference_scores([{("h", 0): 1.0, ("h", 1): 4.0}, {("h", 0): 3.0, ("h", 1): 2.0}])
+>>> ref
+{('h', 0): 3.0, ('h', 1): 4.0}
+>>> round(fraction_of_oracle([2.0, 3.0], list(ref.values()), [0.0, 0.0])[0], 3)
+0.714
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+__all__ = ["BOOTSTRAP_DRAWS", "fraction_of_oracle", "on_top", "reference_scores"]
+
+BOOTSTRAP_DRAWS = 2000
+
+
+def fraction_of_oracle(
+    score: Sequence[float],
+    oracle: Sequence[float],
+    idle: Sequence[float],
+    strata: Sequence[Any] | None = None,
+    *,
+    draws: int = BOOTSTRAP_DRAWS,
+    seed: int = 0,
+) -> tuple[float, tuple[float, float], float]:
+    """Fraction of the oracle's improvement over idle, its bootstrap interval, and the median of
+    the per-pair ratios (see the module docstring).
+
+    The arrays hold one value per (scenario, seed) pair, in the same order; ``strata`` (the
+    scenario of each pair) makes the bootstrap resample within each scenario.
+
+    Examples
+    --------
+    >>> f, (lo, hi), med = fraction_of_oracle([5, 6, 7, 8], [10, 10, 10, 10], [0, 0, 0, 0])
+    >>> f, lo <= f <= hi, round(med, 3)
+    (0.65, True, 0.65)
+    """
+    s, o, z = (np.asarray(x, np.float64) for x in (score, oracle, idle))
+    gain, best = s - z, o - z
+    if s.size == 0 or not np.isfinite(gain).all() or not np.isfinite(best).all():
+        return math.nan, (math.nan, math.nan), math.nan
+    total = best.sum()
+    frac = float(gain.sum() / total) if total > 0 else math.nan
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = np.where(best > 0, gain / best, np.nan)
+    median = float(np.nanmedian(ratios)) if np.isfinite(ratios).any() else math.nan
+    groups = [np.arange(s.size)]
+    if strata is not None:
+        labels = np.asarray([str(x) for x in strata])
+        groups = [np.flatnonzero(labels == u) for u in dict.fromkeys(labels.tolist())]
+    rng = np.random.default_rng(seed)
+    picks = np.concatenate(
+        [g[rng.integers(0, g.size, size=(draws, g.size))] for g in groups], axis=1
+    )
+    num, den = gain[picks].sum(axis=1), best[picks].sum(axis=1)
+    boot = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+    boot = boot[np.isfinite(boot)]
+    if boot.size < draws // 2:
+        return frac, (math.nan, math.nan), median
+    lo, hi = np.percentile(boot, [2.5, 97.5])
+    return frac, (float(lo), float(hi)), median
+
+
+def reference_scores(
+    variants: Sequence[Mapping[tuple[str, int], float]], sign: float = 1.0
+) -> dict[tuple[str, int], float]:
+    """The clairvoyant reference per (scenario, seed): the best score of the oracle variants
+    (``oracle``, ``oracle[routing]``, ...) over the pairs where every variant completed.
+
+    No single clairvoyant planner is best everywhere (a greedy inner planner can be distracted by
+    fire it cannot reach), so the reference is the best of those run, like a best-known solution.
+
+    Examples
+    --------
+    >>> reference_scores([{("h", 0): 1.0, ("h", 1): 5.0}, {("h", 0): 3.0}])
+    {('h', 0): 3.0}
+    >>> reference_scores([{("h", 0): 1.0}, {("h", 0): 3.0}], sign=-1.0)  # lower is better
+    {('h', 0): 1.0}
+    """
+    keys = set(variants[0]).intersection(*variants[1:]) if variants else set()
+    pick = max if sign > 0 else min
+    return {k: pick(v[k] for v in variants) for k in sorted(keys)}
+
+
+def on_top(
+    reference: Mapping[tuple[str, int], float],
+    mine: Mapping[tuple[str, int], float] | None,
+    mean: float,
+    sign: float,
+) -> bool:
+    """Whether the reference's mean is at least a policy's, over the (scenario, seed) pairs both
+    have (a study still running has them on different pairs); without per-pair scores, the
+    reference's mean against the policy's ``mean``."""
+    if mine is not None and (keys := [k for k in reference if k in mine]):
+        diff = np.mean([reference[k] for k in keys]) - np.mean([mine[k] for k in keys])
+        return bool(sign * diff >= 0)
+    return bool(sign * (float(np.mean(list(reference.values()))) - mean) >= 0)
