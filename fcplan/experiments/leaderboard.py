@@ -12,8 +12,9 @@ the tier ``other``) and computes, per tier and scheduler:
 * the **fraction of the oracle**: ``F = sum_i (s_i - idle_i) / sum_i (oracle_i - idle_i)`` over
   the (scenario, seed) pairs ``i`` where the scheduler, the clairvoyant reference and the
   ``idle`` team all completed (the reference ``oracle_i`` is the best of the oracle variants run
-  on the pair, ``oracle``, ``oracle[routing]``, ...: :func:`reference_scores`): the share of the oracle's improvement over doing nothing that the
-  scheduler achieved on the same pairs (1 = as good as the oracle, 0 = no better than idle). It
+  on the pair, ``oracle``, ``oracle[routing]``, ...: :func:`reference_scores`): the share of the
+  oracle's improvement over doing nothing that the scheduler achieved on the same pairs (1 = as
+  good as the oracle, 0 = no better than idle). It
   is a **ratio of means**, not a mean of per-pair ratios: a pair where the oracle barely beats
   idle (nothing was at stake) would give a huge or undefined per-pair ratio, while the ratio of
   means weights each pair by what was achievable there. Normalising by idle makes it independent
@@ -382,7 +383,7 @@ def _scheduler_stats(
             if (r["scenario"], int(r["seed"])) in refs[ORACLE]
             and (r["scenario"], int(r["seed"])) in refs[IDLE]
         ]
-        mine = {(r["scenario"], int(r["seed"])): float(r[metric]) for r in rows}
+        mine = _scores(rows, metric)
         sign = 1.0 if metric_direction(metric)[2] else -1.0  # lower is better: negate
         frac = fraction_of_oracle(
             [sign * mine[k] for k in keys],
