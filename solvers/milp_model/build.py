@@ -25,6 +25,7 @@ import scipy.sparse as sp
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.taskgraph.types import pairwise_distance
 from solvers.milp_model.constraints import model_rows
+from solvers.milp_model.kernels import dominated
 from solvers.milp_model.objective import (
     CELL_RATE,
     block_values,
@@ -33,7 +34,7 @@ from solvers.milp_model.objective import (
     route_cover,
     straight_cover,
 )
-from solvers.milp_model.prune import dominated, route_keys
+from solvers.milp_model.prune import route_keys
 from solvers.milp_model.routes import AgentRoles, agent_roles, enumerate_routes, top_candidates
 from solvers.milp_model.sensing import TAN_Y, best_search_altitude
 from solvers.milp_model.types import (

@@ -31,7 +31,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from fcplan.taskgraph import TaskGraph
-from solvers.milp_model.sensing import segment_coverage
+from solvers.milp_model.kernels import discounted_coverage
 from solvers.milp_model.types import MilpParams
 
 __all__ = [
@@ -140,15 +140,15 @@ def _discounted(
     t_start: np.ndarray,
     p: MilpParams,
 ) -> np.ndarray:
+    """(S, B) ``share (H_s - t)+ / H_s`` of ``blocks`` under the segments ``a -> b`` started at
+    ``t_start``: :func:`~solvers.milp_model.sensing.segment_coverage`'s share, discounted by
+    when the block is passed (the fast kernel,
+    :func:`solvers.milp_model.kernels.discounted_coverage`, equal to that rule bit for bit)."""
     lo, hi = graph.agent_alt_range[agent]
-    speed = float(graph.agent_speed[agent])
-    share, when = segment_coverage(
-        a, b, graph.task_pos[blocks], p.search_block_px, z, float(lo), float(hi), speed
-    )
-    late = t_start[:, None] + when
-    hs = p.search_horizon_s
-    out: np.ndarray = share * np.maximum(hs - late, 0.0) / hs
-    return out
+    return discounted_coverage(
+        a, b, graph.task_pos[blocks], p.search_block_px, z, float(lo), float(hi),
+        float(graph.agent_speed[agent]), t_start, p.search_horizon_s,
+    )  # fmt: skip
 
 
 def route_cover(

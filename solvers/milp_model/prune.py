@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["dominated", "route_keys"]
+__all__ = ["dominated", "group_order", "route_keys"]
 
 
 def route_keys(tasks: np.ndarray, by_first: bool) -> np.ndarray:
@@ -49,6 +49,21 @@ def route_keys(tasks: np.ndarray, by_first: bool) -> np.ndarray:
     return np.where(srt == big, -1, srt)
 
 
+def group_order(
+    keys: np.ndarray, value: np.ndarray, cover: sp.csr_array
+) -> tuple[np.ndarray, np.ndarray]:
+    """The routes ordered by ``keys`` group, then value and total cover (both descending), then
+    enumeration order, and where each group starts in that order: ``(order (P,), starts (G,))``."""
+    n = len(value)
+    total = np.asarray(cover.sum(axis=1)).ravel().astype(np.float64)
+    _, group = np.unique(keys, axis=0, return_inverse=True)
+    group = group.ravel()
+    order = np.lexsort((np.arange(n), -total, -value, group))  # by group, best first
+    g_sorted = group[order]
+    starts = np.flatnonzero(np.r_[True, g_sorted[1:] != g_sorted[:-1]])
+    return order, starts
+
+
 def dominated(keys: np.ndarray, value: np.ndarray, cover: sp.csr_array) -> np.ndarray:
     """(P,) bool: the routes some other route with the same ``keys`` row dominates (module
     docstring); ``value`` (P,) their own objective coefficients, ``cover`` (P, B) their covers."""
@@ -56,12 +71,7 @@ def dominated(keys: np.ndarray, value: np.ndarray, cover: sp.csr_array) -> np.nd
     out = np.zeros(n, dtype=bool)
     if n < 2:
         return out
-    total = np.asarray(cover.sum(axis=1)).ravel().astype(np.float64)
-    _, group = np.unique(keys, axis=0, return_inverse=True)
-    group = group.ravel()
-    order = np.lexsort((np.arange(n), -total, -value, group))  # by group, best first
-    g_sorted = group[order]
-    starts = np.flatnonzero(np.r_[True, g_sorted[1:] != g_sorted[:-1]])
+    order, starts = group_order(keys, value, cover)
     ends = np.r_[starts[1:], n]
     has_cover = np.diff(cover.indptr) > 0
     for s, e in zip(starts.tolist(), ends.tolist(), strict=True):
