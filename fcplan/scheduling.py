@@ -134,7 +134,9 @@ class SolveStats:
     solver_s : float
         Wall time of the scheduler's own call (no validation, no fallback), by :func:`solve`.
     timed_out : bool
-        The clock stopped the scheduler (module docstring), set by :func:`solve`.
+        The clock stopped the scheduler (module docstring), set by :func:`solve`; also when
+        the scheduler raised ``TimeoutError`` (its way of saying so, e.g. a MILP whose model
+        could not be built within the limit).
     partial : bool
         The scheduler's limit stopped it before its plan was complete (:func:`solve` falls back).
     """
@@ -583,6 +585,7 @@ def solve(
     except Exception as exc:  # noqa: BLE001 - an episode must survive any solver failure
         solver_s = time.perf_counter() - t0
         message = f"{type(exc).__name__}: {exc}"
+        timed_out = isinstance(exc, TimeoutError)  # the scheduler says the clock stopped it
         plan = None
     if plan is None:
         plan = _fallback_scheduler().plan(graph, time_limit=None, rng=rng)

@@ -453,6 +453,27 @@ def test_a_clock_bound_scheduler_that_used_up_its_limit_and_routed_nobody_falls_
     assert plan.stats.overrun_s >= 0.01 and plan.stats.solver_s >= 0.02
 
 
+class TimingOut(Raising):
+    """A scheduler that says the clock stopped it: ``TimeoutError`` on every call."""
+
+    def plan(self, graph, *, time_limit=None, rng=None):
+        raise TimeoutError("model not built in time")
+
+
+def test_a_timeout_error_is_a_time_out_and_other_errors_are_not():
+    """A scheduler that raises ``TimeoutError`` (how the MILPs say their model could not be
+    built in time) falls back with ``timed_out`` set; any other exception falls back without it,
+    and both messages name the exception."""
+    g = _synthetic(3)
+    clock = solve(TimingOut(), g, time_limit=0.1, rng=rng())
+    assert clock.stats.status == "fallback" and clock.stats.timed_out
+    assert clock.stats.message == "TimeoutError: model not built in time"
+    bug = solve(Raising(), g, time_limit=0.1, rng=rng())
+    assert bug.stats.status == "fallback" and not bug.stats.timed_out
+    assert bug.stats.message == "RuntimeError: solver exploded"
+    assert dict(clock.routes) == dict(bug.routes) == dict(_greedy_plan(g).routes)
+
+
 def test_an_idle_role_without_a_time_out_is_a_decision():
     """The same empty plan stands when nothing says the clock stopped the scheduler: a
     heuristic status within the limit, or a scheduler that declares ``deterministic = True``
