@@ -213,6 +213,9 @@ class TierResult:
     check: TierCheck
     settings: dict[str, str] = field(default_factory=dict)
     """Scheduler label -> its settings as recorded in the results (``key=value, ...``)."""
+    per_scenario: dict[str, dict[str, tuple[float, float, int]]] = field(default_factory=dict)
+    """Scenario -> scheduler label -> (mean headline metric, mean OFS %, episodes): which
+    scenarios of the tier tell the schedulers apart."""
 
 
 @dataclass
@@ -239,6 +242,13 @@ class Leaderboard:
                         "settings": t.settings,
                         "stats": {k: _stats_dict(v) for k, v in t.stats.items()},
                         "pairs": [_pair_dict(c) for c in t.pairs],
+                        "per_scenario": {
+                            sc: {
+                                k: dict(zip(("mean", "ofs", "n"), v, strict=True))
+                                for k, v in means.items()
+                            }
+                            for sc, means in t.per_scenario.items()
+                        },  # fmt: skip
                         "check": {
                             **_fields(t.check),
                             "keep": t.check.keep,
@@ -477,7 +487,22 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
             {k: _scores(by[k], metric) for k in policies},
         ),  # fmt: skip
         settings={k: _settings(by[k]) for k in order if _settings(by[k])},
+        per_scenario={sc: _scenario_means(by, order, sc, metric) for sc in scenarios},
     )
+
+
+def _scenario_means(
+    by: Mapping[str, list[dict[str, Any]]], order: list[str], scenario: str, metric: str
+) -> dict[str, tuple[float, float, int]]:
+    """Label -> (mean ``metric``, mean OFS, episodes) on one scenario (labels with episodes)."""
+    out = {}
+    for k in order:
+        rows = [r for r in by[k] if r["scenario"] == scenario]
+        if rows:
+            ofs = [float(r[_OFS]) for r in rows if finite(r.get(_OFS))]
+            mean_ofs = float(np.mean(ofs)) if ofs else math.nan
+            out[k] = (float(np.mean([float(r[metric]) for r in rows])), mean_ofs, len(rows))
+    return out
 
 
 def _scores(rows: list[dict[str, Any]], metric: str) -> dict[tuple[str, int], float]:

@@ -21,6 +21,7 @@ Examples
 from __future__ import annotations
 
 import datetime as _dt
+import math
 
 from fcplan.experiments.leaderboard import (
     HOLM_LEVEL,
@@ -134,6 +135,7 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
             f"| {c.effect:+.2f} | {'yes' if c.p_holm < HOLM_LEVEL else 'no'} | {c.verdict()} |"
             for c in t.pairs
         ]
+    out += _scenario_table(t, label, digits)
     c = t.check
     top = {None: "no oracle episodes", True: "yes", False: "**no**"}[c.oracle_top]
     out += [
@@ -150,6 +152,37 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
         f"**{'Accepted' if c.accepted else 'Kept' if c.keep else 'Not kept'}.**",
         "",
     ]
+    return out
+
+
+def _scenario_table(t: TierResult, label: str, digits: int) -> list[str]:
+    """Per scenario, each scheduler's mean and OFS, the policies' spread and whether every
+    policy cleared it (OFS 100 % on every seed): where the tier tells schedulers apart."""
+    if not t.per_scenario:
+        return []
+    cols = t.order
+    out = [
+        "",
+        f"Per scenario: mean {label} (mean OFS %) over the seeds each scheduler completed; "
+        "*spread*: best minus worst policy mean; *cleared by all*: every policy at OFS 100 % "
+        "on every seed (the scenario does not tell them apart on OFS).",
+        "",
+        "| scenario | " + " | ".join(cols) + " | spread | cleared by all |",
+        "|---|" + "---|" * (len(cols) + 2),
+    ]
+    for sc, means in t.per_scenario.items():
+        cells = [
+            f"{_num(means[k][0], digits)} ({_num(means[k][1], 0)})" if k in means else "-"
+            for k in cols
+        ]
+        pol = [means[k] for k in cols if is_policy(k) and k in means]
+        spread = max(m[0] for m in pol) - min(m[0] for m in pol) if pol else math.nan
+        cleared = bool(pol) and all(m[1] >= 100.0 for m in pol)
+        short = sc.rpartition("/")[2]
+        out.append(
+            f"| {short} | " + " | ".join(cells)
+            + f" | {_num(spread, digits)} | {'yes' if cleared else 'no'} |"
+        )  # fmt: skip
     return out
 
 

@@ -207,6 +207,26 @@ def test_tier_check_counts_resolved_pairs_and_cleared_scenarios():
     assert check.cleared_all == ("a", "b") and check.oracle_top is None
 
 
+def test_per_scenario_means_spread_and_clearing_on_the_page():
+    """Each scenario gets every scheduler's mean score and OFS over its seeds, the policies'
+    spread (best minus worst mean) and whether every policy cleared it; the page shows them in
+    one table row per scenario and the JSON has the same numbers."""
+    rows = _rows({"greedy": [10.0, 20.0, 0.0, 0.0], "cbba": [30.0, 30.0, 5.0, 5.0]})
+    for r in rows:  # scenario 1: everyone at OFS 100; scenario 2: cbba short of it on seed 0
+        cleared = r["scenario"] == HARD.format(1) or not (
+            r["scheduler"] == "cbba" and r["seed"] == 0
+        )
+        r["manual.overall_firefighting"] = 100.0 if cleared else 80.0
+    t = leaderboard(rows).tiers[0]
+    assert t.per_scenario[HARD.format(1)] == {"cbba": (30.0, 100.0, 2), "greedy": (15.0, 100.0, 2)}
+    assert t.per_scenario[HARD.format(2)]["cbba"] == (5.0, 90.0, 2)
+    page = markdown(leaderboard(rows))
+    assert "| hard-01 | 30.0 (100) | 15.0 (100) | 15.0 | yes |" in page
+    assert "| hard-02 | 5.0 (90) | 0.0 (100) | 5.0 | no |" in page
+    doc = leaderboard(rows).to_dict()["tiers"][0]["per_scenario"]
+    assert doc[HARD.format(2)]["greedy"] == {"mean": 0.0, "ofs": 100.0, "n": 2}
+
+
 def test_failed_episodes_are_counted_not_averaged():
     """A failed episode counts in `failed` and is left out of the means and pairs."""
     rows = _rows({"greedy": [1.0, 2.0, 3.0, 4.0], "cbba": [2.0, 3.0, 4.0, 5.0]})
