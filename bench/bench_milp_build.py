@@ -1,8 +1,9 @@
 """Benchmark building the MILP route model (issue 13's blocker at 50-100 agents).
 
 Builds :func:`solvers.milp_model.build_milp_model` on the graphs of a greedy episode (every
-``--every`` simulated seconds) of generated ``scale`` designs with 10, 50 and 100 agents (as
-``bench_time_limits.py``'s ``scale50`` / ``scale100``) and of the manual's scenarios 1-24, and
+``--every`` simulated seconds) of the manual's scenarios 1-24 (``suite``), of the benchmark's
+``scale`` tier (``scale-tier``: scale-01..06, 18-30 agents) and of generated ``scale`` designs
+with 10, 50 and 100 agents (as ``bench_time_limits.py``'s ``scale50`` / ``scale100``), and
 prints per design the build's median and p95 wall ms over ``--repeat`` rounds, the ms per agent,
 the routes and nonzeros, and a digest of every model built (objective, rows, routes): two source
 trees that build the same models print the same digest, so an A/B run (``bench/ab.py``) checks
@@ -44,7 +45,9 @@ def digest(models: list) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--designs", nargs="+", default=["suite", "scale10", "scale50", "scale100"])
+    ap.add_argument(
+        "--designs", nargs="+", default=["suite", "scale-tier", "scale10", "scale50", "scale100"]
+    )
     ap.add_argument("--every", type=int, default=30, help="simulated seconds between graphs")
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
@@ -54,6 +57,8 @@ def main() -> None:
     for design in args.designs:
         if design == "suite":
             scenarios = [load_scenario(i) for i in range(1, 25)]
+        elif design == "scale-tier":  # fcplan-bench-v1's scale-01..scale-06 (18-30 agents)
+            scenarios = [load_scenario(f"scale-{i:02d}") for i in range(1, 7)]
         else:
             scenarios = [scale_design(int(design.removeprefix("scale")), 0)]
         graphs = [
