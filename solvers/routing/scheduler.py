@@ -38,7 +38,12 @@ depot slot.
   one, so the others keep searching); this is why the action model is solved first. Other fires
   get ``w_k = clip((staleness - fresh_s) / fresh_s, 0, 1)``: a fire not sensed for a while is
   worth refreshing for the action agents. The default ``watch_value_px = 1000`` px per cell makes
-  watching beat searching almost always.
+  watching beat searching almost always, so the cap covers every fire offered to watch: at most
+  ``max_watch_fraction`` of the perception vehicles (at least one) are offered a fire, one per
+  connected fire, the fires of highest watching value. Without it (``cap_all_watch=False``,
+  the behaviour before 2026-11-29) stale fires were offered uncapped, and once a fight had run
+  for a while every perception agent hovered over some fire and none searched: fires that
+  ignite later went unfound (``bench/README.md``, "Routing: watching capped").
 
 A perception route whose first task is a fire becomes a **watch**: the route is cut to that fire
 (the agent hovers over it until the next replan) at ``watch_altitude`` (low: reliable sensing);
@@ -173,8 +178,11 @@ class RoutingScheduler:
     watch_altitude, search_altitude : float
         Altitudes (m) of watching and searching perception agents (clipped to their bounds).
     max_watch_fraction : float
-        Largest share of the perception vehicles offered a fire being fought to watch (at
-        least one; one fire per connected fire), so the others keep searching.
+        Largest share of the perception vehicles offered a fire to watch (at least one; one
+        fire per connected fire), so the others keep searching.
+    cap_all_watch : bool
+        The ``max_watch_fraction`` cap covers stale fires too (default); False caps only the
+        fires being fought, as before 2026-11-29 (kept to reproduce earlier results).
     charge_return : bool
         Count the way back to the depot slot in the objective (it always counts for the battery).
     first_solution, metaheuristic : str
@@ -211,6 +219,7 @@ class RoutingScheduler:
         watch_altitude: float = 35.0,
         search_altitude: float = 70.0,
         max_watch_fraction: float = 0.5,
+        cap_all_watch: bool = True,
         charge_return: bool = False,
         first_solution: str = "auto",
         metaheuristic: str = "GUIDED_LOCAL_SEARCH",
@@ -242,6 +251,7 @@ class RoutingScheduler:
         self.watch_altitude = float_setting("watch_altitude", watch_altitude, 0, lo_open=True)
         self.search_altitude = float_setting("search_altitude", search_altitude, 0, lo_open=True)
         self.max_watch_fraction = float_setting("max_watch_fraction", max_watch_fraction, 0, 1)
+        self.cap_all_watch = bool_setting("cap_all_watch", cap_all_watch)
         self.charge_return = bool_setting("charge_return", charge_return)
         self.first_solution = first_solution
         self.metaheuristic = metaheuristic
@@ -344,6 +354,9 @@ class RoutingScheduler:
         fought = self._fought(graph, fires, first_fires, sensors.size)
         share_stale = np.clip((stale - self.fresh_s) / max(self.fresh_s, 1e-9), 0.0, 1.0)
         watch = self.watch_value_px * graph.task_value[fires] * np.maximum(fought, share_stale)
+        if self.cap_all_watch:
+            offered = self._watch_cap(graph, fires, watch, sensors.size)
+            fires, watch = fires[offered], watch[offered]
         tasks = np.r_[fires, blocks].astype(np.int64)
         search = self.search_value_px * graph.task_value[blocks]
         if self.search_horizon_s > 0 and blocks.size:
@@ -374,16 +387,31 @@ class RoutingScheduler:
         """(len(fires),) bool: the fires worth watching because a dump is imminent: first tasks
         of action routes, one per connected fire (the most valuable), at most
         ``max_watch_fraction`` of the perception vehicles (at least one)."""
-        out = np.zeros(fires.size, dtype=bool)
         if not first_fires:
-            return out
+            return np.zeros(fires.size, dtype=bool)
         ks = np.unique(np.asarray(first_fires, dtype=np.int64))
-        ks = ks[np.argsort(-graph.task_value[ks], kind="stable")]
+        return np.isin(fires, self._top_per_cluster(graph, ks, graph.task_value[ks], n_sensors))
+
+    def _watch_cap(
+        self, graph: TaskGraph, fires: np.ndarray, watch: np.ndarray, n_sensors: int
+    ) -> np.ndarray:
+        """(k,) positions in ``fires`` of the fires offered to watch: those of positive
+        ``watch`` value, the most valuable of each connected fire, at most ``max_watch_fraction``
+        of the ``n_sensors`` perception vehicles (at least one)."""
+        pos = np.flatnonzero(watch > 0)
+        top = self._top_per_cluster(graph, fires[pos], watch[pos], n_sensors)
+        return pos[np.isin(fires[pos], top)]
+
+    def _top_per_cluster(
+        self, graph: TaskGraph, ks: np.ndarray, value: np.ndarray, n_sensors: int
+    ) -> np.ndarray:
+        """The most valuable of the fire tasks ``ks`` in each connected fire, by ``value``
+        (ties: the order of ``ks``), the first ``max(1, int(max_watch_fraction * n_sensors))``."""
+        order = np.argsort(-value, kind="stable")
+        ks = ks[order]
         _, first = np.unique(graph.task_cluster[ks], return_index=True)
-        ks = ks[np.sort(first)]  # the most valuable fire of each cluster, by value
         n_watch = max(1, int(self.max_watch_fraction * n_sensors))
-        out[np.isin(fires, ks[:n_watch])] = True
-        return out
+        return ks[np.sort(first)][:n_watch]
 
     @property
     def _group_size(self) -> int:

@@ -150,6 +150,46 @@ def test_action_agents_fight_and_a_perception_agent_watches():
         assert plan.altitudes[a] == pytest.approx(35.0)
 
 
+def _watchers(g: TaskGraph, plan: Plan) -> list[str]:
+    """Perception-only agents whose route starts at a fire (they hover over it)."""
+    return [
+        a
+        for a, route in plan.routes.items()
+        if route
+        and g.agent_can_sense[g.agent_index[a]]
+        and not g.agent_can_act[g.agent_index[a]]
+        and g.task_kind[list(g.task_ids).index(route[0])] == TaskKind.FIRE
+    ]
+
+
+@pytest.mark.parametrize("tick", [1200, 2400])
+def test_watching_is_capped_for_stale_fires_too(tick):
+    """Once a fight has run for a while most known fires are stale; at most
+    ``max_watch_fraction`` of the perception agents (here 2 of 4) are offered a fire to watch,
+    so the others keep searching (the cap used to cover only fires being fought: with
+    ``cap_all_watch=False`` 3 and 4 of the 4 hovered over fires on these graphs of hard-03)."""
+    g = episode_graphs("hard-03", (tick,))[0]
+    sensors = int((g.agent_can_sense & ~g.agent_can_act).sum())
+    cap = max(1, int(0.5 * sensors))
+    plan = plan_of(g, deterministic=True)
+    check_routing_plan(g, plan)
+    assert len(_watchers(g, plan)) <= cap
+    uncapped = plan_of(g, deterministic=True, cap_all_watch=False)
+    assert len(_watchers(g, uncapped)) > cap
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1), fraction=st.sampled_from([0.0, 0.25, 0.5, 1.0]))
+def test_watchers_never_exceed_the_cap(seed, fraction):
+    """On any graph, at most ``max(1, int(max_watch_fraction * perception agents))``
+    perception agents watch a fire, whatever the fires' staleness."""
+    g = synthetic_task_graph(6, 40, np.random.default_rng(seed), fire_share=0.6)
+    plan = plan_of(g, **FAST, max_watch_fraction=fraction)
+    check_routing_plan(g, plan)
+    sensors = int((g.agent_can_sense & ~g.agent_can_act).sum())
+    assert len(_watchers(g, plan)) <= max(1, int(fraction * sensors))
+
+
 def test_top_n_candidates_bound_the_model():
     """With ``max_nodes`` the models hold at most that many task nodes per role, and the plan
     stays feasible."""
