@@ -21,7 +21,8 @@ can look at the clock, plus greedy's plan when it gives up (``bench/bench_time_l
 A time-out is a fallback, never an idle team. A plan **comes from a time-out** when the
 scheduler says so (``status="time_limit"``, or ``partial=True``: it knows the plan is
 unfinished) or when a scheduler whose plans may depend on the clock (it does not declare
-``deterministic = True``) used up its limit. Such a plan is replaced by greedy's
+``deterministic = True``) used up its limit; raising ``TimeoutError`` is a time-out with no plan.
+Such a plan is replaced by greedy's
 (``status="fallback"``, ``timed_out=True``, the reason in ``message``) if it is ``partial`` or
 leaves the **team idle** (:func:`idle_team`): agents have work but none gets a route. An agent
 has work when it is available (not ``HOMING``) and can reach (:attr:`fcplan.taskgraph.TaskGraph.
@@ -134,9 +135,7 @@ class SolveStats:
     solver_s : float
         Wall time of the scheduler's own call (no validation, no fallback), by :func:`solve`.
     timed_out : bool
-        The clock stopped the scheduler (module docstring), set by :func:`solve`; also when
-        the scheduler raised ``TimeoutError`` (its way of saying so, e.g. a MILP whose model
-        could not be built within the limit).
+        The clock stopped the scheduler (module docstring, or it raised ``TimeoutError``).
     partial : bool
         The scheduler's limit stopped it before its plan was complete (:func:`solve` falls back).
     """

@@ -4,15 +4,13 @@ Building the model at 50-100 agents spent most of its time in two places (``pyth
 bench/bench_milp_build.py``; figures in ``bench/README.md``):
 
 * **Swept blocks** (:func:`discounted_coverage`): the readable rule,
-  :func:`solvers.milp_model.sensing.segment_coverage` then the discount of
-  :func:`solvers.milp_model.objective._discounted`, works on dense (segments x blocks) arrays,
+  :func:`solvers.milp_model.sensing.discounted_share`, works on dense (segments x blocks) arrays,
   a dozen temporaries each, although a straight flight sweeps only the blocks along its track.
   The kernel first keeps the (segment, block) pairs whose block centre lies in the segment's
-  bounding box grown by ``a + h + s``, then those whose block overlaps the swath in the
-  segment's frame (the swath's half extents along and across the track plus
-  a block side: no block outside can overlap the swath, see below) and applies exactly the
-  readable rule's arithmetic to those pairs only; every other entry is ``0.0``, which is what
-  the rule gives there.
+  bounding box grown by ``a + h + s`` (the swath's half extents along and across the track plus
+  a block side: no block outside can overlap the swath, see below), then those whose block
+  overlaps the swath in the segment's frame, and applies exactly the readable rule's arithmetic
+  to those pairs only; every other entry is ``0.0``, which is what the rule gives there.
 * **Dominated routes** (:func:`dominated`): the readable rule,
   :func:`solvers.milp_model.prune.dominated`, compares the routes of each group in a Python
   loop with a sparse row selection per group; the kernel compares every (earlier, later) pair of
@@ -60,8 +58,8 @@ def discounted_coverage(
     horizon: float,
 ) -> np.ndarray:
     """(S, B) ``share * (H - t)+ / H`` of ``centres`` under the segments ``p -> q`` started at
-    ``t_start`` (S,): :func:`~solvers.milp_model.sensing.segment_coverage` discounted as
-    :func:`solvers.milp_model.objective._discounted` does, computed along the tracks only."""
+    ``t_start`` (S,): :func:`~solvers.milp_model.sensing.discounted_share`, computed along the
+    tracks only."""
     n_s, n_b = len(p), len(centres)
     out = np.zeros((n_s, n_b))
     if n_s == 0 or n_b == 0:

@@ -141,9 +141,8 @@ def _discounted(
     p: MilpParams,
 ) -> np.ndarray:
     """(S, B) ``share (H_s - t)+ / H_s`` of ``blocks`` under the segments ``a -> b`` started at
-    ``t_start``: :func:`~solvers.milp_model.sensing.segment_coverage`'s share, discounted by
-    when the block is passed (the fast kernel,
-    :func:`solvers.milp_model.kernels.discounted_coverage`, equal to that rule bit for bit)."""
+    ``t_start``: :func:`~solvers.milp_model.sensing.discounted_share` (by its fast kernel,
+    :func:`solvers.milp_model.kernels.discounted_coverage`, equal to it bit for bit)."""
     lo, hi = graph.agent_alt_range[agent]
     return discounted_coverage(
         a, b, graph.task_pos[blocks], p.search_block_px, z, float(lo), float(hi),

@@ -42,6 +42,7 @@ __all__ = [
     "TAN_Y",
     "best_search_altitude",
     "detection_probability",
+    "discounted_share",
     "segment_coverage",
 ]
 
@@ -143,3 +144,26 @@ def segment_coverage(
     share = (cross / block) * (along / block) * prob[:, None]
     when = np.clip(w, 0.0, length[:, None]) / max(speed, 1e-9)
     return share, when
+
+
+def discounted_share(
+    p: np.ndarray,
+    q: np.ndarray,
+    centres: np.ndarray,
+    block: float,
+    z: float,
+    lo: float,
+    hi: float,
+    speed: float,
+    t_start: np.ndarray,
+    horizon: float,
+) -> np.ndarray:
+    """(S, B) detection share of each block, discounted by when it is passed:
+    ``share (H - t)+ / H`` with ``share`` and the passing time from :func:`segment_coverage`,
+    ``t = t_start + when`` (``t_start`` (S,): when each segment is started) and ``H`` the
+    ``horizon`` (s). The readable rule; the model builds with its fast twin,
+    :func:`solvers.milp_model.kernels.discounted_coverage`, equal to it bit for bit."""
+    share, when = segment_coverage(p, q, centres, block, z, lo, hi, speed)
+    late = t_start[:, None] + when
+    out: np.ndarray = share * np.maximum(horizon - late, 0.0) / horizon
+    return out

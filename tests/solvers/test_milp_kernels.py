@@ -10,15 +10,8 @@ from hypothesis import strategies as st
 from solvers.milp_model import build, build_milp_model, objective
 from solvers.milp_model.kernels import discounted_coverage, dominated
 from solvers.milp_model.prune import dominated as dominated_rule
-from solvers.milp_model.sensing import segment_coverage
+from solvers.milp_model.sensing import discounted_share
 from tests.solvers.graphs import episode_graphs
-
-
-def discounted_rule(p, q, centres, block, z, lo, hi, speed, t_start, horizon) -> np.ndarray:
-    """The readable rule: the swept share, discounted by when the block is passed."""
-    share, when = segment_coverage(p, q, centres, block, z, lo, hi, speed)
-    late = t_start[:, None] + when
-    return share * np.maximum(horizon - late, 0.0) / horizon
 
 
 @settings(max_examples=60, deadline=None)
@@ -32,8 +25,8 @@ def discounted_rule(p, q, centres, block, z, lo, hi, speed, t_start, horizon) ->
     still=st.floats(0.0, 1.0),
 )
 def test_discounted_coverage_equals_the_rule(seed, n_seg, n_blocks, block, z, spread, still):
-    """discounted_coverage gives exactly (bit for bit, +0.0 outside the swath) what
-    segment_coverage discounted by the passing time gives, on segments of any length and
+    """discounted_coverage gives exactly (bit for bit, +0.0 outside the swath) what the
+    readable discounted_share gives, on segments of any length and
     direction (points included), blocks near and far, at any altitude and block size."""
     rng = np.random.default_rng(seed)
     p = rng.uniform(0.0, 3000.0, (n_seg, 2))
@@ -42,7 +35,7 @@ def test_discounted_coverage_equals_the_rule(seed, n_seg, n_blocks, block, z, sp
     centres = rng.uniform(-200.0, 3200.0, (n_blocks, 2))
     t_start = rng.uniform(0.0, 80.0, n_seg)
     args = (p, q, centres, block, z, 10.0, 120.0, float(rng.uniform(5.0, 300.0)), t_start, 60.0)
-    fast, rule = discounted_coverage(*args), discounted_rule(*args)
+    fast, rule = discounted_coverage(*args), discounted_share(*args)
     assert fast.shape == rule.shape == (n_seg, n_blocks)
     assert fast.tobytes() == rule.tobytes()
 
@@ -72,7 +65,7 @@ def test_models_built_with_the_rules_are_equal(monkeypatch):
     objective, routes) on real episodes' graphs: scenario #1 and #24 over their first minute."""
     fast = [build_milp_model(g) for n in (1, 24) for g in episode_graphs(n, (0, 200, 600))]
     monkeypatch.setattr(build, "dominated", dominated_rule)
-    monkeypatch.setattr(objective, "discounted_coverage", discounted_rule)
+    monkeypatch.setattr(objective, "discounted_coverage", discounted_share)
     slow = [build_milp_model(g) for n in (1, 24) for g in episode_graphs(n, (0, 200, 600))]
     for a, b in zip(fast, slow, strict=True):
         assert a.n_routes == b.n_routes
