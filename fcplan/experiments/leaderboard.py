@@ -382,6 +382,7 @@ def _scheduler_stats(
     metric: str,
     scenarios: list[str],
     refs: dict[str, dict[tuple[str, int], float]],
+    mine: Mapping[tuple[str, int], float],
 ) -> SchedulerStats:
     p50, p95 = _pooled_percentiles(rows)
     bounded, gap50, gap95 = _pooled_gaps(rows)
@@ -393,7 +394,6 @@ def _scheduler_stats(
             if (r["scenario"], int(r["seed"])) in refs[ORACLE]
             and (r["scenario"], int(r["seed"])) in refs[IDLE]
         ]
-        mine = _scores(rows, metric)
         sign = 1.0 if metric_direction(metric)[2] else -1.0  # lower is better: negate
         frac = fraction_of_oracle(
             [sign * mine[k] for k in keys],
@@ -456,13 +456,14 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
     scenarios = sorted({str(r["scenario"]) for r in rows})
     by = {k: [r for r in ok if r["scheduler"] == k] for k in labels}
     sign = 1.0 if metric_direction(metric)[2] else -1.0
-    refs = {IDLE: _scores(by[IDLE], metric)} if by.get(IDLE) else {}
+    scores = {k: _scores(by[k], metric) for k in labels}
+    refs = {IDLE: scores[IDLE]} if by.get(IDLE) else {}
     oracles = [k for k in labels if k.startswith(ORACLE) and by[k]]
     if oracles:
-        refs[ORACLE] = reference_scores([_scores(by[k], metric) for k in oracles], sign)
+        refs[ORACLE] = reference_scores([scores[k] for k in oracles], sign)
     stats = {
         k: _scheduler_stats(by[k], sum(r["scheduler"] == k for r in rows) - len(by[k]),
-                            metric, scenarios, refs)
+                            metric, scenarios, refs, scores[k])
         for k in labels if by[k]
     }  # fmt: skip
     policies = sorted((k for k in stats if is_policy(k)), key=lambda k: -sign * stats[k].mean.mean)
@@ -484,7 +485,7 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
             scenarios,
             sign,
             refs.get(ORACLE),
-            {k: _scores(by[k], metric) for k in policies},
+            {k: scores[k] for k in policies},
         ),  # fmt: skip
         settings={k: _settings(by[k]) for k in order if _settings(by[k])},
         per_scenario={sc: _scenario_means(by, order, sc, metric) for sc in scenarios},
@@ -499,9 +500,7 @@ def _scenario_means(
     for k in order:
         rows = [r for r in by[k] if r["scenario"] == scenario]
         if rows:
-            ofs = [float(r[_OFS]) for r in rows if finite(r.get(_OFS))]
-            mean_ofs = float(np.mean(ofs)) if ofs else math.nan
-            out[k] = (float(np.mean([float(r[metric]) for r in rows])), mean_ofs, len(rows))
+            out[k] = (_mean_of(rows, metric), _mean_of(rows, _OFS), len(rows))
     return out
 
 
