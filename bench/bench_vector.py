@@ -136,6 +136,19 @@ def _batched(env: Any, n_steps: int, parts: list, seed: int) -> tuple[int, Clock
     return env.num_envs * n_steps, clock
 
 
+def copy_floor(shape: tuple[int, ...], repeats: int = 20) -> float:
+    """CPU seconds of copying one float32 array of ``shape`` into another (best of
+    ``repeats``): the least a step can cost that writes an observation of that shape."""
+    src = np.random.default_rng(0).random(shape, dtype=np.float32)
+    dst = np.empty_like(src)
+    best = np.inf
+    for _ in range(repeats):
+        c = _CPU()
+        np.copyto(dst, src)
+        best = min(best, _CPU() - c)
+    return best
+
+
 def memory_per_world(sc: Any, small: int, large: int, level: str = "motion") -> tuple[float, float]:
     """(bytes per added world, bytes of the rest) of a stepped batched env, by tracemalloc."""
     sizes = []
@@ -282,6 +295,14 @@ def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int) -> l
     for label in [lab for _, _, lab in parts]:
         ms = clock.cpu[label] / n_steps * 1e3
         print(f"  {label:40s} {ms:9.3f}  {100 * clock.cpu[label] / clock.cpu['step']:5.1f}%")
+    if level == "motion":
+        env = VectorMotionEnv(sc, 1)
+        shape = (sizes[-1], *env.single_observation_space["fov"].shape)
+        floor = copy_floor(shape) / sizes[-1]
+        print(f"observation floor at B={sizes[-1]}: {4 * np.prod(shape[1:]) / 1e3:.1f} KB of "
+              f"crops per world-step; copying them once costs {1e6 * floor:.2f} us per "
+              f"world-step ({1 / floor / base:.1f}x the single env at most, were nothing else "
+              f"done; 20x leaves {1e6 / base / 20:.2f} us)")  # fmt: skip
     return rows
 
 
