@@ -8,9 +8,14 @@ the knobs changed from it and the generator seeds of the tier's scenarios. Three
     (``--seeds``, kept apart from the seeds the tier is measured on) and rejects the degenerate
     ones, by a rule that looks at no scheduler's rank: *saturated* (every policy played ends
     every screening episode with OFS 100 %) or *futile* (even the oracle keeps the negative
-    reward ratio at 95 % or more on every seed: nothing can be done). By default the policy
-    played is greedy alone (the cheapest; a scenario greedy clears is one a benchmark does not
-    need). It prints the first ``--keep`` seeds that pass, to copy into the design file.
+    reward ratio at 95 % or more on every seed: nothing can be done). A tier may set
+    ``contained_ofs`` (or ``--contained-ofs``): then a scenario is also rejected as *contained*
+    when every policy played puts out, on average over the screening seeds, at least that share
+    of the fire (OFS %): a team that keeps up with the fire leaves little for an algorithm to
+    decide, and the v1 hard tier showed such scenarios to be where the built-in schedulers tie.
+    By default the policies played are greedy (the cheapest; a scenario greedy clears is one a
+    benchmark does not need) and the oracle. It prints the first ``--keep`` seeds that pass, to
+    copy into the design file.
 ``freeze``
     Writes the design file's tiers into ``fcplan/data/suites/<suite>/`` (the TOML files and
     ``manifest.json``, :func:`fcplan.scenario.suite.write_suite`).
@@ -125,23 +130,38 @@ def per_scenario(rows: list[dict[str, Any]]) -> dict[str, dict[str, dict[str, fl
     return out
 
 
-def verdict(by: dict[str, dict[str, float]]) -> str:
-    """``keep``, ``saturated`` or ``futile`` (module docstring) for one scenario's means."""
+def verdict(by: dict[str, dict[str, float]], contained_ofs: float | None = None) -> str:
+    """``keep``, ``saturated``, ``contained`` (when ``contained_ofs`` is given) or ``futile``
+    (module docstring) for one scenario's means."""
     policies = [k for k in by if is_policy(k)]
     if policies and all(by[k]["ofs_min"] >= 100.0 for k in policies):
         return "saturated"
+    if (
+        contained_ofs is not None
+        and policies
+        and all(by[k]["ofs"] >= contained_ofs for k in policies)
+    ):
+        return "contained"
     best = by.get("oracle", {}).get("nrr_min", 0.0)
     if best >= 95.0 and all(by[k]["nrr_min"] >= 95.0 for k in policies):
         return "futile"
     return "keep"
 
 
-def print_scenarios(table: dict[str, dict[str, dict[str, float]]], seeds: dict[str, int]) -> None:
+def print_scenarios(
+    table: dict[str, dict[str, dict[str, float]]],
+    seeds: dict[str, int],
+    contained_ofs: float | None = None,
+) -> None:
+    """Per scenario: each scheduler's mean final score (mean OFS %) and the verdict."""
     names = list(dict.fromkeys(k for v in table.values() for k in v))
-    print(f"\n{'scenario':<34} {'seed':>5} " + " ".join(f"{n:>9}" for n in names) + "  verdict")
+    print(f"\n{'scenario':<34} {'seed':>5} " + " ".join(f"{n:>15}" for n in names) + "  verdict")
     for sc, by in table.items():
-        cells = " ".join(f"{by[n]['final']:9.1f}" if n in by else f"{'-':>9}" for n in names)
-        print(f"{sc:<34} {seeds.get(sc, -1):>5} {cells}  {verdict(by)}")
+        cells = " ".join(
+            f"{by[n]['final']:7.1f} ({by[n]['ofs']:3.0f}%)" if n in by else f"{'-':>15}"
+            for n in names
+        )
+        print(f"{sc:<34} {seeds.get(sc, -1):>5} {cells}  {verdict(by, contained_ofs)}")
 
 
 def cmd_screen(args: argparse.Namespace) -> None:
@@ -150,13 +170,16 @@ def cmd_screen(args: argparse.Namespace) -> None:
     scenarios = candidates(tier, args.candidates)
     seed_of = {s.name: c for s, c in zip(scenarios, args.candidates, strict=True)}
     table = per_scenario(play(scenarios, args))
-    print_scenarios(table, seed_of)
-    kept = [seed_of[sc] for sc, by in table.items() if verdict(by) == "keep"]
+    contained = args.contained_ofs if args.contained_ofs is not None else tier.get("contained_ofs")
+    if contained is not None:
+        print(f"# contained: every policy played at mean OFS >= {contained:g} %")
+    print_scenarios(table, seed_of, contained)
+    kept = [seed_of[sc] for sc, by in table.items() if verdict(by, contained) == "keep"]
     kept = sorted(kept)[: args.keep]
     print(f"\nkept (first {args.keep} in seed order): seeds = {kept}")
     if args.json:
         doc = {"tier": args.tier, "candidates": args.candidates, "seeds": args.seeds,
-               "scenarios": table, "kept": kept}  # fmt: skip
+               "contained_ofs": contained, "scenarios": table, "kept": kept}  # fmt: skip
         Path(args.json).write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
 
 
@@ -231,6 +254,9 @@ def main(argv: list[str] | None = None) -> None:
     s.add_argument("--tier", required=True)
     s.add_argument("--candidates", type=parse_range, required=True, help="generator seeds")
     s.add_argument("--keep", type=int, default=12)
+    s.add_argument("--contained-ofs", type=float, default=None,
+                   help="also reject scenarios every policy clears to this mean OFS %% "
+                        "(default: the tier's contained_ofs, else no such rule)")  # fmt: skip
     f = sub.add_parser("freeze", help="write the design's tiers into the package data")
     f.add_argument("design")
     m = sub.add_parser("measure", parents=[common], help="play a tier and check it")

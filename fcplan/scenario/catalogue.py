@@ -17,7 +17,7 @@ True
 >>> scenario_path("hard-01") == scenario_path("fcplan-bench-v1/hard-01")
 True
 >>> list_scenarios(suites=True)[-1]
-'fcplan-bench-v1/scale-06'
+'fcplan-bench-v2/hard-12'
 """
 
 from __future__ import annotations

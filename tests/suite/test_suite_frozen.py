@@ -1,5 +1,5 @@
-"""The frozen benchmark suite fcplan-bench-v1: its files are what their recorded calls draw,
-every file is a valid scenario that plays, and the wheel ships them."""
+"""The frozen benchmark suites (fcplan-bench-v1, fcplan-bench-v2): their files are what their
+recorded calls draw, every file is a valid scenario that plays, and the wheel ships them."""
 
 from __future__ import annotations
 
@@ -15,11 +15,14 @@ from fcplan import make_scheduler
 from fcplan.mission import Mission
 from fcplan.scenario import GeneratorConfig, load_scenario, recipe_of
 from fcplan.scenario.generate import GENERATOR_VERSION
-from fcplan.scenario.suite import SUITE_VERSION, load_suite
+from fcplan.scenario.suite import SUITE_VERSION, load_suite, suite_versions
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = load_suite()
-ENTRIES = {e.name: e for e in SUITE.entries}
+SUITES = [load_suite(v) for v in suite_versions()]
+#: every shipped suite's scenarios, by qualified name ("fcplan-bench-v2/hard-01")
+ENTRIES = {f"{s.version}/{e.name}": e for s in SUITES for e in s.entries}
+FOLDER = {f"{s.version}/{e.name}": s.folder for s in SUITES for e in s.entries}
 
 
 def test_suite_has_the_tiers_the_issue_asks_for():
@@ -34,12 +37,28 @@ def test_suite_has_the_tiers_the_issue_asks_for():
     assert SUITE.description.startswith("fcplan-bench-v1")
 
 
+def test_v2_holds_a_hard_tier_of_contested_scenarios():
+    """fcplan-bench-v2 holds hard-01..hard-12 of the 'hard' preset on 1,100-1,400 px maps with 5-7
+    fire regions; v1 stays the current suite (short names resolve in it), v2 loads by its
+    qualified names; both are listed, oldest first."""
+    v2 = load_suite("fcplan-bench-v2")
+    assert suite_versions() == ["fcplan-bench-v1", "fcplan-bench-v2"]
+    assert [e.name for e in v2.entries] == [f"hard-{k:02d}" for k in range(1, 13)]
+    assert {e.preset for e in v2.entries} == {"hard"}
+    for e in v2.entries:
+        s = load_scenario(e.qualified_name)
+        assert s.name == f"fcplan-bench-v2/{e.name}"
+        assert 1100 <= s.world_size <= 1400 and 5 <= len(s.regions) <= 7
+        assert len(s.agents) <= 9 and s.duration_s == 300
+    assert load_scenario("hard-01").name == "fcplan-bench-v1/hard-01"
+
+
 @pytest.mark.parametrize("name", list(ENTRIES))
 def test_frozen_file_equals_regenerating_it_from_its_recorded_call(name):
     """The file's bytes are exactly the TOML of the scenario drawn again from the manifest's
     call (seed and every knob), and their SHA-256 is the manifest's."""
     entry = ENTRIES[name]
-    data = (SUITE.folder / entry.file).read_bytes()
+    data = (FOLDER[name] / entry.file).read_bytes()
     assert data.decode("utf-8") == entry.text()
     assert hashlib.sha256(data).hexdigest() == entry.sha256
 
@@ -65,7 +84,7 @@ def test_every_file_validates_and_plays_a_few_ticks(name):
     """Each file loads (validation included) and a greedy team plays 30 ticks on it: time
     advances, the fire burns and no replan falls back."""
     s = load_scenario(name)
-    assert s.name == f"{SUITE_VERSION}/{name}"
+    assert s.name == name
     mission, greedy = Mission(s, seed=0), make_scheduler("greedy")
     while mission.tick < 30:
         commands = None
@@ -102,10 +121,11 @@ def test_package_data_ships_every_suite_file():
     assert unmatched == []
 
 
-def test_manifest_is_plain_json_with_one_record_per_file():
-    """The manifest names exactly the TOML files of its folder."""
-    doc = json.loads((SUITE.folder / "manifest.json").read_text())
-    assert doc["suite"] == SUITE.folder.name
+@pytest.mark.parametrize("suite", SUITES, ids=lambda s: s.version)
+def test_manifest_is_plain_json_with_one_record_per_file(suite):
+    """Each suite's manifest names exactly the TOML files of its folder."""
+    doc = json.loads((suite.folder / "manifest.json").read_text())
+    assert doc["suite"] == suite.folder.name
     assert sorted(r["file"] for r in doc["scenarios"]) == sorted(
-        p.name for p in SUITE.folder.glob("*.toml")
+        p.name for p in suite.folder.glob("*.toml")
     )

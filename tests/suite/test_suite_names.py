@@ -33,11 +33,12 @@ def test_short_and_qualified_names_load_the_same_file():
 
 
 def test_list_scenarios_keeps_the_manual_and_adds_the_suites_on_request():
-    """list_scenarios() is unchanged (practice, 1..24, examples); with suites=True the suite's
-    18 qualified names follow."""
+    """list_scenarios() is unchanged (practice, 1..24, examples); with suites=True every shipped
+    suite's qualified names follow, oldest suite first (v1's 18, then v2's 12)."""
     plain, every = list_scenarios(), list_scenarios(suites=True)
     assert every[: len(plain)] == plain and len(plain) == 27
-    assert every[len(plain) :] == load_suite().names()
+    assert every[len(plain) :] == [n for v in suite_versions() for n in load_suite(v).names()]
+    assert len(every) == 27 + 18 + 12
     assert len(load_suite().names("hard")) == 12 and len(load_suite().names("scale")) == 6
 
 
