@@ -48,3 +48,44 @@ def test_oracle_refuses_itself_as_inner():
     """An oracle inside an oracle is refused with a one-line error naming the setting."""
     with pytest.raises(FcplanError, match="inner must name another scheduler"):
         make_scheduler("oracle:inner=oracle")
+
+
+def test_look_for_fire_raises_only_the_blocks_over_unsensed_fire():
+    """On a clairvoyant graph with fire nobody has sensed, look_for_fire raises exactly the
+    search blocks nearest to an unsensed fire task above every other block (by that fire's
+    value) and changes no other value; on the team's own graph it changes nothing."""
+    from solvers.oracle import look_for_fire
+
+    mission = Mission(1, seed=0)
+    mission.advance(100)
+    g = mission.task_graph(clairvoyant=True)
+    seen = look_for_fire(g)
+    fires, blocks = g.fire_tasks, g.search_tasks
+    unsensed = fires[g.task_staleness[fires] > g.time_s]
+    assert unsensed.size > 0
+    d = np.linalg.norm(g.task_pos[unsensed][:, None] - g.task_pos[blocks][None], axis=2)
+    raised = np.zeros(blocks.size, dtype=bool)
+    raised[d.argmin(axis=1)] = True
+    up = seen.task_value[blocks] != g.task_value[blocks]
+    assert np.array_equal(up, raised)
+    assert seen.task_value[blocks][up].min() > g.task_value[blocks].max()
+    assert np.array_equal(seen.task_value[fires], g.task_value[fires])
+    plain = mission.task_graph()
+    assert look_for_fire(plain) is plain
+
+
+def test_oracle_without_look_for_fire_plans_as_its_inner_scheduler():
+    """look_for_fire=false gives the inner scheduler's plan on the clairvoyant graph unchanged
+    (the former oracle); a non-bool value is a one-line setting error."""
+    from fcplan.scheduling import SettingError
+
+    mission = Mission(24, seed=1)
+    mission.advance(200)
+    g = mission.task_graph(clairvoyant=True)
+    rng = np.random.default_rng(0)
+    old = make_scheduler("oracle:look_for_fire=false").plan(g, rng=rng)
+    inner = make_scheduler("greedy").plan(g, rng=rng)
+    assert old.routes == inner.routes and old.altitudes == inner.altitudes
+    assert make_scheduler("oracle:look_for_fire=false").name == "oracle"
+    with pytest.raises(SettingError, match="look_for_fire"):
+        make_scheduler("oracle", look_for_fire="yes")
