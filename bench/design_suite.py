@@ -13,9 +13,9 @@ the knobs changed from it and the generator seeds of the tier's scenarios. Three
     when every policy played puts out, on average over the screening seeds, at least that share
     of the fire (OFS %): a team that keeps up with the fire leaves little for an algorithm to
     decide, and the v1 hard tier showed such scenarios to be where the built-in schedulers tie.
-    By default the policies played are greedy (the cheapest; a scenario greedy clears is one a
-    benchmark does not need) and the oracle. It prints the first ``--keep`` seeds that pass, to
-    copy into the design file.
+    By default the screen plays greedy, its one policy (the cheapest; a scenario greedy clears is
+    one a benchmark does not need), and the oracle and idle, references that enter only the
+    futile rule. It prints the first ``--keep`` seeds that pass, to copy into the design file.
 ``freeze``
     Writes the design file's tiers into ``fcplan/data/suites/<suite>/`` (the TOML files and
     ``manifest.json``, :func:`fcplan.scenario.suite.write_suite`).
