@@ -108,8 +108,11 @@ def pyvrp_alone(xy: np.ndarray, dist: np.ndarray, limit: float, seed: int = 0) -
     return tour_length(dist, tour)
 
 
-def pyvrp_cpu(dist: np.ndarray, limit: float, seed: int) -> float:
-    """The core's PyVRP model and parameters of a tour, stopped after ``limit`` CPU seconds."""
+def pyvrp_cpu(
+    dist: np.ndarray, limit: float, seed: int, perturbation: tuple[int, int] | None = None
+) -> float:
+    """The core's PyVRP model and parameters of a tour, stopped after ``limit`` CPU seconds
+    (``perturbation``: another (least, most) perturbation range than the core's)."""
     import pyvrp
 
     from solvers.routing.core import RoutingInstance
@@ -117,7 +120,8 @@ def pyvrp_cpu(dist: np.ndarray, limit: float, seed: int) -> float:
 
     start = time.process_time()
     inst = RoutingInstance.of(dist, [0])
-    params = pyvrp.SolveParams(perturbation=pyvrp.search.PerturbationParams(*TOUR_PERTURBATION))
+    pert = TOUR_PERTURBATION if perturbation is None else perturbation
+    params = pyvrp.SolveParams(perturbation=pyvrp.search.PerturbationParams(*pert))
     res = pyvrp.solve(_data(inst, PyVRPOptions().scale),
                       lambda _: time.process_time() - start >= limit, seed=seed,
                       collect_stats=False, params=params)  # fmt: skip
@@ -150,25 +154,34 @@ def main() -> None:
     ap.add_argument("--cpu-limits", type=float, nargs="+")
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--repeats", type=int, default=1, help="runs of every wall-clock cell")
+    ap.add_argument("--perturbations", nargs="+", default=None, metavar="LO,HI",
+                    help="with --cpu-limits: one table per PyVRP perturbation range")  # fmt: skip
     args = ap.parse_args()
     configs = list(FIRST_SOLUTIONS) if args.first_solutions else args.configs
     print(f"# load average at start: {os.getloadavg()[0]:.2f} (2 cores)")
     if args.cpu_limits:
-        print(f"## core-pyvrp stopped on CPU time: gap (%) mean / max over {args.seeds} seeds")
-        print(f"{'instance':<9} {'optimum':>7}  " + "  ".join(
-            f"{f'{lim:g} cpu s':>14}" for lim in args.cpu_limits))  # fmt: skip
-        for name in args.instances:
-            xy, kind = read_coords(DATA / f"{name}.tsp")
-            dist = tsplib_distances(xy, kind)
-            cells = []
-            for lim in args.cpu_limits:
-                gaps = [
-                    100 * (pyvrp_cpu(dist, lim, s) / OPTIMA[name] - 1) for s in range(args.seeds)
-                ]
-                cells.append(f"{np.mean(gaps):>6.2f} / {max(gaps):>5.2f}")
-            print(
-                f"{name:<9} {OPTIMA[name]:>7}  " + "  ".join(f"{c:>14}" for c in cells), flush=True
-            )
+        ranges: list[tuple[int, int] | None] = [None]
+        for r in args.perturbations or []:
+            lo, hi = (int(v) for v in r.split(","))
+            ranges.append((lo, hi))
+        for pert in ranges[1:] if args.perturbations else ranges:
+            what = "" if pert is None else f", perturbation {pert[0]}-{pert[1]}"
+            print(f"## core-pyvrp stopped on CPU time{what}: gap (%) mean / max over "
+                  f"{args.seeds} seeds")  # fmt: skip
+            print(f"{'instance':<9} {'optimum':>7}  " + "  ".join(
+                f"{f'{lim:g} cpu s':>14}" for lim in args.cpu_limits))  # fmt: skip
+            for name in args.instances:
+                xy, kind = read_coords(DATA / f"{name}.tsp")
+                dist = tsplib_distances(xy, kind)
+                cells = []
+                for lim in args.cpu_limits:
+                    gaps = [
+                        100 * (pyvrp_cpu(dist, lim, s, pert) / OPTIMA[name] - 1)
+                        for s in range(args.seeds)
+                    ]
+                    cells.append(f"{np.mean(gaps):>6.2f} / {max(gaps):>5.2f}")
+                print(f"{name:<9} {OPTIMA[name]:>7}  " + "  ".join(f"{c:>14}" for c in cells),
+                      flush=True)  # fmt: skip
         return
     if args.deterministic:
         print(f"{'instance':<9} {'optimum':>7}  " + "  ".join(
