@@ -160,11 +160,10 @@ def main() -> None:
     configs = list(FIRST_SOLUTIONS) if args.first_solutions else args.configs
     print(f"# load average at start: {os.getloadavg()[0]:.2f} (2 cores)")
     if args.cpu_limits:
-        ranges: list[tuple[int, int] | None] = [None]
-        for r in args.perturbations or []:
-            lo, hi = (int(v) for v in r.split(","))
-            ranges.append((lo, hi))
-        for pert in ranges[1:] if args.perturbations else ranges:
+        ranges: list[tuple[int, int] | None] = [None]  # the core's own range
+        if args.perturbations:
+            ranges = [(int(r.split(",")[0]), int(r.split(",")[1])) for r in args.perturbations]
+        for pert in ranges:
             what = "" if pert is None else f", perturbation {pert[0]}-{pert[1]}"
             print(f"## core-pyvrp stopped on CPU time{what}: gap (%) mean / max over "
                   f"{args.seeds} seeds")  # fmt: skip
