@@ -36,7 +36,8 @@ the tier ``other``) and computes, per tier and scheduler:
 * the **tier check** of issue 12: a tier separates the schedulers when the policies are not all
   within each other's 95 % intervals and no scheduler clears every scenario; its acceptance
   asks that at least half of the policy pairs differ with Holm p < 0.01 and that the oracle's mean
-  be at least every policy's.
+  be at least every policy's. A policy that has not played every (scenario, seed) pair of the
+  tier is ranked after the complete ones and makes the check provisional.
 
 :func:`fcplan.experiments.leaderboard_page.markdown` writes the page (``docs/leaderboard.md``):
 the suite version, seeds, library versions, date and wall time of producing the results, then one
@@ -153,6 +154,8 @@ class SchedulerStats:
     episodes: int
     failed: int
     mean: MeanCI
+    instances: int = 0
+    """Distinct (scenario, seed) pairs completed (below the tier's count: the row is partial)."""
     fraction: float = math.nan
     fraction_ci: tuple[float, float] = (math.nan, math.nan)
     fraction_median_pair: float = math.nan
@@ -186,6 +189,8 @@ class TierCheck:
     """The clairvoyant reference's mean (the best oracle variant per pair,
     :func:`reference_scores`) is at least as good as every policy's (None without oracle
     episodes)."""
+    incomplete: tuple[str, ...] = ()
+    """Policies short of some of the tier's (scenario, seed) pairs: the check is provisional."""
 
     @property
     def keep(self) -> bool:
@@ -194,8 +199,14 @@ class TierCheck:
 
     @property
     def accepted(self) -> bool:
-        """The issue's acceptance: kept, half the pairs resolved at Holm p < 0.01, oracle on top."""
-        return self.keep and 2 * self.resolved >= self.pairs > 0 and self.oracle_top is True
+        """The issue's acceptance: every policy on every pair, kept, half the pairs resolved at
+        Holm p < 0.01, oracle on top."""
+        return (
+            not self.incomplete
+            and self.keep
+            and 2 * self.resolved >= self.pairs > 0
+            and self.oracle_top is True
+        )
 
 
 @dataclass
@@ -209,8 +220,12 @@ class TierResult:
     metric: str
     stats: dict[str, SchedulerStats]
     order: list[str]
+    """Policies with every (scenario, seed) pair ranked by mean, then partial ones (ranked
+    apart: their means are over fewer instances), then the references and baselines."""
     pairs: list[PairedComparison]
     check: TierCheck
+    instances: int = 0
+    """Distinct (scenario, seed) pairs any scheduler of the tier played."""
     settings: dict[str, str] = field(default_factory=dict)
     """Scheduler label -> its settings as recorded in the results (``key=value, ...``)."""
     per_scenario: dict[str, dict[str, tuple[float, float, int]]] = field(default_factory=dict)
@@ -238,6 +253,7 @@ class Leaderboard:
                         "tier": t.tier,
                         "scenarios": t.scenarios,
                         "seeds": t.seeds,
+                        "instances": t.instances,
                         "order": t.order,
                         "settings": t.settings,
                         "stats": {k: _stats_dict(v) for k, v in t.stats.items()},
@@ -406,6 +422,7 @@ def _scheduler_stats(
         episodes=len(rows),
         failed=failed,
         mean=mean_ci([float(r[metric]) for r in rows]),
+        instances=len(mine),
         fraction=frac[0],
         fraction_ci=frac[1],
         fraction_median_pair=frac[2],
@@ -431,6 +448,7 @@ def _check(
     sign: float,
     reference: Mapping[tuple[str, int], float] | None = None,
     scores: Mapping[str, Mapping[tuple[str, int], float]] | None = None,
+    instances: int = 0,
 ) -> TierCheck:
     policies = tuple(k for k in stats if is_policy(k))
     cis = {k: stats[k].mean for k in policies}
@@ -447,6 +465,7 @@ def _check(
         resolved=sum(c.p_holm < HOLM_LEVEL for c in pairs),
         pairs=len(pairs),
         oracle_top=top,
+        incomplete=tuple(k for k in policies if stats[k].instances < instances),
     )
 
 
@@ -466,7 +485,11 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
                             metric, scenarios, refs, scores[k])
         for k in labels if by[k]
     }  # fmt: skip
-    policies = sorted((k for k in stats if is_policy(k)), key=lambda k: -sign * stats[k].mean.mean)
+    instances = len({_instance(r) for r in rows})
+    policies = sorted(
+        (k for k in stats if is_policy(k)),
+        key=lambda k: (stats[k].instances < instances, -sign * stats[k].mean.mean),
+    )
     others = [k for k in stats if not is_policy(k)]
     order = policies + sorted(others, key=lambda k: (k != ORACLE, not k.startswith(ORACLE), k))
     pairs = paired_table(ok, policies, metric, _instance) if len(policies) > 1 else []
@@ -486,7 +509,9 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
             sign,
             refs.get(ORACLE),
             {k: scores[k] for k in policies},
+            instances,
         ),  # fmt: skip
+        instances=instances,
         settings={k: _settings(by[k]) for k in order if _settings(by[k])},
         per_scenario={sc: _scenario_means(by, order, sc, metric) for sc in scenarios},
     )
@@ -526,17 +551,18 @@ def _settings(rows: list[dict[str, Any]]) -> str:
 def _meta(rows: list[dict[str, Any]], wall: float | None) -> dict[str, Any]:
     versions = sorted({str(r["versions"]) for r in rows if isinstance(r.get("versions"), str)})
     done = [str(r["finished_at"]) for r in rows if isinstance(r.get("finished_at"), str)]
-    span = math.nan
+    busy, last = math.nan, -math.inf  # the union of the episodes' run intervals (pauses left out)
     if done and all(finite(r.get("episode_wall_s")) for r in rows):
-        ends = [_dt.datetime.fromisoformat(str(r["finished_at"])) for r in rows]
-        starts = [e - _dt.timedelta(seconds=float(r["episode_wall_s"])) for e, r in zip(ends, rows, strict=True)]  # fmt: skip
-        span = (max(ends) - min(starts)).total_seconds()
+        ends = [_dt.datetime.fromisoformat(str(r["finished_at"])).timestamp() for r in rows]
+        busy = 0.0
+        for a, b in sorted((e - float(r["episode_wall_s"]), e) for e, r in zip(ends, rows, strict=True)):  # fmt: skip
+            busy, last = busy + max(b - max(a, last), 0.0), max(last, b)
     return {
         "episodes": len(rows),
         "failed": sum(r.get("status", "ok") != "ok" for r in rows),
         "libraries": [json.loads(v) for v in versions],
         "finished": max(done) if done else "",
-        "wall_time_s": wall if wall is not None else span,
+        "wall_time_s": wall if wall is not None else busy,
         "episode_time_s": float(sum(float(r.get("episode_wall_s") or 0.0) for r in rows)),
         "hosts": sorted({str(r["host"]) for r in rows if r.get("host")}),
         "suites": sorted({tier_of(str(r["scenario"]))[0] for r in rows} - {""}),

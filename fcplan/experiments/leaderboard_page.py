@@ -34,6 +34,7 @@ from fcplan.experiments.leaderboard import (
     is_policy,
     metric_direction,
 )
+from fcplan.scenario.suite import load_suite, suite_versions
 
 __all__ = ["markdown"]
 
@@ -77,7 +78,7 @@ def _gap(s: SchedulerStats) -> str:
     return f"{pct[0]} / {pct[1]}{share}"
 
 
-def _row(rank: str, name: str, s: SchedulerStats, n_scen: int, digits: int) -> str:
+def _row(rank: str, name: str, s: SchedulerStats, t: TierResult, digits: int) -> str:
     lo, hi = s.fraction_ci
     frac = "n/a" if not finite(s.fraction) else f"{s.fraction:.3f}"
     if finite(lo):
@@ -85,13 +86,15 @@ def _row(rank: str, name: str, s: SchedulerStats, n_scen: int, digits: int) -> s
     note = _NOTES.get(name, _NOTES[ORACLE] if name.startswith(ORACLE) else "")
     label = f"{name} ({note})" if note else name
     failed = f" ({s.failed} failed)" if s.failed else ""
+    if s.instances < t.instances:
+        failed += f" (partial: {s.instances} of {t.instances} pairs)"
     cells = [
         rank,
         label + failed,
         f"{s.mean.mean:.{digits}f} ± {_num(s.mean.half_width, digits)}",
         frac,
         _num(s.ofs, 1),
-        f"{s.cleared}/{n_scen}",
+        f"{s.cleared}/{len(t.scenarios)}",
         _num(s.containment_s, 1),
         _num(s.burned, 0),
         f"{_num(s.solve_p50_ms, 1)} / {_num(s.solve_p95_ms, 1)}",
@@ -103,10 +106,15 @@ def _row(rank: str, name: str, s: SchedulerStats, n_scen: int, digits: int) -> s
 
 def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
     name = f"{t.suite}/{t.tier}" if t.suite else "other scenarios"
+    size = len(load_suite(t.suite).tiers().get(t.tier, [])) if t.suite in suite_versions() else 0
     out = [
         f"## Tier `{name}`: {_count(len(t.scenarios), 'scenario')} x "
         f"{_count(len(t.seeds), 'seed')} ({_span(t.seeds)})",
         "",
+    ]
+    if size > len(t.scenarios):
+        out += [f"Only {len(t.scenarios)} of the tier's {size} scenarios have episodes so far.", ""]
+    out += [
         f"| # | scheduler | {label} (mean ± 95 % CI) | fraction of oracle [95 % CI] | OFS % "
         "| cleared | containment s | burned cells | solve p50 / p95 ms | gap p50 / p95 % "
         "| fallbacks / replans |",
@@ -114,9 +122,16 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
     ]
     rank = 0
     for k in t.order:
-        rank += is_policy(k)
-        r = str(rank) if is_policy(k) else "ref" if k.startswith(ORACLE) else "base"
-        out.append(_row(r, k, t.stats[k], len(t.scenarios), digits))
+        whole = t.stats[k].instances >= t.instances
+        rank += is_policy(k) and whole
+        r = (
+            (str(rank) if whole else "-")
+            if is_policy(k)
+            else "ref"
+            if k.startswith(ORACLE)
+            else "base"
+        )
+        out.append(_row(r, k, t.stats[k], t, digits))
     if t.settings:
         text = "; ".join(f"{k}: {v}" for k, v in t.settings.items())
         out += ["", f"Scheduler settings: {text}."]
@@ -138,6 +153,11 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
     out += _scenario_table(t, label, digits)
     c = t.check
     top = {None: "no oracle episodes", True: "yes", False: "**no**"}[c.oracle_top]
+    verdict = "Accepted" if c.accepted else "Kept" if c.keep else "Not kept"
+    if c.incomplete:
+        short = ", ".join(f"{k} {t.stats[k].instances} of {t.instances}" for k in c.incomplete)
+        verdict = f"Provisional: not every policy has played every pair yet ({short})"
+
     out += [
         "",
         "Tier check (issue 12): policies "
@@ -149,7 +169,7 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
         + "; OFS 100 % on every scenario: "
         + f"{', '.join(c.cleared_all) or 'none'}; pairs with Holm p < 0.01: {c.resolved} of "
         f"{c.pairs}; reference (best oracle) mean at least every policy's: {top}. "
-        f"**{'Accepted' if c.accepted else 'Kept' if c.keep else 'Not kept'}.**",
+        f"**{verdict}.**",
         "",
     ]
     return out
@@ -186,6 +206,19 @@ def _scenario_table(t: TierResult, label: str, digits: int) -> list[str]:
     return out
 
 
+def _missing_tiers(board: Leaderboard) -> list[str]:
+    """``suite/tier (n scenarios)`` for every tier of the board's suites that it has no row of."""
+    have = {(t.suite, t.tier) for t in board.tiers}
+    out = []
+    for version in board.meta.get("suites", []):
+        if version not in suite_versions():
+            continue
+        for tier, entries in load_suite(version).tiers().items():
+            if (version, tier) not in have:
+                out.append(f"`{version}/{tier}` ({_count(len(entries), 'scenario')})")
+    return out
+
+
 def markdown(board: Leaderboard, command: str = "") -> str:
     """The leaderboard page (``docs/leaderboard.md``); ``command`` is how it was made."""
     m = board.meta
@@ -206,7 +239,7 @@ def markdown(board: Leaderboard, command: str = "") -> str:
         + (f", the last finished {m['finished']}" if m["finished"] else "")
         + (f" on {', '.join(m['hosts'])}" if m["hosts"] else "")
         + f". Producing the results took {_duration(m['wall_time_s'])} of wall-clock time "
-        f"({_duration(m['episode_time_s'])} of episode time).",
+        f"(while any of these episodes ran; {_duration(m['episode_time_s'])} of episode time).",
         "",
         "Schedulers ran in their deterministic modes where they have one, so their scores do not "
         "depend on machine load; solve times do."
@@ -216,6 +249,9 @@ def markdown(board: Leaderboard, command: str = "") -> str:
         f"Libraries: {libs or 'not recorded'}.",
         "",
     ]
+    missing = _missing_tiers(board)
+    if missing:
+        out += [f"Tiers of these suites with no episodes in the results: {', '.join(missing)}.", ""]
     for t in board.tiers:
         out += _tier_section(t, label, digits)
     out += [
@@ -229,7 +265,9 @@ def markdown(board: Leaderboard, command: str = "") -> str:
         "of seeds within each scenario. Above 1: better than the oracle on these pairs (the "
         "oracle is a reference, not a bound).",
         "* **mean ± 95 % CI**: Student t over every episode of the tier (it includes the spread "
-        "between scenarios); the paired table is the comparison to quote.",
+        "between scenarios); the paired table is the comparison to quote. A *partial* row "
+        "(rank `-`) has not played every (scenario, seed) pair of the tier yet: its mean is over "
+        "other instances than the ranked rows' and is not comparable with them.",
         "* **cleared**: scenarios where every seed ended with OFS 100 %. **fallbacks**: replans "
         "where the scheduler failed or ran out of time and greedy planned instead.",
         "* **solve p50 / p95**: milliseconds per scheduler call over every replan of the tier, "

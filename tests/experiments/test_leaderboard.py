@@ -3,6 +3,7 @@ the oracle, paired comparisons, the tier check, and a page built from real resul
 
 from __future__ import annotations
 
+import datetime
 import json
 import math
 
@@ -305,3 +306,46 @@ def test_lower_is_better_metrics_rank_and_normalise_the_other_way():
     assert t.stats["b"].fraction == pytest.approx(0.75)
     assert t.stats["oracle"].fraction == pytest.approx(1.0)
     assert t.check.oracle_top is True
+
+
+def test_a_partial_policy_is_ranked_apart_and_makes_the_check_provisional():
+    """A policy that has played only some (scenario, seed) pairs of the tier is ranked after the
+    complete ones whatever its mean, the tier check names it and cannot accept the tier, and the
+    page gives it rank `-`, says how many pairs it has and calls the verdict provisional."""
+    rng = np.random.default_rng(0)
+    base = rng.normal(0, 30, 40)
+    full = {"a": base + 50, "b": base + 25, "c": base, "oracle": base + 80, "idle": base - 200}
+    rows = _rows(full)
+    assert leaderboard(rows).tiers[0].check.accepted  # every pair played: accepted
+    # "late" is the best policy on the few pairs it has played (scenario 1, seeds 0-4)
+    rows += [dict(r, scheduler="late", **{"manual.final_score": 500.0})
+             for r in rows if r["scheduler"] == "a" and r["seed"] < 5
+             and r["scenario"] == HARD.format(1)]  # fmt: skip
+    t = leaderboard(rows).tiers[0]
+    assert t.instances == 40 and t.stats["late"].instances == 5 and t.stats["a"].instances == 40
+    assert t.order[:4] == ["a", "b", "c", "late"]
+    assert t.check.incomplete == ("late",) and not t.check.accepted
+    page = markdown(leaderboard(rows), "fcplan leaderboard results")
+    assert "| - | late (partial: 5 of 40 pairs) | 500.0" in page
+    assert "| 1 | a |" in page and "| 3 | c |" in page
+    assert "**Provisional: not every policy has played every pair yet (late 5 of 40)." in page
+
+
+def test_page_names_the_tiers_of_a_suite_that_have_no_episodes():
+    """Results on two scenarios of fcplan-bench-v1's hard tier alone: the page says that the
+    suite's scale tier (six scenarios) has no episodes and that the hard tier has two of its
+    twelve, instead of silently leaving them out."""
+    page = markdown(leaderboard(_rows({"a": [1.0, 2.0, 3.0, 4.0]})), "cmd")
+    assert "no episodes in the results: `fcplan-bench-v1/scale` (6 scenarios)." in page
+    assert "Only 2 of the tier's 12 scenarios have episodes so far." in page
+
+
+def test_wall_time_is_the_union_of_the_episodes_run_intervals():
+    """Two overlapping episodes (10-40 s and 20-50 s) and one after a pause (1000-1030 s) took
+    70 s of wall-clock time: overlaps count once and the pause between runs is left out."""
+    rows = _rows({"a": [1.0, 2.0, 3.0]}, scenarios=1)
+    for r, (end, took) in zip(rows, [(40.0, 30.0), (50.0, 30.0), (1030.0, 30.0)], strict=True):
+        r["finished_at"] = datetime.datetime.fromtimestamp(end, datetime.UTC).isoformat()
+        r["episode_wall_s"] = took
+    meta = leaderboard(rows).meta
+    assert meta["wall_time_s"] == pytest.approx(70.0) and meta["episode_time_s"] == 90.0
