@@ -22,11 +22,15 @@ locally optimal), stopped
 
 Perturbation: on a tour (one vehicle through required tasks only: a TSP or shortest Hamiltonian
 path) each iteration perturbs 3 to 40 moves (:data:`TOUR_PERTURBATION`) instead of PyVRP's
-default 1 to 25: at equal CPU time it reached 0-0.78 % above the optimum on att48, eil51 and
-berlin52 at 0.1 s (default: up to 1.74 %) and 0-0.37 % on st70, eil76, kroA100 and rd100 at 1 s
-(default: up to 1.29 %, kroA100's plateau), 5-6 seeds each. On the scheduler's prize-collecting
-models the default was better at equal CPU (0.13 % against 0.22-0.28 % above the best found),
-so it stays there (``bench/README.md``).
+default 1 to 25. It was chosen on 5-6 seeds per instance, where it reached 0-0.78 % above the
+optimum on att48, eil51 and berlin52 at 0.1 s (default: up to 1.74 %) and 0-0.37 % on st70, eil76,
+kroA100 and rd100 at 1 s (default: up to 1.29 %, kroA100's plateau). Ten seeds at 1 CPU second
+later showed a trade-off, not a winner: (3, 40) keeps kroA100 and rd100 at 0 % but leaves eil76
+at 1.04 % on average and 1.67 % at worst, while (1, 25) keeps eil76 within 0.93 % and leaves
+kroA100 at up to 2.66 %; no range tried keeps both within 1 % on every seed
+(``bench_tsplib.py --perturbations``). On the scheduler's prize-collecting models the default was
+better at equal CPU (0.13 % against 0.22-0.28 % above the best found), so it stays there
+(``bench/README.md``).
 
 PyVRP keeps the best *feasible* solution it found; if it found none (or, with forbidden tasks,
 one that breaks the input's rules), the search is treated as having found nothing.
