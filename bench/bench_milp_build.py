@@ -9,9 +9,16 @@ the routes and nonzeros, and a digest of every model built (objective, rows, rou
 trees that build the same models print the same digest, so an A/B run (``bench/ab.py``) checks
 that a speed-up left the models unchanged while it measures it.
 
+``--set KEY=VALUE`` builds with other model settings (:class:`solvers.milp_model.MilpParams`
+fields, e.g. ``search_candidates=5``; ``max_scored_ends=N`` sets
+:data:`solvers.milp_model.build.MAX_SCORED_ENDS`), and ``--solve`` also times CP-SAT on each model
+in the scheduler's deterministic mode (5 deterministic seconds, one worker): what smaller
+candidate sets buy at the scale tier.
+
 Usage::
 
     python bench/bench_milp_build.py
+    python bench/bench_milp_build.py --designs scale-tier --solve --set search_candidates=5
     git worktree add ../fcplan-old HEAD~1
     python bench/ab.py ../fcplan-old . bench/bench_milp_build.py --rounds 5
 """
@@ -28,7 +35,9 @@ import numpy as np
 
 from fcplan import load_scenario
 from fcplan.testing import episode_graphs
-from solvers.milp_model import build_milp_model
+from solvers.milp import solve_cpsat
+from solvers.milp_model import MilpParams, build_milp_model
+from solvers.milp_model import build as milp_build
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_time_limits import scale_design  # noqa: E402
@@ -50,10 +59,18 @@ def main() -> None:
     )
     ap.add_argument("--every", type=int, default=30, help="simulated seconds between graphs")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
+                    help="model settings (MilpParams fields, or max_scored_ends)")  # fmt: skip
+    ap.add_argument("--solve", action="store_true", help="also time CP-SAT on every model")
     args = ap.parse_args()
+    changes = {k: float(v) if "." in v else int(v) for k, v in (a.split("=", 1) for a in args.set)}
+    milp_build.MAX_SCORED_ENDS = int(changes.pop("max_scored_ends", milp_build.MAX_SCORED_ENDS))
+    params = MilpParams(**changes)  # type: ignore[arg-type]
     print(f"# load average at start: {os.getloadavg()[0]:.2f} ({os.cpu_count()} cores)")
+    print(f"# settings: {' '.join(args.set) or 'defaults'}")
     print(f"{'design':<10} {'graphs':>6} {'build p50 ms':>13} {'p95 ms':>8} {'ms/agent':>9} "
-          f"{'routes':>7} {'nonzeros':>9}  digest")  # fmt: skip
+          f"{'routes':>7} {'nonzeros':>9}  digest"
+          + (f"  {'solve p50 ms':>12} {'p95 ms':>8} {'optimal':>7}" if args.solve else ""))  # fmt: skip
     for design in args.designs:
         if design == "suite":
             scenarios = [load_scenario(i) for i in range(1, 25)]
@@ -71,16 +88,27 @@ def main() -> None:
             models = []
             for i, g in enumerate(graphs):
                 t0 = time.perf_counter()
-                models.append(build_milp_model(g))
+                models.append(build_milp_model(g, params))
                 times[r, i] = time.perf_counter() - t0
         per_graph = times.min(axis=0) * 1e3  # each graph's best round: the least disturbed
         agents = np.array([g.n_agents for g in graphs])
         routes = int(np.median([m.n_routes for m in models]))
         nnz = int(np.median([m.A_ub.nnz for m in models]))
+        solve = ""
+        if args.solve:
+            ms, optimal = [], 0
+            for m in models:
+                t0 = time.perf_counter()
+                _, stats = solve_cpsat(m)
+                ms.append((time.perf_counter() - t0) * 1e3)
+                optimal += stats.status == "optimal"
+            solve = (
+                f"  {np.median(ms):>12.1f} {np.percentile(ms, 95):>8.1f} {optimal:>3}/{len(ms):<3}"
+            )
         print(
             f"{design:<10} {len(graphs):>6} {np.median(per_graph):>13.1f} "
             f"{np.percentile(per_graph, 95):>8.1f} {np.median(per_graph / agents):>9.2f} "
-            f"{routes:>7} {nnz:>9}  {digest(models)}"
+            f"{routes:>7} {nnz:>9}  {digest(models)}{solve}"
         )
     print(f"# load average at end: {os.getloadavg()[0]:.2f}")
 
