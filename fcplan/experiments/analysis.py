@@ -13,10 +13,12 @@ limit).
   Wilcoxon signed-rank p-value and its Holm adjustment over the family of pairs, and a verdict in
   words (:meth:`~fcplan.experiments.stats.PairedComparison.verdict`, e.g. ``"unresolved at
   n=5 (~40 pairs for 80% power at d_z=+0.45)"`` when the interval is too wide to tell).
-* :func:`oracle_fractions`: each scheduler's metric as a fraction of the clairvoyant ``oracle``'s
-  on the same instance (the number a paper quotes), the mean over instances of
-  ``x_i / oracle_i`` with its interval, and the ratio of the means. A fraction is only defined
-  where the oracle's value is positive; instances where it is not are counted, not used.
+* :func:`oracle_fractions`: each scheduler's share of the clairvoyant reference's improvement
+  over the idle team on the same instances, ``sum (x_i - idle_i) / sum (oracle_i - idle_i)``
+  with a bootstrap interval (the number a paper quotes, and the leaderboard's:
+  :mod:`fcplan.experiments.oracle_reference`); the reference on an instance is the best of the
+  oracle variants run on it. Without the idle team in the study it is ``sum x_i / sum
+  oracle_i``, meaningful only for positive scores.
 * :func:`metric_rankings`: per metric of :data:`~fcplan.experiments.tables.RANKING_COLUMNS` (the
   manual's final score and NRR, time to containment, contained, burned area, facility damage),
   the schedulers ordered by mean, the pairs that differ (interval excludes 0 and Holm-adjusted
@@ -47,9 +49,9 @@ from typing import Any
 
 import numpy as np
 
+from fcplan.experiments.oracle_reference import fraction_of_oracle, reference_scores
 from fcplan.experiments.stats import (
     Friedman,
-    MeanCI,
     PairedComparison,
     friedman,
     mean_ci,
@@ -68,6 +70,7 @@ __all__ = [
     "oracle_fractions",
     "paired_scores",
     "paired_table",
+    "reference_label",
     "results_pair_key",
     "separation",
     "StudyStats",
@@ -78,6 +81,9 @@ PairKey = Callable[[Mapping[str, Any]], Hashable]
 """The instance an episode row played (rows of two schedulers with equal keys are a pair)."""
 
 Rows = Sequence[Mapping[str, Any]]
+
+IDLE = "idle"
+"""The baseline that normalises the fraction of the oracle (the team that does nothing)."""
 
 RANKING_METRICS: tuple[str, ...] = tuple(c.name for c in RANKING_COLUMNS)
 """Column names of :data:`~fcplan.experiments.tables.RANKING_COLUMNS`."""
@@ -160,64 +166,91 @@ def paired_table(
 
 @dataclass(frozen=True)
 class OracleFraction:
-    """One scheduler's metric as a fraction of the oracle's on the same instances.
+    """One scheduler's fraction of the clairvoyant reference on the same instances.
 
     Attributes
     ----------
-    scheduler, oracle, metric : str
-    fraction : MeanCI
-        Mean and 95 % interval over instances of ``x_i / oracle_i`` (instances where the
-        oracle's value is positive).
-    ratio_of_means : float
-        ``mean(x_i) / mean(oracle_i)`` over the same instances.
-    excluded : int
-        Instances left out because the oracle's value was 0 or negative (no fraction).
+    scheduler, metric : str
+    oracle : str
+        The reference: an oracle label, or ``"best of a, b"`` when several oracle variants ran
+        (the best of them on each instance, :func:`~fcplan.experiments.oracle_reference.reference_scores`).
+    baseline : str or None
+        ``"idle"`` when the study ran the idle team: the fraction is then ``sum (x_i - idle_i) /
+        sum (oracle_i - idle_i)``, the share of the reference's improvement over doing nothing
+        (:func:`~fcplan.experiments.oracle_reference.fraction_of_oracle`, the leaderboard's
+        number). None: ``sum x_i / sum oracle_i``, which means something only when every score
+        is positive (NaN for a lower-is-better metric).
+    fraction, low, high : float
+        The fraction and its 95 % bootstrap interval (seeds resampled within each scenario).
+    median_pair : float
+        The median of the per-instance ratios.
+    n : int
+        Instances where the scheduler, the reference and the baseline all completed.
     above : int
-        Instances where the scheduler's value was better than the oracle's (the oracle is a
-        reference, not a bound).
+        Instances where the scheduler did better than the reference (a reference, not a bound).
     """
 
     scheduler: str
     oracle: str
     metric: str
-    fraction: MeanCI
-    ratio_of_means: float
-    excluded: int
+    baseline: str | None
+    fraction: float
+    low: float
+    high: float
+    median_pair: float
+    n: int
     above: int
 
 
+def reference_label(references: Sequence[str]) -> str:
+    """How the reference of several oracle variants is named (one: its own label)."""
+    return references[0] if len(references) == 1 else "best of " + ", ".join(references)
+
+
 def oracle_fractions(
-    rows: Rows, schedulers: Sequence[str], oracle: str, metric: str, pair_key: PairKey
+    rows: Rows,
+    schedulers: Sequence[str],
+    references: str | Sequence[str],
+    metric: str,
+    pair_key: PairKey,
+    *,
+    baseline: str = IDLE,
 ) -> list[OracleFraction]:
-    """:class:`OracleFraction` of every scheduler but ``oracle`` (see the module docstring).
+    """:class:`OracleFraction` of every scheduler but the references and the ``baseline``
+    (normalised by it when it is among ``schedulers``; see :class:`OracleFraction`).
 
     Examples
     --------
     >>> rows = [{"scheduler": s, "seed": k, "x": v} for s, vals in
-    ...         {"oracle": [100.0, 200.0, -5.0], "g": [90.0, 150.0, -20.0]}.items()
+    ...         {"oracle": [100.0, 200.0], "g": [90.0, 150.0], "idle": [-50.0, 0.0]}.items()
     ...         for k, v in enumerate(vals)]
-    >>> (f,) = oracle_fractions(rows, ["oracle", "g"], "oracle", "x", lambda r: r["seed"])
-    >>> round(f.fraction.mean, 3), round(f.ratio_of_means, 3), f.excluded, f.fraction.n
-    (0.825, 0.8, 1, 2)
+    >>> (f,) = oracle_fractions(rows, ["oracle", "g", "idle"], "oracle", "x", lambda r: r["seed"])
+    >>> f.baseline, round(f.fraction, 3), f.n  # (140 + 150) / (150 + 200)
+    ('idle', 0.829, 2)
     """
-    scores = paired_scores(rows, schedulers, metric, pair_key)
-    ref = scores[oracle]
-    higher = higher_is_better(metric)
+    refs = [references] if isinstance(references, str) else list(references)
+    names = list(dict.fromkeys([*refs, *schedulers]))
+    scores = {
+        k: {i: v for i, v in d.items() if math.isfinite(v)}
+        for k, d in paired_scores(rows, names, metric, pair_key).items()
+    }
+    sign = 1.0 if higher_is_better(metric) else -1.0
+    ref = reference_scores([scores[r] for r in refs], sign)
+    zero = scores[baseline] if baseline in schedulers and scores.get(baseline) else None
+    scenario = {pair_key(r): str(r.get("scenario", "")) for r in rows}
     out = []
     for name in schedulers:
-        if name == oracle:
+        if name in refs or name == baseline:
             continue
-        common = [k for k in scores[name] if k in ref]
-        x = np.array([scores[name][k] for k in common], np.float64)
-        o = np.array([ref[k] for k in common], np.float64)
-        ok = o > 0
-        ratio = float(x[ok].mean() / o[ok].mean()) if ok.any() else math.nan
-        above = int((x > o).sum() if higher else (x < o).sum())
-        out.append(
-            OracleFraction(
-                name, oracle, metric, mean_ci(x[ok] / o[ok]), ratio, int((~ok).sum()), above
-            )
-        )
+        keys = [k for k in scores[name] if k in ref and (zero is None or k in zero)]
+        x = [sign * scores[name][k] for k in keys]
+        o = [sign * ref[k] for k in keys]
+        z = [sign * zero[k] for k in keys] if zero is not None else [0.0] * len(keys)
+        frac, (lo, hi), med = fraction_of_oracle(x, o, z, [scenario[k] for k in keys])
+        above = sum(a > b for a, b in zip(x, o, strict=True))
+        label = reference_label(refs)
+        base = baseline if zero is not None else None
+        out.append(OracleFraction(name, label, metric, base, frac, lo, hi, med, len(keys), above))
     return out
 
 
@@ -356,7 +389,8 @@ class StudyStats:
     policies : tuple of str
         The compared schedulers (every scheduler but the clairvoyant references).
     oracle : str or None
-        The scheduler the fractions are taken of (None: no oracle in the study).
+        The reference the fractions are taken of (:func:`reference_label`; None: no oracle in
+        the study).
     metrics : tuple of str
         The metrics with a paired table, headline first.
     paired : dict of str -> list of PairedComparison
@@ -413,11 +447,12 @@ class StudyStats:
                 "scheduler": f.scheduler,
                 "oracle": f.oracle,
                 "metric": f.metric,
-                "pairs": f.fraction.n,
-                "fraction_mean": f.fraction.mean,
-                "fraction_ci": f.fraction.half_width,
-                "ratio_of_means": f.ratio_of_means,
-                "excluded": f.excluded,
+                "baseline": f.baseline,
+                "pairs": f.n,
+                "fraction": f.fraction,
+                "low": f.low,
+                "high": f.high,
+                "median_pair": f.median_pair,
                 "better_than_oracle": f.above,
             }
             for f in self.fractions
@@ -463,18 +498,18 @@ def study_stats(
     references : sequence of str
         Clairvoyant schedulers: not compared, not ranked.
     oracle : str, optional
-        The reference the fractions are taken of (default: the first of ``references``).
+        The one reference the fractions are taken of (default: the best of ``references`` on
+        each instance).
     """
     policies = tuple(s for s in schedulers if s not in references)
-    oracle = oracle if oracle is not None else (references[0] if references else None)
+    refs = [oracle] if oracle is not None else list(references)
     paired = {
         m: paired_table(rows, policies, m, pair_key, confidence=confidence, alpha=alpha)
         for m in metrics
     }
     fractions = (
-        oracle_fractions(rows, [oracle, *policies], oracle, metrics[0], pair_key)
-        if oracle is not None and metrics
-        else []
+        oracle_fractions(rows, policies, refs, metrics[0], pair_key) if refs and metrics else []
     )
+    oracle = reference_label(refs) if refs else None
     rankings = metric_rankings(rows, policies, RANKING_METRICS, pair_key, alpha=alpha)
     return StudyStats(policies, oracle, tuple(metrics), paired, fractions, rankings, confidence)

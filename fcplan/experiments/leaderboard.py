@@ -18,10 +18,9 @@ the tier ``other``) and computes, per tier and scheduler:
   is a **ratio of means**, not a mean of per-pair ratios: a pair where the oracle barely beats
   idle (nothing was at stake) would give a huge or undefined per-pair ratio, while the ratio of
   means weights each pair by what was achievable there. Normalising by idle makes it independent
-  of the score's zero: final scores are often negative on this suite, where the raw ratio
-  ``s_i / oracle_i`` of ``fcplan compare``
-  (:func:`~fcplan.experiments.analysis.oracle_fractions`, defined only where the oracle's score
-  is positive) would drop the hardest instances; the two agree when idle scores 0. Its 95 %
+  of the score's zero: final scores are often negative on this suite, where a raw ratio
+  ``s_i / oracle_i`` would mean nothing. ``fcplan compare`` and ``fcplan report`` give the same
+  number (:func:`~fcplan.experiments.analysis.oracle_fractions`) when idle was run. Its 95 %
   interval is a percentile bootstrap (2,000 draws, seed 0) that resamples seeds within each
   scenario: the suite's scenarios are fixed, seeds are the random part;
 * OFS, time to containment and burned area (means), the scenarios *cleared* (OFS 100 % on every

@@ -24,14 +24,16 @@ Examples
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Hashable, Mapping, Sequence
+from typing import Any, TypeVar
 
 import numpy as np
 
 __all__ = ["BOOTSTRAP_DRAWS", "fraction_of_oracle", "on_top", "reference_scores"]
 
 BOOTSTRAP_DRAWS = 2000
+
+K = TypeVar("K", bound=Hashable)
 
 
 def fraction_of_oracle(
@@ -81,9 +83,7 @@ def fraction_of_oracle(
     return frac, (float(lo), float(hi)), median
 
 
-def reference_scores(
-    variants: Sequence[Mapping[tuple[str, int], float]], sign: float = 1.0
-) -> dict[tuple[str, int], float]:
+def reference_scores(variants: Sequence[Mapping[K, float]], sign: float = 1.0) -> dict[K, float]:
     """The clairvoyant reference per (scenario, seed): the best score of the oracle variants
     (``oracle``, ``oracle[routing]``, ...) over the pairs where every variant completed.
 
@@ -99,7 +99,11 @@ def reference_scores(
     """
     keys = set(variants[0]).intersection(*variants[1:]) if variants else set()
     pick = max if sign > 0 else min
-    return {k: pick(v[k] for v in variants) for k in sorted(keys)}
+    try:
+        order = sorted(keys)  # type: ignore[type-var]
+    except TypeError:  # keys that do not compare (a results row's None beside a string)
+        order = sorted(keys, key=repr)
+    return {k: pick(v[k] for v in variants) for k in order}
 
 
 def on_top(

@@ -22,8 +22,9 @@ the report then states: :mod:`fcplan.experiments.studies`) and writes, into ``ou
     two-sided Wilcoxon signed-rank p-value (:func:`~fcplan.experiments.stats.wilcoxon_p`) and its
     Holm adjustment over the pairs, and a verdict in words (``"unresolved at n=5 (...)"`` when
     the interval is too wide to tell: :mod:`fcplan.experiments.analysis`);
-  - *fraction of the oracle*, when a clairvoyant ``oracle`` was swept: each scheduler's
-    headline metric as a fraction of the oracle's on the same instance (the oracle is a
+  - *fraction of the oracle*, when a clairvoyant ``oracle`` was swept: each scheduler's share
+    of the reference's improvement over the ``idle`` team on the headline metric, as on the
+    leaderboard (:func:`~fcplan.experiments.analysis.oracle_fractions`; the oracle is a
     reference: it is left out of the paired tables and rankings);
   - *ranking per metric* (final score, NRR, time to containment, contained, burned area,
     facility damage): the order by mean, the pairs that differ, the median ``|d_z|``, Friedman's

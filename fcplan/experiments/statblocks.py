@@ -107,12 +107,17 @@ def paired_cells(comparisons: Sequence[PairedComparison]) -> Cells:
 
 def fraction_cells(fractions: Sequence[OracleFraction]) -> Cells:
     """Header and rows of the fraction-of-oracle table."""
-    head = ["scheduler", "n", "x / oracle [95% CI]", "mean x / mean oracle", "better than oracle"]
-    body = []
-    for f in fractions:
-        cell = f"{f.fraction.mean:.3f} [{f.fraction.low:.3f}, {f.fraction.high:.3f}]"
-        n = str(f.fraction.n) + (f" (+{f.excluded} oracle <= 0)" if f.excluded else "")
-        body.append([f.scheduler, n, cell, _num(f.ratio_of_means, 3), str(f.above)])
+    head = ["scheduler", "n", "fraction [95% CI]", "median pair", "better than reference"]
+    body = [
+        [
+            f.scheduler,
+            str(f.n),
+            f"{_num(f.fraction, 3)} [{_num(f.low, 3)}, {_num(f.high, 3)}]",
+            _num(f.median_pair, 3),
+            str(f.above),
+        ]
+        for f in fractions
+    ]
     return head, body
 
 
@@ -167,11 +172,19 @@ def blocks(study: StudyStats) -> list[Block]:
             note += f" The {study.oracle} reference is not among the compared pairs."
         out.append(Block(f"Paired differences: {metric_label(metric)}", note, paired_cells(pairs)))
     if study.fractions:
-        metric = study.fractions[0].metric
+        metric, base = study.fractions[0].metric, study.fractions[0].baseline
+        share = (
+            f"sum (x - {base}) / sum (reference - {base}): the share of the reference's "
+            f"improvement over the {base} team"
+            if base
+            else "sum x / sum reference (no idle team in the study: meaningful only for "
+            "positive scores; add idle for the leaderboard's fraction)"
+        )
         note = (
-            f"{metric_label(metric)} as a fraction of {study.oracle}'s on the same instance "
-            f"(mean of the per-instance ratios with its {pct} interval, and the ratio of the "
-            f"means); {study.oracle} sees the true fire: a reference, not a policy nor a bound."
+            f"{metric_label(metric)}: {share}, over the instances all completed, with a {pct} "
+            f"bootstrap interval (seeds resampled within each scenario) and the median of the "
+            f"per-instance ratios. The reference ({study.oracle}) sees the true fire: not a "
+            "policy, nor a bound."
         )
         out.append(Block(f"Fraction of {study.oracle}", note, fraction_cells(study.fractions)))
     if study.rankings and len(study.policies) > 1:

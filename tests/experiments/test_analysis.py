@@ -17,6 +17,7 @@ from fcplan.experiments.analysis import (
     separation,
     study_stats,
 )
+from fcplan.experiments.oracle_reference import fraction_of_oracle
 from fcplan.experiments.statblocks import blocks, fixed_width
 
 
@@ -45,14 +46,53 @@ def test_paired_table_uses_the_metric_direction():
     assert bc.verdict() == "b better"  # b is 1 cell smaller on every pair
 
 
-def test_oracle_fraction_per_instance_and_exclusions():
-    """The fraction is the mean of x_i / oracle_i over instances where the oracle's value is
-    positive; others are counted as excluded; 'above' counts instances beating the oracle."""
-    rows = _rows({"oracle": [200.0, 100.0, 0.0, 50.0], "g": [100.0, 100.0, -5.0, 60.0]})
-    (f,) = oracle_fractions(rows, ["oracle", "g"], "oracle", "manual.final_score", _seed)
-    assert f.fraction.n == 3 and f.excluded == 1 and f.above == 1
-    assert f.fraction.mean == pytest.approx((0.5 + 1.0 + 1.2) / 3)
-    assert f.ratio_of_means == pytest.approx(260 / 350)
+def test_oracle_fraction_is_normalised_by_idle_as_on_the_leaderboard():
+    """With the idle team in the study the fraction is sum(x - idle) / sum(oracle - idle), the
+    leaderboard's number (fraction_of_oracle), also where scores are negative; idle itself gets
+    no row; 'above' counts instances beating the reference."""
+    rows = _rows(
+        {
+            "oracle": [200.0, 100.0, -50.0, 50.0],
+            "g": [100.0, 120.0, -80.0, 40.0],
+            "idle": [-100.0, -100.0, -200.0, -100.0],
+        }
+    )
+    (f,) = oracle_fractions(rows, ["g", "idle"], "oracle", "manual.final_score", _seed)
+    assert f.baseline == "idle" and f.n == 4 and f.above == 1
+    assert f.fraction == pytest.approx((200 + 220 + 120 + 140) / (300 + 200 + 150 + 150))
+    assert f.fraction == pytest.approx(fraction_of_oracle([100, 120, -80, 40], [200, 100, -50, 50],
+                                                          [-100, -100, -200, -100])[0])  # fmt: skip
+    assert f.low <= f.fraction <= f.high
+
+
+def test_oracle_fraction_without_idle_is_the_ratio_of_sums_and_nan_when_lower_is_better():
+    """Without an idle team: sum x / sum oracle (baseline None); for a lower-is-better metric
+    that ratio has no meaning and is NaN rather than a misleading number."""
+    rows = _rows({"oracle": [200.0, 100.0], "g": [100.0, 110.0]})
+    (f,) = oracle_fractions(rows, ["g"], "oracle", "manual.final_score", _seed)
+    assert f.baseline is None and f.fraction == pytest.approx(210 / 300)
+    burned = _rows({"oracle": [200.0, 100.0], "g": [100.0, 110.0]}, "outcome.burned_area_cells")
+    (f,) = oracle_fractions(burned, ["g"], "oracle", "outcome.burned_area_cells", _seed)
+    assert math.isnan(f.fraction)
+
+
+def test_the_reference_is_the_best_oracle_variant_on_each_instance():
+    """With two oracle variants the reference on each instance is the better of the two (as on
+    the leaderboard), named 'best of ...'; a lower-is-better metric takes the smaller."""
+    rows = _rows(
+        {
+            "oracle": [10.0, 40.0],
+            "oracle[routing]": [30.0, 20.0],
+            "g": [20.0, 20.0],
+            "idle": [0.0, 0.0],
+        }
+    )
+    refs = ["oracle", "oracle[routing]"]
+    (f,) = oracle_fractions(rows, ["g", "idle"], refs, "manual.final_score", _seed)
+    assert f.oracle == "best of oracle, oracle[routing]"
+    assert f.fraction == pytest.approx(40 / 70)
+    st = study_stats(rows, [*refs, "g", "idle"], ["manual.final_score"], _seed, references=refs)
+    assert st.oracle == f.oracle and st.fractions == [f]
 
 
 def test_rankings_order_by_direction_and_name_the_separating_metric():
