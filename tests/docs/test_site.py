@@ -99,3 +99,21 @@ def test_scheduler_howto_runs(monkeypatch):
     for block in blocks:
         exec(compile(block, "docs/howto/scheduler.md", "exec"), namespace)  # noqa: S102
     assert namespace["report"].failures == []
+
+
+def test_benchmark_howto_runs(monkeypatch):
+    """The runnable block of docs/howto/benchmark.md (```python; the hours-long study is a ```py
+    block, shown and not run) plays its short comparison: the stand-in scheduler is compared in
+    deterministic mode and gets a fraction of the oracle normalised by the idle team."""
+    from fcplan import scheduling
+
+    monkeypatch.setattr(scheduling, "_RUNTIME", dict(scheduling._RUNTIME))  # registers "mine"
+    page = (DOCS / "howto" / "benchmark.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", page, flags=re.S)
+    assert len(blocks) == 1 and "```py\n" in page
+    namespace: dict = {"__name__": "docs_howto"}
+    exec(compile(blocks[0], "docs/howto/benchmark.md", "exec"), namespace)  # noqa: S102
+    result, stats = namespace["result"], namespace["stats"]
+    assert {e["deterministic"] for e in result.episodes if e["scheduler"] == "mine"} == {True}
+    (mine,) = [f for f in stats.fractions if f.scheduler == "mine"]
+    assert mine.baseline == "idle" and mine.n == 4 and 0.0 < mine.fraction < 1.5
