@@ -18,6 +18,12 @@ Resume and failures.
 * An episode whose worker process died (killed, out of memory) is *lost*: nothing is stored and
   a re-run plays it. :attr:`SweepSummary.lost` counts them.
 
+Order. The episodes play seed by seed: the first seed of every scenario, override, setting and
+scheduler, then the second, and so on (within a seed, in the grid's expansion order). A long
+study stopped half-way therefore holds whole (scenario, seed) instances, every scheduler played
+on them, spread over every scenario, rather than every seed of its first scenarios: its paired
+comparisons already cover the whole grid on fewer seeds.
+
 Processes and files.
 
 * One sweep at a time writes into a results folder (:func:`~fcplan.experiments.results.lock_results`);
@@ -255,6 +261,8 @@ def _run(
     specs = list({s.key: s for s in cfg.episodes()}.values())
     status = stored_status(out)
     todo = [s for s in specs if s.key not in status or (retry_failed and status[s.key] != "ok")]
+    rounds = {seed: k for k, seed in enumerate(cfg.seeds)}
+    todo.sort(key=lambda s: rounds.get(s.seed, len(rounds)))  # seed by seed (stable: grid order)
     h = cfg.config_hash
     doc = {"config_hash": h, "study_hash": cfg.study_hash, "source": cfg.source, **cfg.to_dict()}
     write_manifest(out, cfg.study_hash, doc)

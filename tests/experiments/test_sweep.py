@@ -160,6 +160,21 @@ def test_progress_callback_and_summary(tmp_path):
     assert "4 run now" in s.format() and s.backend == "serial"
 
 
+def test_episodes_play_seed_by_seed_so_a_stopped_study_holds_whole_instances(tmp_path):
+    """The first seed of every (scenario, scheduler) plays before any second seed, so a sweep
+    stopped after that round has every scheduler on every scenario at seed 0 (paired over the
+    whole grid), and a resumed sweep keeps the order for what is left."""
+    config = {**TINY, "seeds": [3, 0, 1], "overrides": {"duration_s": 5}}
+    order = []
+    sweep(config, tmp_path, jobs=1, progress=lambda d, t, r: order.append(r["seed"]))
+    assert order == [3] * 4 + [0] * 4 + [1] * 4  # the seeds' order in the file, 4 episodes each
+    for p in sorted(tmp_path.glob("*.parquet"))[:5]:  # lose five stored episodes
+        p.unlink()
+    again = []
+    sweep(config, tmp_path, jobs=1, progress=lambda d, t, r: again.append(r["seed"]))
+    assert again == sorted(again, key=[3, 0, 1].index) and len(again) == 5
+
+
 def test_sweeps_run_schedulers_in_their_deterministic_mode_by_default(tmp_path):
     """A sweep adds deterministic=true to schedulers that support it (recorded in the settings
     and deterministic columns); deterministic=False or a file's deterministic = false leaves it
