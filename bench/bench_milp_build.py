@@ -9,6 +9,8 @@ the routes and nonzeros, and a digest of every model built (objective, rows, rou
 trees that build the same models print the same digest, so an A/B run (``bench/ab.py``) checks
 that a speed-up left the models unchanged while it measures it.
 
+``--given-greedy`` builds each model from greedy's route of each agent (one column per agent)
+instead of enumerating routes: the per-agent cost that remains when nothing is enumerated.
 ``--set KEY=VALUE`` builds with other model settings (:class:`solvers.milp_model.MilpParams`
 fields, e.g. ``search_candidates=5``; ``max_scored_ends=N`` sets
 :data:`solvers.milp_model.build.MAX_SCORED_ENDS`), and ``--solve`` also times CP-SAT on each model
@@ -33,7 +35,7 @@ import time
 
 import numpy as np
 
-from fcplan import load_scenario
+from fcplan import load_scenario, make_scheduler
 from fcplan.testing import episode_graphs
 from solvers.milp import solve_cpsat
 from solvers.milp_model import MilpParams, build_milp_model
@@ -52,6 +54,17 @@ def digest(models: list) -> str:
     return h.hexdigest()[:12]
 
 
+def greedy_routes(graph) -> dict[int, list[list[int]]]:
+    """Greedy's plan of ``graph`` as one given route (task rows) per agent: the least a build
+    that keeps each agent's current route as a column must value."""
+    plan = make_scheduler("greedy").plan(graph, rng=np.random.default_rng(0))
+    row = {tid: k for k, tid in enumerate(graph.task_ids)}
+    return {
+        a: [[row[t] for t in plan.routes.get(agent, ()) if t in row]]
+        for a, agent in enumerate(graph.agent_ids)
+    }
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument(
@@ -62,12 +75,15 @@ def main() -> None:
     ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
                     help="model settings (MilpParams fields, or max_scored_ends)")  # fmt: skip
     ap.add_argument("--solve", action="store_true", help="also time CP-SAT on every model")
+    ap.add_argument("--given-greedy", action="store_true",
+                    help="build from greedy's route of each agent instead of enumerating")  # fmt: skip
     args = ap.parse_args()
     changes = {k: float(v) if "." in v else int(v) for k, v in (a.split("=", 1) for a in args.set)}
     milp_build.MAX_SCORED_ENDS = int(changes.pop("max_scored_ends", milp_build.MAX_SCORED_ENDS))
     params = MilpParams(**changes)  # type: ignore[arg-type]
     print(f"# load average at start: {os.getloadavg()[0]:.2f} ({os.cpu_count()} cores)")
-    print(f"# settings: {' '.join(args.set) or 'defaults'}")
+    given = " (greedy's routes given)" if args.given_greedy else ""
+    print(f"# settings: {' '.join(args.set) or 'defaults'}{given}")
     print(f"{'design':<10} {'graphs':>6} {'build p50 ms':>13} {'p95 ms':>8} {'ms/agent':>9} "
           f"{'routes':>7} {'nonzeros':>9}  digest"
           + (f"  {'solve p50 ms':>12} {'p95 ms':>8} {'optimal':>7}" if args.solve else ""))  # fmt: skip
@@ -87,8 +103,9 @@ def main() -> None:
         for r in range(args.repeat):
             models = []
             for i, g in enumerate(graphs):
+                given = greedy_routes(g) if args.given_greedy else None
                 t0 = time.perf_counter()
-                models.append(build_milp_model(g, params))
+                models.append(build_milp_model(g, params, routes=given))
                 times[r, i] = time.perf_counter() - t0
         per_graph = times.min(axis=0) * 1e3  # each graph's best round: the least disturbed
         agents = np.array([g.n_agents for g in graphs])
