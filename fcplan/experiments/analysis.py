@@ -49,7 +49,7 @@ from typing import Any
 
 import numpy as np
 
-from fcplan.experiments.oracle_reference import fraction_of_oracle, reference_scores
+from fcplan.experiments.oracle_reference import fraction_on_pairs, reference_scores
 from fcplan.experiments.stats import (
     Friedman,
     PairedComparison,
@@ -242,12 +242,10 @@ def oracle_fractions(
     for name in schedulers:
         if name in refs or name == baseline:
             continue
-        keys = [k for k in scores[name] if k in ref and (zero is None or k in zero)]
-        x = [sign * scores[name][k] for k in keys]
-        o = [sign * ref[k] for k in keys]
-        z = [sign * zero[k] for k in keys] if zero is not None else [0.0] * len(keys)
-        frac, (lo, hi), med = fraction_of_oracle(x, o, z, [scenario[k] for k in keys])
-        above = sum(a > b for a, b in zip(x, o, strict=True))
+        (frac, (lo, hi), med), keys = fraction_on_pairs(
+            scores[name], ref, zero, sign, scenario.__getitem__
+        )
+        above = sum(sign * (scores[name][k] - ref[k]) > 0 for k in keys)
         label = reference_label(refs)
         base = baseline if zero is not None else None
         out.append(OracleFraction(name, label, metric, base, frac, lo, hi, med, len(keys), above))

@@ -70,7 +70,12 @@ import numpy as np
 
 from fcplan.errors import FcplanError
 from fcplan.experiments.analysis import metric_label, paired_table
-from fcplan.experiments.oracle_reference import fraction_of_oracle, on_top, reference_scores
+from fcplan.experiments.oracle_reference import (
+    fraction_of_oracle,
+    fraction_on_pairs,
+    on_top,
+    reference_scores,
+)
 from fcplan.experiments.stats import MeanCI, PairedComparison, mean_ci
 from fcplan.experiments.tables import REPORT_COLUMNS, higher_is_better
 from fcplan.metrics import metric_spec
@@ -403,19 +408,8 @@ def _scheduler_stats(
     bounded, gap50, gap95 = _pooled_gaps(rows)
     frac: tuple[float, tuple[float, float], float] = (math.nan, (math.nan, math.nan), math.nan)
     if ORACLE in refs and IDLE in refs:
-        keys = [
-            (r["scenario"], int(r["seed"]))
-            for r in rows
-            if (r["scenario"], int(r["seed"])) in refs[ORACLE]
-            and (r["scenario"], int(r["seed"])) in refs[IDLE]
-        ]
         sign = 1.0 if metric_direction(metric)[2] else -1.0  # lower is better: negate
-        frac = fraction_of_oracle(
-            [sign * mine[k] for k in keys],
-            [sign * refs[ORACLE][k] for k in keys],
-            [sign * refs[IDLE][k] for k in keys],
-            strata=[k[0] for k in keys],
-        )
+        frac, _ = fraction_on_pairs(mine, refs[ORACLE], refs[IDLE], sign, lambda k: k[0])
     flags = {bool(r["deterministic"]) for r in rows if isinstance(r.get("deterministic"), bool)}
     return SchedulerStats(
         episodes=len(rows),

@@ -122,15 +122,13 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
     ]
     rank = 0
     for k in t.order:
-        whole = t.stats[k].instances >= t.instances
-        rank += is_policy(k) and whole
-        r = (
-            (str(rank) if whole else "-")
-            if is_policy(k)
-            else "ref"
-            if k.startswith(ORACLE)
-            else "base"
-        )
+        if not is_policy(k):
+            r = "ref" if k.startswith(ORACLE) else "base"
+        elif t.stats[k].instances < t.instances:
+            r = "-"  # partial: not ranked
+        else:
+            rank += 1
+            r = str(rank)
         out.append(_row(r, k, t.stats[k], t, digits))
     if t.settings:
         text = "; ".join(f"{k}: {v}" for k, v in t.settings.items())

@@ -24,12 +24,18 @@ Examples
 from __future__ import annotations
 
 import math
-from collections.abc import Hashable, Mapping, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from typing import Any, TypeVar
 
 import numpy as np
 
-__all__ = ["BOOTSTRAP_DRAWS", "fraction_of_oracle", "on_top", "reference_scores"]
+__all__ = [
+    "BOOTSTRAP_DRAWS",
+    "fraction_of_oracle",
+    "fraction_on_pairs",
+    "on_top",
+    "reference_scores",
+]
 
 BOOTSTRAP_DRAWS = 2000
 
@@ -81,6 +87,36 @@ def fraction_of_oracle(
         return frac, (math.nan, math.nan), median
     lo, hi = np.percentile(boot, [2.5, 97.5])
     return frac, (float(lo), float(hi)), median
+
+
+def fraction_on_pairs(
+    mine: Mapping[K, float],
+    reference: Mapping[K, float],
+    idle: Mapping[K, float] | None,
+    sign: float,
+    stratum: Callable[[K], Any],
+) -> tuple[tuple[float, tuple[float, float], float], list[K]]:
+    """:func:`fraction_of_oracle` of one scheduler's scores ``mine`` (pair key -> value) on the
+    pairs it shares with ``reference`` and ``idle`` (None: a zero baseline), in ``mine``'s order,
+    with ``sign`` -1 for a lower-is-better metric and ``stratum(key)`` the pair's scenario; also
+    returns those pairs.
+
+    Examples
+    --------
+    >>> (f, _, _), keys = fraction_on_pairs({("h", 0): 5.0, ("h", 1): 7.0}, {("h", 0): 10.0},
+    ...                                     {("h", 0): 0.0}, 1.0, lambda k: k[0])
+    >>> f, keys
+    (0.5, [('h', 0)])
+    """
+    keys = [k for k in mine if k in reference and (idle is None or k in idle)]
+    zero = [sign * idle[k] for k in keys] if idle is not None else [0.0] * len(keys)
+    frac = fraction_of_oracle(
+        [sign * mine[k] for k in keys],
+        [sign * reference[k] for k in keys],
+        zero,
+        strata=[stratum(k) for k in keys],
+    )
+    return frac, keys
 
 
 def reference_scores(variants: Sequence[Mapping[K, float]], sign: float = 1.0) -> dict[K, float]:
