@@ -9,11 +9,15 @@ the routes and nonzeros, and a digest of every model built (objective, rows, rou
 trees that build the same models print the same digest, so an A/B run (``bench/ab.py``) checks
 that a speed-up left the models unchanged while it measures it.
 
+``--per-agent`` also times the readable build, one agent at a time (``batched=False``), on
+the same graphs interleaved with the default build (across agents,
+:mod:`solvers.milp_model.batch`), and prints its figures, the ratio of the medians and whether
+the two builds' digests are equal.
+
 ``--given-greedy`` builds each model from greedy's route of each agent (one column per agent)
 instead of enumerating routes: the per-agent cost that remains when nothing is enumerated.
 ``--set KEY=VALUE`` builds with other model settings (:class:`solvers.milp_model.MilpParams`
-fields, e.g. ``search_candidates=5``; ``max_scored_ends=N`` sets
-:data:`solvers.milp_model.build.MAX_SCORED_ENDS`), and ``--solve`` also times CP-SAT on each model
+fields, e.g. ``search_candidates=5`` or ``max_scored_ends=64``), and ``--solve`` also times CP-SAT on each model
 in the scheduler's deterministic mode (5 deterministic seconds, one worker): what smaller
 candidate sets buy at the scale tier.
 
@@ -21,6 +25,7 @@ Usage::
 
     python bench/bench_milp_build.py
     python bench/bench_milp_build.py --designs scale-tier --solve --set search_candidates=5
+    python bench/bench_milp_build.py --designs scale-tier scale50 scale100 --per-agent
     git worktree add ../fcplan-old HEAD~1
     python bench/ab.py ../fcplan-old . bench/bench_milp_build.py --rounds 5
 """
@@ -39,7 +44,6 @@ from fcplan import load_scenario, make_scheduler
 from fcplan.testing import episode_graphs
 from solvers.milp import solve_cpsat
 from solvers.milp_model import MilpParams, build_milp_model
-from solvers.milp_model import build as milp_build
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_time_limits import scale_design  # noqa: E402
@@ -73,13 +77,14 @@ def main() -> None:
     ap.add_argument("--every", type=int, default=30, help="simulated seconds between graphs")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
-                    help="model settings (MilpParams fields, or max_scored_ends)")  # fmt: skip
+                    help="model settings (MilpParams fields)")  # fmt: skip
     ap.add_argument("--solve", action="store_true", help="also time CP-SAT on every model")
     ap.add_argument("--given-greedy", action="store_true",
                     help="build from greedy's route of each agent instead of enumerating")  # fmt: skip
+    ap.add_argument("--per-agent", action="store_true",
+                    help="also time the per-agent build, interleaved, and print the ratio")  # fmt: skip
     args = ap.parse_args()
     changes = {k: float(v) if "." in v else int(v) for k, v in (a.split("=", 1) for a in args.set)}
-    milp_build.MAX_SCORED_ENDS = int(changes.pop("max_scored_ends", milp_build.MAX_SCORED_ENDS))
     params = MilpParams(**changes)  # type: ignore[arg-type]
     print(f"# load average at start: {os.getloadavg()[0]:.2f} ({os.cpu_count()} cores)")
     given = " (greedy's routes given)" if args.given_greedy else ""
@@ -100,13 +105,18 @@ def main() -> None:
             for g in episode_graphs(sc, range(0, sc.n_ticks, args.every * sc.ticks_per_second))
         ]
         times = np.zeros((args.repeat, len(graphs)))
+        base = np.zeros((args.repeat, len(graphs)))
         for r in range(args.repeat):
-            models = []
+            models, base_models = [], []
             for i, g in enumerate(graphs):
                 given = greedy_routes(g) if args.given_greedy else None
                 t0 = time.perf_counter()
                 models.append(build_milp_model(g, params, routes=given))
                 times[r, i] = time.perf_counter() - t0
+                if args.per_agent:  # the readable build on the same graph, right after
+                    t0 = time.perf_counter()
+                    base_models.append(build_milp_model(g, params, routes=given, batched=False))
+                    base[r, i] = time.perf_counter() - t0
         per_graph = times.min(axis=0) * 1e3  # each graph's best round: the least disturbed
         agents = np.array([g.n_agents for g in graphs])
         routes = int(np.median([m.n_routes for m in models]))
@@ -127,6 +137,16 @@ def main() -> None:
             f"{np.percentile(per_graph, 95):>8.1f} {np.median(per_graph / agents):>9.2f} "
             f"{routes:>7} {nnz:>9}  {digest(models)}{solve}"
         )
+        if args.per_agent:
+            b = base.min(axis=0) * 1e3
+            same = "equal" if digest(base_models) == digest(models) else "DIFFERENT"
+            print(
+                f"{'  per-agent':<10} {len(graphs):>6} {np.median(b):>13.1f} "
+                f"{np.percentile(b, 95):>8.1f} {np.median(b / agents):>9.2f} "
+                f"{'':>7} {'':>9}  {digest(base_models)}  models {same}; per-agent / across "
+                f"agents: p50 {np.median(b) / np.median(per_graph):.2f}x, per graph median "
+                f"{np.median(b / per_graph):.2f}x"
+            )
     print(f"# load average at end: {os.getloadavg()[0]:.2f}")
 
 

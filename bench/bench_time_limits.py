@@ -20,6 +20,9 @@ Designs
 -------
 ``suite``
     The manual's scenarios 1-24, seed 0.
+``scale-tier``
+    The benchmark's ``scale`` tier, ``fcplan-bench-v1/scale-01`` .. ``scale-06`` (18-30 agents,
+    3,000-10,000 px maps), seed 0: what issue 13 measures.
 ``scale50``, ``scale100``
     Generated ``scale``-tier designs (:meth:`fcplan.scenario.GeneratorConfig.scale`) with 50 and
     100 agents (2 : 2 : 1 perception : action : hybrid) on a 4,000 px map, 240 s; scenario seeds
@@ -51,7 +54,7 @@ from fcplan.scheduling import available_schedulers, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph, synthetic_task_graph
 from fcplan.testing import episode_graphs
 
-DESIGNS = ("suite", "scale50", "scale100", "synthetic")
+DESIGNS = ("suite", "scale-tier", "scale50", "scale100", "synthetic")
 SYNTHETIC_SIZES = [(a, k) for a in (10, 50, 100) for k in (200, 2000)]
 
 
@@ -77,6 +80,9 @@ def sequences(design: str, every_s: int, synthetic_seeds: int) -> list[tuple[str
         ]
     if design == "suite":
         scenarios = [(str(i), load_scenario(i)) for i in range(1, 25)]
+    elif design == "scale-tier":
+        names = [f"fcplan-bench-v1/scale-{i:02d}" for i in range(1, 7)]
+        scenarios = [(n.split("/")[1], load_scenario(n)) for n in names]
     else:
         n = int(design.removeprefix("scale"))
         scenarios = [(f"{design}-{s}", scale_design(n, s)) for s in (0, 1)]

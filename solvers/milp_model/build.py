@@ -24,6 +24,7 @@ import scipy.sparse as sp
 
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.taskgraph.types import pairwise_distance
+from solvers.milp_model.batch import batched_route_set
 from solvers.milp_model.constraints import model_rows
 from solvers.milp_model.kernels import dominated
 from solvers.milp_model.objective import (
@@ -49,12 +50,7 @@ from solvers.milp_model.types import (
     MilpParams,
 )
 
-__all__ = ["MAX_SCORED_ENDS", "RouteSet", "build_milp_model"]
-
-#: Search blocks scored as the end of a searcher's straight flight (the candidates' ranking): all
-#: of them up to this many (every shipped scenario), else half of this the nearest and half the
-#: ones of most value per second of flight.
-MAX_SCORED_ENDS = 256
+__all__ = ["RouteSet", "build_milp_model"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -132,11 +128,12 @@ def _agent_routes(ctx: _Context, a: int) -> list[tuple[int, np.ndarray, np.ndarr
         _, z = ctx.altitudes(a)
         seen = ctx.near_blocks(a, z)  # every block with a positive score is among these
         ends = ctx.near_blocks(a, z, factor=2.0)  # heading for a farther block: as for these
-        if ends.size > MAX_SCORED_ENDS:  # the nearest ends and those of most value per second
+        n_ends = p.max_scored_ends
+        if ends.size > n_ends:  # the nearest ends and those of most value per second
             eta = t0 + g.start_task_distance[a, ctx.blocks[ends]] / speed
             proxy = ctx.block_value[ends] / (1.0 + eta)
-            pick = np.r_[np.argsort(eta, kind="stable")[: MAX_SCORED_ENDS // 2],
-                         np.argsort(-proxy, kind="stable")[: MAX_SCORED_ENDS // 2]]  # fmt: skip
+            pick = np.r_[np.argsort(eta, kind="stable")[: n_ends // 2],
+                         np.argsort(-proxy, kind="stable")[: n_ends // 2]]  # fmt: skip
             ends = ends[np.unique(pick)]
         score_b = straight_cover(g, a, ctx.block_pos[ends], ctx.blocks[seen], z, t0, p)
         score = np.zeros(g.n_tasks)
@@ -224,6 +221,8 @@ def _route_set(
     deadline: float | None,
     prune: bool,
 ) -> RouteSet:
+    """The routes of every agent, one agent and kind at a time: the readable build, which
+    :func:`solvers.milp_model.batch.batched_route_set` reproduces across agents bit for bit."""
     parts = []
     n = ctx.graph.n_agents
     start = time.perf_counter()
@@ -310,6 +309,7 @@ def build_milp_model(
     recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
     deadline: float | None = None,
     prune: bool = True,
+    batched: bool = True,
 ) -> MilpModel:
     """Build the route model of ``graph`` (see :mod:`solvers.milp_model`).
 
@@ -327,6 +327,9 @@ def build_milp_model(
         passed, or once the build, projected from the agents done so far, would end past it.
     prune : bool
         Leave out dominated routes (:mod:`solvers.milp_model.prune`; the optimum is the same).
+    batched : bool
+        Enumerate and value every agent's routes at once (:mod:`solvers.milp_model.batch`,
+        default), or one agent at a time (the readable build; the same model bit for bit).
 
     Raises
     ------
@@ -337,7 +340,10 @@ def build_milp_model(
     """
     p = params or MilpParams()
     ctx = _Context(graph, p, recent_fire)
-    rs = _route_set(ctx, routes, deadline, prune)
+    if batched and routes is None:
+        rs = batched_route_set(ctx, prune, deadline)
+    else:
+        rs = _route_set(ctx, routes, deadline, prune)
     if len(rs.agent) > p.max_routes:
         raise ValueError(f"{len(rs.agent)} routes exceed max_routes={p.max_routes}")
     swept = np.unique(rs.cover.indices)

@@ -17,7 +17,10 @@ move of the large-neighbourhood search (:mod:`solvers.milp_model.lns`).
 **Bound.** Covers are concave (``min(L, .)``) and each freeze needs a route in it, so
 ``c @ x <= sum_r y_r g_r + sum_z c_z`` with ``g_r`` the gain of route ``r`` alone; each agent
 flies one route, hence :func:`gain_bound` ``= sum_a max_r g_r + sum_z c_z`` bounds every solution.
-It is loose (overlapping sweeps counted twice) but needs no solver.
+It is loose (overlapping sweeps counted twice) but needs no solver. :func:`loose_bound` is
+coarser still and costs one pass over the objective: each agent's best route value of its own
+plus every auxiliary at its upper bound (``c @ x <= sum_a max_r c_r+ + sum_z c_z+ ub_z``); the
+search uses it for the parts a deadline left unsolved.
 
 Examples
 --------
@@ -46,7 +49,7 @@ from scipy.sparse.csgraph import connected_components
 from solvers.milp_model.start import Gains
 from solvers.milp_model.types import ROUTE, MilpModel
 
-__all__ = ["Restricted", "components", "gain_bound", "restrict"]
+__all__ = ["Restricted", "components", "gain_bound", "loose_bound", "restrict"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,3 +137,15 @@ def gain_bound(model: MilpModel) -> float:
         model.A_ub[:, model.var_kind != ROUTE].tocoo().col, minlength=freeze.size
     )
     return float(best.sum() + freeze[rows_per_aux == 2].sum())
+
+
+def loose_bound(model: MilpModel) -> float:
+    """An upper bound on every solution's objective without gains (module docstring)."""
+    route = model.var_kind == ROUTE
+    aux = ~route
+    total = float(np.sum(np.maximum(model.c[aux], 0.0) * model.ub[aux]))
+    if model.n_routes:
+        best = np.zeros(int(model.route_agent.max()) + 1)
+        np.maximum.at(best, model.route_agent, np.maximum(model.c[route], 0.0))
+        total += float(best.sum())
+    return total

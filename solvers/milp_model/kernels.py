@@ -11,6 +11,18 @@ bench/bench_milp_build.py``; figures in ``bench/README.md``):
   a block side: no block outside can overlap the swath, see below), then those whose block
   overlaps the swath in the segment's frame, and applies exactly the readable rule's arithmetic
   to those pairs only; every other entry is ``0.0``, which is what the rule gives there.
+* **Every agent's segments at once** (:func:`discounted_pairs`, used by the build across agents,
+  :mod:`solvers.milp_model.batch`): the same arithmetic with each segment's own altitude,
+  altitude bounds and speed, on the (segment, block) pairs found through a bucket grid of the
+  block centres (:func:`box_pairs`: the buckets a segment's box overlaps, one bucket of slack on
+  each side, then the exact box test) instead of a dense (segments x blocks) test, and restricted
+  to the blocks within each segment's own radius of a point (the agent's reach); it returns
+  the pairs, not a dense array.
+* **Known cells near each block** (:func:`near_cells`): the readable rule,
+  :func:`solvers.milp_model.objective.near_known_cells`, tests every (block, fire) pair of every
+  snapshot of recent fire; the kernel takes the pairs from :func:`box_pairs` (the squares around
+  each fire), applies the rule's test to them and sums the cells per block with ``bincount``
+  (sums of whole numbers, exact in any order).
 * **Dominated routes** (:func:`dominated`): the readable rule,
   :func:`solvers.milp_model.prune.dominated`, compares the routes of each group in a Python
   loop with a sparse row selection per group; the kernel compares every (earlier, later) pair of
@@ -22,6 +34,9 @@ corners lie within ``(a + s / 2) + (h + s / 2)`` of the segment's ends along eac
 
 Both kernels do per element the same IEEE operations in the same order as the readable rules,
 so their results are equal bit for bit (``tests/solvers/test_milp_kernels.py``, hypothesis).
+:func:`dominated_sparse` is :func:`dominated` with the covers compared through a sparse
+difference of each pair's rows, for route sets of many agents at once (no dense copy of every
+route's covers).
 
 Examples
 --------
@@ -36,13 +51,22 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import scipy.sparse as sp
 
 from solvers.milp_model.prune import group_order
-from solvers.milp_model.sensing import TAN_Y, detection_probability
+from solvers.milp_model.sensing import SENSE_TICKS_PER_S, TAN_Y, detection_probability
 
-__all__ = ["discounted_coverage", "dominated"]
+__all__ = [
+    "box_pairs",
+    "discounted_coverage",
+    "discounted_pairs",
+    "dominated",
+    "dominated_sparse",
+    "near_cells",
+]
 
 
 def discounted_coverage(
@@ -106,23 +130,31 @@ def discounted_coverage(
     return out
 
 
-def dominated(keys: np.ndarray, value: np.ndarray, cover: sp.csr_array) -> np.ndarray:
-    """(P,) bool: :func:`solvers.milp_model.prune.dominated` in one pass over every (earlier,
-    later) pair of routes with the same ``keys`` row."""
+def _ordered_pairs(
+    keys: np.ndarray, value: np.ndarray, cover: sp.csr_array
+) -> tuple[np.ndarray, np.ndarray]:
+    """Every (i, j) of routes with the same ``keys`` row, ``i`` before ``j`` in
+    :func:`~solvers.milp_model.prune.group_order`'s order: the candidate dominations."""
     n = len(value)
-    out = np.zeros(n, dtype=bool)
     if n < 2:
-        return out
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
     order, starts = group_order(keys, value, cover)
     sizes = np.diff(np.r_[starts, n])
-    # every (i, j) of one group with i before j in the order, as positions in ``order``
+    # as positions in ``order``
     pos_start = np.repeat(starts, sizes)  # (n,) start of each position's group
     rank = np.arange(n) - pos_start  # (n,) place within its group
     later = np.repeat(np.arange(n), rank)  # j, once per earlier member
     earlier = pos_start[later] + (np.arange(later.size) - np.repeat(np.cumsum(rank) - rank, rank))
-    if later.size == 0:
+    return order[earlier], order[later]
+
+
+def dominated(keys: np.ndarray, value: np.ndarray, cover: sp.csr_array) -> np.ndarray:
+    """(P,) bool: :func:`solvers.milp_model.prune.dominated` in one pass over every (earlier,
+    later) pair of routes with the same ``keys`` row."""
+    out = np.zeros(len(value), dtype=bool)
+    i, j = _ordered_pairs(keys, value, cover)
+    if j.size == 0:
         return out
-    i, j = order[earlier], order[later]
     ok = value[i] >= value[j]
     used = np.unique(cover.indices)
     if used.size:
@@ -130,4 +162,192 @@ def dominated(keys: np.ndarray, value: np.ndarray, cover: sp.csr_array) -> np.nd
         pair = np.flatnonzero(ok)
         ok[pair] = np.all(dense[i[pair]] >= dense[j[pair]], axis=1)
     out[j[ok]] = True
+    return out
+
+
+def box_pairs(
+    lo_xy: np.ndarray,
+    hi_xy: np.ndarray,
+    centres: np.ndarray,
+    cell: float,
+    band: tuple[np.ndarray, ...] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Candidate (box, centre) pairs: every centre inside the closed box ``lo_xy[s] ..
+    hi_xy[s]`` (S, 2 each) and some near it. The centres are sorted into a grid of buckets of
+    side ``cell`` (at least; wider when they are spread thin), numbered column by column, so the
+    buckets of one column of a box hold one contiguous run of centres. With ``band = (p, unit,
+    length, across, along)`` (each box's segment start, unit direction, length and the
+    rectangle's half extents across the track and beyond its ends) only the centres of each
+    column within a y-range that holds the rectangle over the column (+1 px) are taken: only
+    centres outside the rectangle are left out. Returns ``(si, bi)``, ordered by box, then
+    by column."""
+    n_s, n_b = len(lo_xy), len(centres)
+    if n_s == 0 or n_b == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    origin = centres.min(axis=0)
+    extent = centres.max(axis=0) - origin
+    cell = max(float(cell), float(np.sqrt(extent[0] * extent[1] / max(n_b, 1)) / 2.0), 1e-9)
+    nx, ny = (int(v) for v in (np.floor(extent / cell).astype(np.int64) + 1).tolist())
+    top = np.array([nx - 1, ny - 1])
+    ix = np.minimum(np.floor((centres - origin) / cell).astype(np.int64), top)
+    by_bucket = np.argsort(ix[:, 0] * ny + ix[:, 1], kind="stable")
+    run = np.r_[0, np.cumsum(np.bincount(ix[:, 0] * ny + ix[:, 1], minlength=nx * ny))]
+    # a millionth of a bucket of slack each side: a centre's bucket index is computed with the
+    # same rounding, so no centre inside a box falls in a bucket outside its range
+    b_lo = np.clip(np.floor((lo_xy - origin) / cell - 1e-6).astype(np.int64), 0, top)
+    b_hi = np.clip(np.floor((hi_xy - origin) / cell + 1e-6).astype(np.int64), 0, top)
+    cols = np.where((hi_xy < lo_xy).any(axis=1), 0, np.maximum(b_hi[:, 0] - b_lo[:, 0] + 1, 0))
+    s_col = np.repeat(np.arange(n_s), cols)
+    x = np.repeat(b_lo[:, 0] - (np.cumsum(cols) - cols), cols) + np.arange(s_col.size)
+    y_lo, y_hi = b_lo[s_col, 1], b_hi[s_col, 1]
+    if band is not None:
+        y_min, y_max = _band_rows(band, s_col, origin[0] + x * cell - 1.0,
+                                  origin[0] + (x + 1) * cell + 1.0)  # fmt: skip
+        # (a strip that misses the rectangle has y_min = inf > y_max = -inf: no rows)
+        row_lo = np.clip(np.floor((y_min - origin[1]) / cell - 1e-6), -1, ny)
+        row_hi = np.clip(np.floor((y_max - origin[1]) / cell + 1e-6), -1, ny)
+        y_lo = np.maximum(y_lo, row_lo.astype(np.int64))
+        y_hi = np.minimum(y_hi, row_hi.astype(np.int64))
+    start = run[x * ny + y_lo]
+    k = np.maximum(run[x * ny + np.maximum(y_hi, y_lo - 1) + 1] - start, 0)
+    si = np.repeat(s_col, k)
+    bi = by_bucket[np.repeat(start - (np.cumsum(k) - k), k) + np.arange(si.size)]
+    return si, bi
+
+
+def _band_rows(
+    band: tuple[np.ndarray, ...], seg: np.ndarray, x0: np.ndarray, x1: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """A y-range that holds each segment's rectangle ``|c| <= across``,
+    ``-along <= w <= length + along`` (its own frame) over the strip ``x0 <= x <= x1``: the
+    rectangle is the meet of the band across the track and the band along it, so the
+    intersection of the two bands' y-ranges over the strip holds it (an empty range,
+    ``lo > hi``, when the strip misses it)."""
+    p, unit, length, across, along = (a[seg] for a in band)
+    u0, u1 = unit[:, 0], unit[:, 1]
+    dx0, dx1 = x0 - p[:, 0], x1 - p[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # across: c = (y - py) u0 - (x - px) u1, |c| <= across
+        m = u1 / u0
+        mid_lo, mid_hi = np.minimum(dx0 * m, dx1 * m), np.maximum(dx0 * m, dx1 * m)
+        spread = across / np.abs(u0)
+        lo = np.where(u0 != 0, mid_lo - spread, -np.inf)
+        hi = np.where(u0 != 0, mid_hi + spread, np.inf)
+        # along: w = (x - px) u0 + (y - py) u1, -along <= w <= length + along
+        k = u0 / u1
+        w_lo, w_hi = -along / u1, (length + along) / u1
+        ends_lo, ends_hi = np.minimum(w_lo, w_hi), np.maximum(w_lo, w_hi)
+        lo2 = ends_lo - np.maximum(dx0 * k, dx1 * k)
+        hi2 = ends_hi - np.minimum(dx0 * k, dx1 * k)
+    lo = np.maximum(lo, np.where(u1 != 0, lo2, -np.inf)) + p[:, 1] - 1.0
+    hi = np.minimum(hi, np.where(u1 != 0, hi2, np.inf)) + p[:, 1] + 1.0
+    return lo, hi
+
+
+def discounted_pairs(
+    p: np.ndarray,
+    q: np.ndarray,
+    z: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    speed: np.ndarray,
+    t_start: np.ndarray,
+    centres: np.ndarray,
+    block: float,
+    horizon: float,
+    origin: np.ndarray,
+    radius: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`discounted_coverage` for segments with their own altitude ``z``, altitude bounds
+    ``lo`` / ``hi`` and ``speed`` (all (S,)), over the blocks within ``radius`` (S,) of
+    ``origin`` (S, 2) only (``hypot(centre - origin) <= radius``, as
+    :meth:`solvers.milp_model.build._Context.near_blocks` tests it).
+
+    Returns ``(si, bi, value)``: the pairs of a segment and a block that overlaps its swath, and
+    the value :func:`~solvers.milp_model.sensing.discounted_share` gives them, bit for bit
+    (every other pair's value is ``0.0``).
+    """
+    d = q - p
+    length = np.hypot(d[:, 0], d[:, 1])
+    unit = d / np.maximum(length, 1e-9)[:, None]
+    still = length <= 1e-9
+    unit[still] = (1.0, 0.0)
+    along_h = z * (np.abs(unit[:, 0]) + TAN_Y * np.abs(unit[:, 1]))
+    across_h = z * (np.abs(unit[:, 1]) + TAN_Y * np.abs(unit[:, 0]))
+    # detection_probability's arithmetic with each segment's own bounds and speed
+    draws = 2.0 * along_h * SENSE_TICKS_PER_S / np.maximum(speed, 1e-9)
+    flat = hi <= lo
+    with np.errstate(divide="ignore", invalid="ignore"):
+        conf = np.where(flat, 1.0, np.clip(1.0 - 0.6 * (z - lo) / (hi - lo), 0.4, 1.0))
+    prob = np.where(still, 0.0, 1.0 - (1.0 - conf) ** draws)
+    reach = along_h + across_h + block + 1.0
+    # the segment's box, cut to the square around ``origin`` that holds its radius (+1 px)
+    lo_xy = np.maximum(np.minimum(p, q) - reach[:, None], origin - (radius + 1.0)[:, None])
+    hi_xy = np.minimum(np.maximum(p, q) + reach[:, None], origin + (radius + 1.0)[:, None])
+    half = 0.5 * block
+    band = (p, unit, length, across_h + half + 1.0, along_h + half + 1.0)
+    si, bi = box_pairs(lo_xy, hi_xy, centres, block, band)
+    cx, cy = centres[bi, 0], centres[bi, 1]
+    rel0 = cx - p[si, 0]
+    rel1 = cy - p[si, 1]
+    u0, u1 = unit[si, 0], unit[si, 1]
+    w = rel0 * u0 + rel1 * u1
+    c = rel1 * u0 - rel0 * u1
+    hh, ah, ln = across_h[si], along_h[si], length[si]
+    hit = np.flatnonzero(
+        (c + half > -hh) & (c - half < hh) & (w + half > -ah) & (w - half < ln + ah)
+    )
+    si, bi, w, c, hh, ah, ln = si[hit], bi[hit], w[hit], c[hit], hh[hit], ah[hit], ln[hit]
+    cx, cy = cx[hit], cy[hit]
+    near = np.flatnonzero(np.hypot(cx - origin[si, 0], cy - origin[si, 1]) <= radius[si])
+    si, bi, w, c, hh, ah, ln = si[near], bi[near], w[near], c[near], hh[near], ah[near], ln[near]
+    cross = np.clip(np.minimum(c + half, hh) - np.maximum(c - half, -hh), 0.0, block)
+    along = np.clip(np.minimum(w + half, ln + ah) - np.maximum(w - half, -ah), 0.0, block)
+    share = (cross / block) * (along / block) * prob[si]
+    when = np.clip(w, 0.0, ln) / np.maximum(speed[si], 1e-9)
+    late = t_start[si] + when
+    return si, bi, share * np.maximum(horizon - late, 0.0) / horizon
+
+
+def dominated_sparse(keys: np.ndarray, value: np.ndarray, cover: sp.csr_array) -> np.ndarray:
+    """(P,) bool: :func:`dominated`, each candidate pair's covers compared through the sparse
+    difference of their rows (a later route is kept when it sees some block more)."""
+    out = np.zeros(len(value), dtype=bool)
+    i, j = _ordered_pairs(keys, value, cover)
+    if j.size == 0:
+        return out
+    ok = value[i] >= value[j]
+    pair = np.flatnonzero(ok)
+    if pair.size and cover.nnz:
+        diff = sp.csr_array(cover[j[pair]] - cover[i[pair]])
+        rows = np.repeat(np.arange(pair.size), np.diff(diff.indptr))
+        ok[pair[np.unique(rows[diff.data > 0])]] = False
+    out[j[ok]] = True
+    return out
+
+
+def near_cells(
+    centres: np.ndarray, snapshots: Sequence[tuple[np.ndarray, np.ndarray]], reach: float
+) -> np.ndarray:
+    """:func:`solvers.milp_model.objective.near_known_cells` through :func:`box_pairs` (the
+    rule itself when some cell count is not a whole number)."""
+    n_b = len(centres)
+    snaps = [(np.asarray(pos, np.float64).reshape(-1, 2), np.asarray(cells, np.float64))
+             for pos, cells in snapshots if len(cells)]  # fmt: skip
+    if not snaps or n_b == 0:
+        return np.zeros(n_b)
+    pos = np.concatenate([q[0] for q in snaps])
+    cells = np.concatenate([q[1] for q in snaps])
+    if not (np.all(cells == np.round(cells)) and np.abs(cells).sum() < 2.0**52):
+        from solvers.milp_model.objective import near_known_cells
+
+        return near_known_cells(centres, snapshots, reach)
+    snap = np.repeat(np.arange(len(snaps)), [len(q[1]) for q in snaps])
+    si, bi = box_pairs(pos - reach, pos + reach, centres, reach)
+    ok = (np.abs(centres[bi, 0] - pos[si, 0]) <= reach) & (
+        np.abs(centres[bi, 1] - pos[si, 1]) <= reach
+    )
+    si, bi = si[ok], bi[ok]
+    per = np.bincount(snap[si] * n_b + bi, weights=cells[si], minlength=len(snaps) * n_b)
+    out: np.ndarray = np.maximum(per.reshape(len(snaps), n_b).max(axis=0), 0.0)
     return out

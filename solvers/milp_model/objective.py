@@ -31,7 +31,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from fcplan.taskgraph import TaskGraph
-from solvers.milp_model.kernels import discounted_coverage
+from solvers.milp_model.kernels import discounted_coverage, near_cells
 from solvers.milp_model.types import MilpParams
 
 __all__ = [
@@ -39,6 +39,7 @@ __all__ = [
     "dump_value",
     "fire_weight",
     "hidden_cells",
+    "near_known_cells",
     "route_cover",
     "straight_cover",
 ]
@@ -90,17 +91,28 @@ def hidden_cells(
     fire they belong to is put out."""
     age = np.minimum(graph.task_staleness[blocks], p.search_age_cap_s)
     fires = graph.fire_tasks
-    near = np.zeros(blocks.size)
     snapshots = [(graph.task_pos[fires], graph.task_cells[fires]), *recent_fire]
-    centres = graph.task_pos[blocks]
-    for pos, cells in snapshots:
-        if len(cells) and blocks.size:
-            gap = np.abs(centres[:, None, :] - np.asarray(pos)[None, :, :])
-            close = np.all(gap <= 1.5 * p.search_block_px, axis=2)
-            np.maximum(near, close.astype(np.float64) @ np.asarray(cells, np.float64), out=near)
+    near = near_cells(graph.task_pos[blocks], snapshots, 1.5 * p.search_block_px)
     scale = AGE_UNIT_S * (np.maximum(age, 0.0) / AGE_UNIT_S) ** p.search_age_exponent
     out: np.ndarray = p.search_weight * scale * (1.0 + np.minimum(near, 50.0) / 10.0)
     return out
+
+
+def near_known_cells(
+    centres: np.ndarray, snapshots: Sequence[tuple[np.ndarray, np.ndarray]], reach: float
+) -> np.ndarray:
+    """(B,) the most known cells within ``reach`` (px, along each axis) of each of ``centres``
+    (B, 2) in any snapshot of fire tasks (positions (F, 2), cells (F,)): the readable rule, one
+    dense (blocks x fires) test per snapshot. :func:`hidden_cells` uses its fast twin,
+    :func:`solvers.milp_model.kernels.near_cells`, equal to it when the cells are whole
+    numbers (they count cells)."""
+    near = np.zeros(len(centres))
+    for pos, cells in snapshots:
+        if len(cells) and len(centres):
+            gap = np.abs(centres[:, None, :] - np.asarray(pos)[None, :, :])
+            close = np.all(gap <= reach, axis=2)
+            np.maximum(near, close.astype(np.float64) @ np.asarray(cells, np.float64), out=near)
+    return near
 
 
 def block_values(

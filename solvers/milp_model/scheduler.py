@@ -6,6 +6,20 @@ from an earlier time than the last one): its last plan, the warm start of the ne
 the fire tasks of the last ``recent_fire_s`` seconds, which value the search blocks near fire
 that has just been put out.
 
+Model size under a wall-clock limit
+-----------------------------------
+In the deterministic mode the model is always the configured one. Under a wall-clock limit the
+build may take at most ``build_share`` of the time left before the solve's deadline, so that the
+warm start and the solver keep the rest: the scheduler builds the first of
+:data:`MODEL_STEPS` (the configured model, then fewer candidates and scored ends, each step
+capping the configured settings) whose predicted build time fits. The prediction is the step's
+build time per agent measured on the ``scale`` tier (:data:`STEP_COST_S`) times the number of
+agents times a factor for this machine and load, which every build in wall-clock mode updates
+(a moving average of measured over predicted, in logs; a build stopped by the deadline counts
+as at least its time so far). The step a plan came from is in its stats
+(``size["model_step"]``, 0: the configured model). At the manual's team sizes the configured
+model fits 0.1 s; at the ``scale`` tier's 18-30 agents it does not (``bench/README.md``).
+
 Examples
 --------
 >>> import numpy as np
@@ -47,6 +61,18 @@ __all__ = ["MilpSchedulerBase"]
 
 _LNS = ("exact_routes", "lns_routes", "lns_rounds")
 
+#: The model sizes a wall-clock limit steps down through: each caps the configured settings.
+MODEL_STEPS: tuple[dict[str, int], ...] = (
+    {},
+    {"search_candidates": 6, "fire_candidates": 5, "max_scored_ends": 128},
+    {"search_candidates": 4, "fire_candidates": 4, "max_scored_ends": 64},
+    {"search_candidates": 3, "fire_candidates": 3, "watch_candidates": 2, "slots": 2,
+     "search_slots": 1, "max_scored_ends": 16},
+)  # fmt: skip
+#: Build seconds per agent of each step at the ``scale`` tier (``python bench/bench_milp_build.py
+#: --designs scale-tier --set ...``, 2026-11-29, bench/README.md): the prediction's priors.
+STEP_COST_S = (3.5e-3, 2.6e-3, 1.6e-3, 0.8e-3)
+
 
 class MilpSchedulerBase:
     """What both MILP schedulers share (see :mod:`solvers.milp` for the settings' meaning).
@@ -86,6 +112,8 @@ class MilpSchedulerBase:
     #: deadline (CP-SAT overshoots by up to 5 ms, then the completion) and 4-5 ms more follow;
     #: 5 % left p99 at 109-117 ms against the 115 ms bound.
     reserve_share = 0.15
+    #: share of the time before the solve's deadline that building the model may take
+    build_share = 0.35
 
     def __init__(
         self,
@@ -114,6 +142,11 @@ class MilpSchedulerBase:
                 takes = ", ".join([*own, *known])
                 raise SettingError(key, f"unknown setting; {self.name} takes: {takes}", value=value)
         self.params = MilpParams(**model_settings)
+        self._steps = [
+            self.params.replace(**{k: min(getattr(self.params, k), v) for k, v in caps.items()})
+            for caps in MODEL_STEPS
+        ]
+        self._log_factor = 0.0  # log of measured over predicted build time, averaged
         self._previous: dict[str, tuple[str, ...]] = {}
         self._previous_time = -math.inf
         self._recent: list[tuple[float, np.ndarray, np.ndarray]] = []
@@ -148,7 +181,8 @@ class MilpSchedulerBase:
             self._previous, self._recent = {}, []
         keep = graph.time_s - self.params.recent_fire_s
         recent = [(pos, cells) for t, pos, cells in self._recent if t >= keep]
-        model = build_milp_model(graph, self.params, recent_fire=recent, deadline=deadline)
+        step = 0 if deadline is None else self._step(graph.n_agents, deadline - t0)
+        model = self._build(graph, step, recent, deadline)
         limits = SolverLimits(deadline, self.work_limit)
         left = limits.seconds_left()
         if left is not None and left <= 0:
@@ -171,7 +205,7 @@ class MilpSchedulerBase:
             raise IncompletePlanError(
                 f"the wall-clock limit left agents {names} idle with routes to fly"
             )
-        stats = replace(stats, size=dict(stats.size, solver=self.solver_name))
+        stats = replace(stats, size=dict(stats.size, solver=self.solver_name, model_step=step))
         plan = decode_plan(model, x, graph, stats)
         self._previous = dict(plan.routes)
         self._previous_time = graph.time_s
@@ -180,6 +214,37 @@ class MilpSchedulerBase:
         if fires.size:
             self._recent.append((graph.time_s, graph.task_pos[fires], graph.task_cells[fires]))
         return plan
+
+    def _predicted(self, n_agents: int, step: int) -> float:
+        """Predicted build seconds of ``step`` for ``n_agents`` on this machine."""
+        return STEP_COST_S[step] * max(n_agents, 1) * math.exp(self._log_factor)
+
+    def _step(self, n_agents: int, before_deadline: float) -> int:
+        """The first model step whose predicted build fits ``build_share`` of the time."""
+        budget = self.build_share * before_deadline
+        for step in range(len(MODEL_STEPS)):
+            if self._predicted(n_agents, step) <= budget:
+                return step
+        return len(MODEL_STEPS) - 1
+
+    def _build(
+        self,
+        graph: TaskGraph,
+        step: int,
+        recent: list[tuple[np.ndarray, np.ndarray]],
+        deadline: float | None,
+    ) -> MilpModel:
+        """Build the model of ``step``; under a deadline, learn from the time it took."""
+        start = time.perf_counter()
+        try:
+            return build_milp_model(graph, self._steps[step], recent_fire=recent, deadline=deadline)
+        finally:
+            if deadline is not None:
+                prior = STEP_COST_S[step] * max(graph.n_agents, 1)
+                ratio = (time.perf_counter() - start) / prior
+                self._log_factor = float(
+                    np.clip(0.6 * self._log_factor + 0.4 * math.log(max(ratio, 1e-6)), -3, 3)
+                )
 
     def _solve(
         self, model: MilpModel, *, limits: SolverLimits, seed: int, hint: np.ndarray

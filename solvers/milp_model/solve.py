@@ -11,7 +11,9 @@ the small ones, large-neighbourhood search on the large ones, and an honest repo
   bound is :func:`~solvers.milp_model.decompose.gain_bound` (no solver proves more).
 
 Under a wall-clock deadline each part gets a share of the time left in proportion to its routes.
-A part whose solve finds nothing within its limit keeps the warm start. The solution is then
+A part whose solve finds nothing within its limit keeps the warm start, and so does every part
+left when the deadline has passed (counted in ``size["parts_skipped"]``; the bound then adds
+:func:`~solvers.milp_model.decompose.loose_bound`, which costs one pass, for them). The solution is then
 completed (:func:`~solvers.milp_model.start.complete`): routes of positive gain are added to
 agents left without one, so a limit never leaves an agent idle that has work (unless the
 deadline passed before the warm start itself was complete; the scheduler then raises).
@@ -49,7 +51,7 @@ from typing import Any
 import numpy as np
 
 from fcplan.scheduling import SolveStats, int_setting
-from solvers.milp_model.decompose import components, gain_bound, restrict
+from solvers.milp_model.decompose import components, gain_bound, loose_bound, restrict
 from solvers.milp_model.lns import large_neighbourhood_search
 from solvers.milp_model.start import complete
 from solvers.milp_model.types import IncompletePlanError, MilpModel
@@ -118,8 +120,8 @@ def _solve_part(
     if sub.n_routes <= settings.exact_routes:
         try:
             x, st = backend(sub, limits=limits, seed=seed, hint=hint)
-        except IncompletePlanError as exc:
-            return hint, "time_limit", gain_bound(sub), {"message": str(exc)}
+        except IncompletePlanError as exc:  # out of time: the cheap bound
+            return hint, "time_limit", loose_bound(sub), {"message": str(exc)}
         if st.status != "optimal" and sub.objective(x) < sub.objective(hint):
             # a limit stopped a backend that takes no hint (HiGHS through cvxpy) at a worse
             # point than the warm start: keep the better of the two (an anytime incumbent)
@@ -169,7 +171,11 @@ def solve_model(
                                 "lns_improved": 0}  # fmt: skip
     messages = []
     left_routes = float(model.n_routes)
+    skipped = 0
     for part in parts:
+        if limits.deadline is not None and time.perf_counter() >= limits.deadline:
+            skipped += 1  # out of time: the part keeps the warm start
+            continue
         sub = restrict(model, part, x) if len(parts) > 1 else None
         sub_model = sub.model if sub is not None else model
         cols = sub.cols if sub is not None else np.arange(model.n_vars)
@@ -185,6 +191,11 @@ def solve_model(
             messages.append(extra.pop("message"))
         for key, v in extra.items():
             counters[key] += v
+    if skipped:
+        statuses.append("time_limit")
+        bound += loose_bound(model)  # covers the skipped parts (and more)
+        messages.append(f"the deadline passed before {skipped} of {len(parts)} parts")
+    counters["parts_skipped"] = skipped
     x = complete(model, x, limits.deadline)
     obj = model.objective(x)
     if all(s == "optimal" for s in statuses):

@@ -92,6 +92,10 @@ class MilpParams:
         (:func:`solvers.milp_model.sensing.best_search_altitude`).
     max_routes : int
         Most routes in one model (>= 1): a graph that would need more raises ``ValueError``.
+    max_scored_ends : int
+        Search blocks scored per searcher as the end of a straight flight, to rank its search
+        candidates (2..4096): every block in twice its reach up to this many, else half of this
+        the nearest and half those of most value per second of flight.
     """
 
     slots: int = 3
@@ -114,6 +118,7 @@ class MilpParams:
     watch_altitude: float = 35.0
     search_altitude: float | None = None
     max_routes: int = 20_000
+    max_scored_ends: int = 256
 
     def __post_init__(self) -> None:
         int_setting("slots", self.slots, 1, 4)
@@ -136,6 +141,7 @@ class MilpParams:
         if self.search_altitude is not None:
             float_setting("search_altitude", self.search_altitude, 0.0, unit=" m")
         int_setting("max_routes", self.max_routes, 1)
+        int_setting("max_scored_ends", self.max_scored_ends, 2, 4096)
 
     def replace(self, **changes: Any) -> MilpParams:
         """A copy with ``changes`` (validated)."""

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import scipy.sparse as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from solvers.milp_model import build, build_milp_model, objective
-from solvers.milp_model.kernels import discounted_coverage, dominated
+from solvers.milp_model.kernels import discounted_coverage, dominated, dominated_sparse, near_cells
 from solvers.milp_model.prune import dominated as dominated_rule
 from solvers.milp_model.sensing import discounted_share
 from tests.solvers.graphs import episode_graphs
@@ -49,26 +50,60 @@ def test_discounted_coverage_equals_the_rule(seed, n_seg, n_blocks, block, z, sp
     density=st.floats(0.0, 1.0),
     levels=st.integers(1, 4),
 )
-def test_dominated_equals_the_rule(seed, n, groups, n_blocks, density, levels):
-    """The one-pass kernel drops exactly the routes the per-group rule drops, with ties in
-    value and cover (coarse levels make them common) and groups without any cover."""
+@pytest.mark.parametrize("kernel", [dominated, dominated_sparse])
+def test_dominated_equals_the_rule(kernel, seed, n, groups, n_blocks, density, levels):
+    """Both one-pass kernels (dense covers per pair, and the sparse difference of each pair's
+    rows) drop exactly the routes the per-group rule drops, with ties in value and cover
+    (coarse levels make them common) and groups without any cover."""
     rng = np.random.default_rng(seed)
     keys = rng.integers(0, groups, (n, 2))
     value = rng.integers(0, 4, n).astype(np.float64)
     dense = rng.integers(0, levels + 1, (n, n_blocks)) * (rng.random((n, n_blocks)) < density)
     cover = sp.csr_array(dense.astype(np.int64))
-    assert dominated(keys, value, cover).tolist() == dominated_rule(keys, value, cover).tolist()
+    assert kernel(keys, value, cover).tolist() == dominated_rule(keys, value, cover).tolist()
 
 
 def test_models_built_with_the_rules_are_equal(monkeypatch):
-    """A model built with the readable rules in place of both kernels is the same model (rows,
-    objective, routes) on real episodes' graphs: scenario #1 and #24 over their first minute."""
+    """A model built agent by agent with the readable rules in place of the kernels is the
+    same model (rows, objective, routes) as the default build, on real episodes' graphs:
+    scenario #1 and #24 over their first minute."""
     fast = [build_milp_model(g) for n in (1, 24) for g in episode_graphs(n, (0, 200, 600))]
     monkeypatch.setattr(build, "dominated", dominated_rule)
     monkeypatch.setattr(objective, "discounted_coverage", discounted_share)
-    slow = [build_milp_model(g) for n in (1, 24) for g in episode_graphs(n, (0, 200, 600))]
+    monkeypatch.setattr(objective, "near_cells", objective.near_known_cells)
+    slow = [
+        build_milp_model(g, batched=False)
+        for n in (1, 24)
+        for g in episode_graphs(n, (0, 200, 600))
+    ]
     for a, b in zip(fast, slow, strict=True):
         assert a.n_routes == b.n_routes
         for x, y in ((a.c, b.c), (a.b_ub, b.b_ub), (a.route_tasks, b.route_tasks)):
             assert np.array_equal(x, y)
         assert (a.A_ub != b.A_ub).nnz == 0
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n_blocks=st.integers(0, 50),
+    n_snap=st.integers(0, 4),
+    n_fire=st.integers(0, 30),
+    reach=st.floats(10.0, 400.0),
+    whole=st.booleans(),
+)
+def test_near_cells_equals_the_rule(seed, n_blocks, n_snap, n_fire, reach, whole):
+    """The bucketed kernel gives exactly (bit for bit) the readable rule's most known cells near
+    each block over the snapshots, fires on a block's edge included, with whole cell counts
+    and (through the rule itself) with fractional ones."""
+    rng = np.random.default_rng(seed)
+    centres = (rng.integers(0, 30, (n_blocks, 2)) + 0.5) * 100.0
+    snaps = []
+    for _ in range(n_snap):
+        pos = rng.uniform(-100.0, 3100.0, (n_fire, 2))
+        if n_blocks and n_fire:
+            pos[0] = centres[0] + reach  # exactly at the reach
+        cells = rng.integers(0, 40, n_fire).astype(np.float64)
+        snaps.append((pos, cells if whole else cells + 0.25))
+    fast = near_cells(centres, snaps, reach)
+    assert fast.tobytes() == objective.near_known_cells(centres, snaps, reach).tobytes()

@@ -201,3 +201,38 @@ def test_episode_completes_and_prunes_fire(name):
     assert result.trace.pruned[-1] > 0
     assert result.metrics["manual"].overall_firefighting > 0
     assert any(s.status == "optimal" for s in result.solves)
+
+
+def test_wall_clock_limit_sizes_the_model():
+    """Under a wall-clock limit the scheduler picks the largest model size predicted to fit
+    its share of the time (on a fresh scheduler the prediction is the measured priors: the
+    configured model for 4 agents at 0.1 s, the smallest for 24), the configured model under a
+    generous limit and always in the deterministic mode; each size caps the settings, never
+    raises them; the plan's stats name the size."""
+    from fcplan.taskgraph import synthetic_task_graph
+
+    s = MilpScheduler()
+    before = 0.1 * (1.0 - s.reserve_share)
+    assert s._step(4, before) == 0 and s._step(24, before) == 3 and s._step(24, 30.0) == 0
+    g = synthetic_task_graph(8, 60, np.random.default_rng(0))
+    assert MilpScheduler().plan(g, time_limit=30.0).stats.size["model_step"] == 0
+    assert MilpScheduler().plan(g).stats.size["model_step"] == 0
+    small = MilpScheduler(search_candidates=2, slots=1)
+    assert all(p.search_candidates == 2 and p.slots == 1 for p in small._steps)
+    assert MilpScheduler()._steps[3].max_scored_ends == 16
+
+
+def test_a_slow_build_teaches_the_prediction():
+    """A build slower than predicted raises the scheduler's factor (so a later replan of the
+    same size under the same limit gets a smaller model); a faster one lowers it."""
+    from fcplan.taskgraph import synthetic_task_graph
+
+    g = synthetic_task_graph(4, 40, np.random.default_rng(0))
+    s = MilpScheduler()
+    s._log_factor = -3.0  # as after builds far faster than their priors
+    s._build(g, 0, [], deadline=time.perf_counter() + 30.0)
+    assert s._log_factor > -3.0
+    s._log_factor = 3.0
+    s._build(g, 0, [], deadline=time.perf_counter() + 30.0)
+    assert s._log_factor < 3.0
+    assert s._step(4, 0.085) == 3  # e^3 times the priors: only the smallest size is left
