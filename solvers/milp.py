@@ -17,10 +17,12 @@ Limits and determinism
   same previous plan, the warm start) gives the same plan in any process and under any load.
 * **Wall-clock mode** (a ``time_limit`` given to :meth:`plan`, or ``deterministic=False`` with
   the ``time_limit`` setting): the limit covers the whole call. About 15 % of it is kept back
-  for what follows the solve (completing, checking and decoding the plan); CP-SAT gets what is
-  left after building the model and its own arrays (``max_time_in_seconds``). If building used
-  it all, or is projected to (from the agents built so far), :meth:`plan` raises
-  ``TimeoutError`` at once, leaving the fallback its time.
+  for what follows the solve (completing, checking and decoding the plan). The model is the
+  largest of :data:`solvers.milp_model.scheduler.MODEL_STEPS` whose build is predicted to fit
+  35 % of the time (the configured model at the manual's team sizes; fewer candidates at the
+  ``scale`` tier's); CP-SAT gets what is left after building it and its own arrays
+  (``max_time_in_seconds``). If building used it all, or is projected to (from the segments
+  valued so far), :meth:`plan` raises ``TimeoutError`` at once, leaving the fallback its time.
 * **No idle team**: the search starts from a complete first solution (the previous plan's
   routes still in the model, then routes of largest gain, :mod:`solvers.milp_model.start`) given
   as a hint. If a limit stops CP-SAT with no solution, or with agents idle that a route would

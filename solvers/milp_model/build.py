@@ -324,7 +324,8 @@ def build_milp_model(
         the schedulers pass those of the last ``recent_fire_s`` seconds.
     deadline : float, optional
         A :func:`time.perf_counter` time: building stops with ``TimeoutError`` once it has
-        passed, or once the build, projected from the agents done so far, would end past it.
+        passed, or once the build, projected from the agents done so far (``batched=False``) or
+        from the chunks of segments valued so far (the default), would end past it.
     prune : bool
         Leave out dominated routes (:mod:`solvers.milp_model.prune`; the optimum is the same).
     batched : bool

@@ -161,7 +161,8 @@ class MilpSchedulerBase:
         Raises
         ------
         TimeoutError
-            If building the model used up the wall-clock limit (checked between agents).
+            If building the model used up the wall-clock limit (checked between the build's
+            steps and its chunks of segments).
         IncompletePlanError
             If a limit stopped the solver with no plan, or with agents left idle that a route
             would have improved (the plan came from the limit, not from a decision).
