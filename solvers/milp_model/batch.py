@@ -13,7 +13,7 @@ runs once for all agents:
   the lower row, as :func:`~solvers.milp_model.routes.top_candidates`); the searchers' straight
   flights to their scored ends are valued by one :func:`~solvers.milp_model.kernels.discounted_pairs`
   call over every searcher's segments (each searcher's blocks in reach, as
-  ``_Context.near_blocks``), then one dense product per searcher, as the readable build does;
+  ``BuildContext.near_blocks``), then one dense product per searcher, as the readable build does;
 * **enumeration**: agents with the same number of candidates and route length share one
   table of orders (:func:`~solvers.milp_model.routes.enumerate_routes`'s arithmetic on an
   (agents, orders, slots) array);
@@ -44,20 +44,17 @@ Examples
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 
+from solvers.milp_model.context import BuildContext, RouteSet
 from solvers.milp_model.kernels import discounted_pairs, dominated_sparse
 from solvers.milp_model.objective import dump_value
 from solvers.milp_model.prune import route_keys
 from solvers.milp_model.routes import _orders
 from solvers.milp_model.sensing import TAN_Y
 from solvers.milp_model.types import DUMP, SEARCH, WATCH
-
-if TYPE_CHECKING:
-    from solvers.milp_model.build import RouteSet, _Context
 
 __all__ = ["batched_route_set"]
 
@@ -124,7 +121,7 @@ def _top(score: np.ndarray, allowed: np.ndarray, n: int) -> list[np.ndarray]:
 
 
 def _enumerate(
-    ctx: _Context,
+    ctx: BuildContext,
     agents: np.ndarray,
     cands: list[np.ndarray],
     lengths: np.ndarray,
@@ -194,7 +191,7 @@ def _enumerate(
 class _Agents:
     """Per-agent constants of the build: speeds, one-task arrivals, altitudes, reach."""
 
-    def __init__(self, ctx: _Context) -> None:
+    def __init__(self, ctx: BuildContext) -> None:
         g, p, roles = ctx.graph, ctx.p, ctx.roles
         n = g.n_agents
         self.t0 = roles.t0
@@ -209,13 +206,13 @@ class _Agents:
         self.half_diag = p.search_block_px / np.sqrt(2.0)
 
     def reach(self, agents: np.ndarray, z: np.ndarray, factor: float = 1.0) -> np.ndarray:
-        """``_Context.near_blocks``'s radius for ``agents`` at altitudes ``z``."""
+        """``BuildContext.near_blocks``'s radius for ``agents`` at altitudes ``z``."""
         out: np.ndarray = factor * self.fly[agents] + z * (1.0 + TAN_Y) + self.half_diag
         return out
 
 
 def _scored_ends(
-    ctx: _Context, ag: _Agents, searchers: np.ndarray, max_ends: int
+    ctx: BuildContext, ag: _Agents, searchers: np.ndarray, max_ends: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """(S, B) blocks in each searcher's sight and the blocks scored as ends of its flights."""
     g = ctx.graph
@@ -241,7 +238,7 @@ def _scored_ends(
 
 
 def _search_candidates(
-    ctx: _Context, ag: _Agents, searchers: np.ndarray, max_ends: int, deadline: float | None
+    ctx: BuildContext, ag: _Agents, searchers: np.ndarray, max_ends: int, deadline: float | None
 ) -> tuple[list[np.ndarray], np.ndarray]:
     """Each searcher's candidate blocks (task rows, near ones first) and how many are near."""
     g, p = ctx.graph, ctx.p
@@ -273,7 +270,7 @@ def _search_candidates(
 
 
 def _covers(
-    ctx: _Context, ag: _Agents, agent: np.ndarray, tasks: np.ndarray, arrival: np.ndarray,
+    ctx: BuildContext, ag: _Agents, agent: np.ndarray, tasks: np.ndarray, arrival: np.ndarray,
     alt: np.ndarray, deadline: float | None,
 ) -> sp.csr_array:  # fmt: skip
     """(R, B) cover levels of every route (``route_cover`` of each agent and kind, rounded)."""
@@ -326,11 +323,9 @@ def _covers(
     return sp.csr_array((level[on], (cell // n_b, cell % n_b)), shape=(n_r, n_b))
 
 
-def batched_route_set(ctx: _Context, prune: bool, deadline: float | None) -> RouteSet:
+def batched_route_set(ctx: BuildContext, prune: bool, deadline: float | None) -> RouteSet:
     """The routes of every agent (see the module docstring): the readable build's
     ``RouteSet``, bit for bit."""
-    from solvers.milp_model.build import RouteSet
-
     g, p, roles = ctx.graph, ctx.p, ctx.roles
     ag = _Agents(ctx)
     all_tasks = np.arange(g.n_tasks)

@@ -17,27 +17,24 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
-from fcplan.taskgraph import TaskGraph, TaskKind
+from fcplan.taskgraph import TaskGraph
 from fcplan.taskgraph.types import pairwise_distance
 from solvers.milp_model.batch import batched_route_set
 from solvers.milp_model.constraints import model_rows
+from solvers.milp_model.context import BuildContext, RouteSet
 from solvers.milp_model.kernels import dominated
 from solvers.milp_model.objective import (
     CELL_RATE,
-    block_values,
     dump_value,
-    fire_weight,
     route_cover,
     straight_cover,
 )
 from solvers.milp_model.prune import route_keys
-from solvers.milp_model.routes import AgentRoles, agent_roles, enumerate_routes, top_candidates
-from solvers.milp_model.sensing import TAN_Y, best_search_altitude
+from solvers.milp_model.routes import enumerate_routes, top_candidates
 from solvers.milp_model.types import (
     COVER,
     DUMP,
@@ -50,65 +47,16 @@ from solvers.milp_model.types import (
     MilpParams,
 )
 
-__all__ = ["RouteSet", "build_milp_model"]
-
-
-@dataclass(frozen=True, eq=False)
-class RouteSet:
-    """The routes of a model (``R`` rows), before the variables are laid out."""
-
-    agent: np.ndarray  # (R,) int64
-    kind: np.ndarray  # (R,) int8 DUMP / WATCH / SEARCH
-    tasks: np.ndarray  # (R, L) int64, -1 padded
-    arrival: np.ndarray  # (R, L) float64, NaN padded
-    length: np.ndarray  # (R,) float64 px
-    value: np.ndarray  # (R,) float64 own objective coefficient
-    altitude: np.ndarray  # (R,) float64 (NaN: no camera)
-    cover: sp.csr_array  # (R, B) int64 detected share of each block, in 1 / cover_levels
-
-
-class _Context:
-    """What every agent's routes need from the graph (computed once per model)."""
-
-    def __init__(
-        self, graph: TaskGraph, p: MilpParams, recent_fire: Sequence[tuple[np.ndarray, np.ndarray]]
-    ) -> None:
-        self.graph, self.p = graph, p
-        self.roles: AgentRoles = agent_roles(graph)
-        self.weight = fire_weight(graph, p)
-        self.fire = graph.task_kind == TaskKind.FIRE
-        self.blocks = np.flatnonzero(~self.fire)
-        self.block_value = block_values(graph, p, self.blocks, recent_fire)
-        self.block_pos = graph.task_pos[self.blocks]
-        self.width = max(p.slots, p.search_slots)
-
-    def near_blocks(self, agent: int, z: float, factor: float = 1.0) -> np.ndarray:
-        """Positions (in ``blocks``) of the search blocks a flight of ``agent`` at altitude ``z``
-        can cover before the look-ahead ends (``factor`` times that radius): nothing farther
-        from its start than ``v (H_s - t0)+`` plus the field of view and half a block diagonal
-        is ever in view in time, so its cover is provably 0."""
-        g, p = self.graph, self.p
-        fly = float(g.agent_speed[agent]) * max(p.search_horizon_s - float(self.roles.t0[agent]), 0)
-        reach = factor * fly + z * (1.0 + TAN_Y) + p.search_block_px / np.sqrt(2.0)
-        d = np.hypot(*(self.block_pos - g.agent_start_pos[agent]).T)
-        return np.flatnonzero(d <= reach)
-
-    def altitudes(self, agent: int) -> tuple[float, float]:
-        """(watch, search) altitudes of a camera agent, clipped to its bounds."""
-        g, p = self.graph, self.p
-        lo, hi = (float(v) for v in g.agent_alt_range[agent])
-        speed = float(g.agent_speed[agent])
-        z_search = (
-            best_search_altitude(lo, hi, speed) if p.search_altitude is None else p.search_altitude
-        )
-        return g.clip_altitude(agent, p.watch_altitude), g.clip_altitude(agent, z_search)
+__all__ = ["build_milp_model"]
 
 
 def _pad(a: np.ndarray, width: int, fill: float) -> np.ndarray:
     return np.pad(a, ((0, 0), (0, width - a.shape[1])), constant_values=fill)
 
 
-def _agent_routes(ctx: _Context, a: int) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+def _agent_routes(
+    ctx: BuildContext, a: int
+) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
     """The enumerated routes of agent ``a``: (kind, tasks, arrival, length) per kind."""
     g, p, roles = ctx.graph, ctx.p, ctx.roles
     t0 = float(roles.t0[a])
@@ -148,7 +96,7 @@ def _agent_routes(ctx: _Context, a: int) -> list[tuple[int, np.ndarray, np.ndarr
 
 
 def _given_routes(
-    ctx: _Context, a: int, routes: Sequence[Sequence[int]]
+    ctx: BuildContext, a: int, routes: Sequence[Sequence[int]]
 ) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
     """Agent ``a``'s ``routes`` (task rows) as (kind, tasks, arrival, length) rows: dumps when the
     agent has water and the route starts at a fire, a watch for a camera agent's fire, else a
@@ -172,7 +120,7 @@ def _given_routes(
 
 
 def _valued(
-    ctx: _Context,
+    ctx: BuildContext,
     a: int,
     kind: int,
     route: tuple[np.ndarray, np.ndarray, np.ndarray],
@@ -216,7 +164,7 @@ def _valued(
 
 
 def _route_set(
-    ctx: _Context,
+    ctx: BuildContext,
     given: Mapping[int, Sequence[Sequence[int]]] | None,
     deadline: float | None,
     prune: bool,
@@ -267,7 +215,7 @@ def _route_set(
     )
 
 
-def _fire_visits(ctx: _Context, rs: RouteSet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _fire_visits(ctx: BuildContext, rs: RouteSet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(R, L) connected fire of each route entry (-1: none), and which entries dump on it and
     which sense it (a watch, or a dump by an agent with a camera)."""
     g = ctx.graph
@@ -280,7 +228,7 @@ def _fire_visits(ctx: _Context, rs: RouteSet) -> tuple[np.ndarray, np.ndarray, n
 
 
 def _freeze(
-    ctx: _Context, rs: RouteSet, cl: np.ndarray, dump: np.ndarray, sees: np.ndarray
+    ctx: BuildContext, rs: RouteSet, cl: np.ndarray, dump: np.ndarray, sees: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Connected fires with a dump route and a sensing route: labels and coefficients
     ``0.1 q gamma (H - t_c)+^2 / 2``, ``t_c`` the earliest arrival of an agent with water at a
@@ -340,7 +288,7 @@ def build_milp_model(
         If ``deadline`` passed, or was projected to pass, while the routes were being enumerated.
     """
     p = params or MilpParams()
-    ctx = _Context(graph, p, recent_fire)
+    ctx = BuildContext(graph, p, recent_fire)
     if batched and routes is None:
         rs = batched_route_set(ctx, prune, deadline)
     else:

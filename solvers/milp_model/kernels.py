@@ -66,6 +66,7 @@ __all__ = [
     "dominated",
     "dominated_sparse",
     "near_cells",
+    "whole_counts",
 ]
 
 
@@ -261,7 +262,7 @@ def discounted_pairs(
     """:func:`discounted_coverage` for segments with their own altitude ``z``, altitude bounds
     ``lo`` / ``hi`` and ``speed`` (all (S,)), over the blocks within ``radius`` (S,) of
     ``origin`` (S, 2) only (``hypot(centre - origin) <= radius``, as
-    :meth:`solvers.milp_model.build._Context.near_blocks` tests it).
+    :meth:`solvers.milp_model.context.BuildContext.near_blocks` tests it).
 
     Returns ``(si, bi, value)``: the pairs of a segment and a block that overlaps its swath, and
     the value :func:`~solvers.milp_model.sensing.discounted_share` gives them, bit for bit
@@ -329,19 +330,23 @@ def dominated_sparse(keys: np.ndarray, value: np.ndarray, cover: sp.csr_array) -
 def near_cells(
     centres: np.ndarray, snapshots: Sequence[tuple[np.ndarray, np.ndarray]], reach: float
 ) -> np.ndarray:
-    """:func:`solvers.milp_model.objective.near_known_cells` through :func:`box_pairs` (the
-    rule itself when some cell count is not a whole number)."""
+    """:func:`solvers.milp_model.objective.near_known_cells` through :func:`box_pairs`, for
+    cell counts that are whole numbers (their sums are then exact in any order).
+
+    Raises
+    ------
+    ValueError
+        If a cell count is not a whole number, or the counts are too large to sum exactly.
+    """
     n_b = len(centres)
     snaps = [(np.asarray(pos, np.float64).reshape(-1, 2), np.asarray(cells, np.float64))
              for pos, cells in snapshots if len(cells)]  # fmt: skip
+    if snaps and not all(whole_counts(q[1]) for q in snaps):
+        raise ValueError("near_cells sums whole cell counts only; use near_known_cells")
     if not snaps or n_b == 0:
         return np.zeros(n_b)
     pos = np.concatenate([q[0] for q in snaps])
     cells = np.concatenate([q[1] for q in snaps])
-    if not (np.all(cells == np.round(cells)) and np.abs(cells).sum() < 2.0**52):
-        from solvers.milp_model.objective import near_known_cells
-
-        return near_known_cells(centres, snapshots, reach)
     snap = np.repeat(np.arange(len(snaps)), [len(q[1]) for q in snaps])
     si, bi = box_pairs(pos - reach, pos + reach, centres, reach)
     ok = (np.abs(centres[bi, 0] - pos[si, 0]) <= reach) & (
@@ -351,3 +356,9 @@ def near_cells(
     per = np.bincount(snap[si] * n_b + bi, weights=cells[si], minlength=len(snaps) * n_b)
     out: np.ndarray = np.maximum(per.reshape(len(snaps), n_b).max(axis=0), 0.0)
     return out
+
+
+def whole_counts(cells: np.ndarray) -> bool:
+    """True when ``cells`` are whole numbers whose sum is exact in float64 (:func:`near_cells`)."""
+    cells = np.asarray(cells, np.float64)
+    return bool(np.all(cells == np.round(cells)) and np.abs(cells).sum() < 2.0**52)

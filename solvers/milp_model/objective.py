@@ -31,7 +31,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from fcplan.taskgraph import TaskGraph
-from solvers.milp_model.kernels import discounted_coverage, near_cells
+from solvers.milp_model.kernels import discounted_coverage, near_cells, whole_counts
 from solvers.milp_model.types import MilpParams
 
 __all__ = [
@@ -92,7 +92,10 @@ def hidden_cells(
     age = np.minimum(graph.task_staleness[blocks], p.search_age_cap_s)
     fires = graph.fire_tasks
     snapshots = [(graph.task_pos[fires], graph.task_cells[fires]), *recent_fire]
-    near = near_cells(graph.task_pos[blocks], snapshots, 1.5 * p.search_block_px)
+    exact = all(whole_counts(cells) for _, cells in snapshots)
+    near = (near_cells if exact else near_known_cells)(
+        graph.task_pos[blocks], snapshots, 1.5 * p.search_block_px
+    )
     scale = AGE_UNIT_S * (np.maximum(age, 0.0) / AGE_UNIT_S) ** p.search_age_exponent
     out: np.ndarray = p.search_weight * scale * (1.0 + np.minimum(near, 50.0) / 10.0)
     return out
@@ -104,8 +107,8 @@ def near_known_cells(
     """(B,) the most known cells within ``reach`` (px, along each axis) of each of ``centres``
     (B, 2) in any snapshot of fire tasks (positions (F, 2), cells (F,)): the readable rule, one
     dense (blocks x fires) test per snapshot. :func:`hidden_cells` uses its fast twin,
-    :func:`solvers.milp_model.kernels.near_cells`, equal to it when the cells are whole
-    numbers (they count cells)."""
+    :func:`solvers.milp_model.kernels.near_cells`, equal to it, when the cells are whole
+    numbers (they count cells), and this rule otherwise."""
     near = np.zeros(len(centres))
     for pos, cells in snapshots:
         if len(cells) and len(centres):

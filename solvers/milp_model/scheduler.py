@@ -15,8 +15,9 @@ warm start and the solver keep the rest: the scheduler builds the first of
 capping the configured settings) whose predicted build time fits. The prediction is the step's
 build time per agent measured on the ``scale`` tier (:data:`STEP_COST_S`) times the number of
 agents times a factor for this machine and load, which every build in wall-clock mode updates
-(a moving average of measured over predicted, in logs; a build stopped by the deadline counts
-as at least its time so far). The step a plan came from is in its stats
+(the ratio of measured to prior, in logs: it rises at once to a slower build's, and falls
+slowly, a fifth of the way per build; a build stopped by the deadline counts as at least its
+time so far). The step a plan came from is in its stats
 (``size["model_step"]``, 0: the configured model). At the manual's team sizes the configured
 model fits 0.1 s; at the ``scale`` tier's 18-30 agents it does not (``bench/README.md``).
 
@@ -243,8 +244,10 @@ class MilpSchedulerBase:
             if deadline is not None:
                 prior = STEP_COST_S[step] * max(graph.n_agents, 1)
                 ratio = (time.perf_counter() - start) / prior
+                new = math.log(max(ratio, 1e-6))
+                # rises at once (a slower machine or a load spike), falls slowly
                 self._log_factor = float(
-                    np.clip(0.6 * self._log_factor + 0.4 * math.log(max(ratio, 1e-6)), -3, 3)
+                    np.clip(max(new, 0.8 * self._log_factor + 0.2 * new), -3.0, 3.0)
                 )
 
     def _solve(
