@@ -20,9 +20,13 @@ bench/bench_milp_build.py``; figures in ``bench/README.md``):
   the pairs, not a dense array.
 * **Known cells near each block** (:func:`near_cells`): the readable rule,
   :func:`solvers.milp_model.objective.near_known_cells`, tests every (block, fire) pair of every
-  snapshot of recent fire; the kernel takes the pairs from :func:`box_pairs` (the squares around
-  each fire), applies the rule's test to them and sums the cells per block with ``bincount``
-  (sums of whole numbers, exact in any order).
+  snapshot of recent fire. The search blocks' centres lie on a grid, so the kernel finds along
+  each axis the run of grid lines within reach of each fire (``searchsorted``, then the rule's
+  own test at the run's ends), adds the fire's cells to that rectangle of a difference array
+  per snapshot and sums it with two ``cumsum`` (sums of whole numbers, exact in any order).
+  Centres off a grid take the pairs from :func:`box_pairs` instead and sum them with
+  ``bincount``. In a whole ``scale``-tier episode of the MILP the rule and the bucketed pairs
+  cost 15-35 ms per build (24 snapshots of 5,700 fires over 2,116 blocks at the median).
 * **Dominated routes** (:func:`dominated`): the readable rule,
   :func:`solvers.milp_model.prune.dominated`, compares the routes of each group in a Python
   loop with a sparse row selection per group; the kernel compares every (earlier, later) pair of
@@ -51,7 +55,7 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -330,8 +334,13 @@ def dominated_sparse(keys: np.ndarray, value: np.ndarray, cover: sp.csr_array) -
 def near_cells(
     centres: np.ndarray, snapshots: Sequence[tuple[np.ndarray, np.ndarray]], reach: float
 ) -> np.ndarray:
-    """:func:`solvers.milp_model.objective.near_known_cells` through :func:`box_pairs`, for
-    cell counts that are whole numbers (their sums are then exact in any order).
+    """:func:`solvers.milp_model.objective.near_known_cells` for cell counts that are whole
+    numbers (their sums are then exact in any order).
+
+    When the block centres lie on a grid (their distinct x and y values span at most a few
+    times as many grid points as there are centres, as the task graph's search blocks do), each
+    fire adds its cells to a rectangle of grid points through a difference array summed with
+    two ``cumsum``; otherwise the (fire, block) pairs come from :func:`box_pairs`.
 
     Raises
     ------
@@ -341,24 +350,90 @@ def near_cells(
     n_b = len(centres)
     snaps = [(np.asarray(pos, np.float64).reshape(-1, 2), np.asarray(cells, np.float64))
              for pos, cells in snapshots if len(cells)]  # fmt: skip
-    if snaps and not all(whole_counts(q[1]) for q in snaps):
+    if not whole_counts(snaps):
         raise ValueError("near_cells sums whole cell counts only; use near_known_cells")
     if not snaps or n_b == 0:
         return np.zeros(n_b)
     pos = np.concatenate([q[0] for q in snaps])
     cells = np.concatenate([q[1] for q in snaps])
     snap = np.repeat(np.arange(len(snaps)), [len(q[1]) for q in snaps])
-    si, bi = box_pairs(pos - reach, pos + reach, centres, reach)
-    ok = (np.abs(centres[bi, 0] - pos[si, 0]) <= reach) & (
-        np.abs(centres[bi, 1] - pos[si, 1]) <= reach
-    )
-    si, bi = si[ok], bi[ok]
-    per = np.bincount(snap[si] * n_b + bi, weights=cells[si], minlength=len(snaps) * n_b)
-    out: np.ndarray = np.maximum(per.reshape(len(snaps), n_b).max(axis=0), 0.0)
+    centres = np.asarray(centres, np.float64)
+    xs, ix = np.unique(centres[:, 0], return_inverse=True)
+    ys, iy = np.unique(centres[:, 1], return_inverse=True)
+    if (xs.size + 1) * (ys.size + 1) <= 4 * n_b + 64:
+        per = _grid_sums(xs, ys, pos, cells, snap, len(snaps), reach)[:, iy.ravel(), ix.ravel()]
+    else:
+        si, bi = box_pairs(pos - reach, pos + reach, centres, reach)
+        ok = (np.abs(centres[bi, 0] - pos[si, 0]) <= reach) & (
+            np.abs(centres[bi, 1] - pos[si, 1]) <= reach
+        )
+        si, bi = si[ok], bi[ok]
+        flat = np.bincount(snap[si] * n_b + bi, weights=cells[si], minlength=len(snaps) * n_b)
+        per = flat.reshape(len(snaps), n_b)
+    out: np.ndarray = np.maximum(per.max(axis=0), 0.0)
     return out
 
 
-def whole_counts(cells: np.ndarray) -> bool:
-    """True when ``cells`` are whole numbers whose sum is exact in float64 (:func:`near_cells`)."""
-    cells = np.asarray(cells, np.float64)
-    return bool(np.all(cells == np.round(cells)) and np.abs(cells).sum() < 2.0**52)
+def _axis_range(grid: np.ndarray, f: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """For each of ``f``, the indices ``lo <= k < hi`` of the sorted distinct ``grid`` values
+    with ``|grid[k] - f| <= reach``, computed as the rule computes it. ``grid[k] - f`` rounds
+    monotonically in ``grid[k]``, so they are one run; ``searchsorted`` guesses its ends and
+    the exact test moves each guess to the end of the run."""
+    n = grid.size
+
+    def settle(k: np.ndarray, inside: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+        # the first k whose value passes ``inside`` (a test that is False, then True, along k)
+        while True:
+            down = (k > 0) & inside(np.maximum(k - 1, 0))
+            if not down.any():
+                break
+            k = k - down
+        while True:
+            up = (k < n) & ~inside(np.minimum(k, n - 1))
+            if not up.any():
+                return k
+            k = k + up
+
+    lo = settle(np.searchsorted(grid, f - reach), lambda k: grid[k] - f >= -reach)
+    hi = settle(np.searchsorted(grid, f + reach, side="right"), lambda k: grid[k] - f > reach)
+    return lo, hi
+
+
+def _grid_sums(
+    xs: np.ndarray,
+    ys: np.ndarray,
+    pos: np.ndarray,
+    cells: np.ndarray,
+    snap: np.ndarray,
+    n_snap: int,
+    reach: float,
+) -> np.ndarray:
+    """(S, Y, X) per snapshot, the cells of the fires within ``reach`` of each grid point (each
+    axis apart), through a difference array: every partial sum is a whole number no larger
+    than the snapshot's total, so the result is exact."""
+    x_lo, x_hi = _axis_range(xs, pos[:, 0], reach)
+    y_lo, y_hi = _axis_range(ys, pos[:, 1], reach)
+    hit = (x_lo < x_hi) & (y_lo < y_hi)
+    nx, ny = xs.size + 1, ys.size + 1
+    base = snap[hit] * (nx * ny)
+    xl, xh, yl, yh, w = x_lo[hit], x_hi[hit], y_lo[hit] * nx, y_hi[hit] * nx, cells[hit]
+    corners = np.concatenate([base + yl + xl, base + yl + xh, base + yh + xl, base + yh + xh])
+    weights = np.concatenate([w, -w, -w, w])
+    diff = np.bincount(corners, weights=weights, minlength=n_snap * nx * ny)
+    sums = diff.reshape(n_snap, ny, nx).cumsum(axis=2).cumsum(axis=1)
+    out: np.ndarray = sums[:, :-1, :-1]
+    return out
+
+
+def whole_counts(snapshots: Sequence[tuple[np.ndarray, np.ndarray]]) -> bool:
+    """True when every snapshot's cell counts are whole numbers whose sum is exact in float64
+    (:func:`near_cells`); one pass over all the snapshots' cells."""
+    cells = [np.asarray(c, np.float64).ravel() for _, c in snapshots]
+    if not cells:
+        return True
+    flat = np.concatenate(cells)
+    if not np.all(flat == np.round(flat)):
+        return False
+    per = np.bincount(np.repeat(np.arange(len(cells)), [c.size for c in cells]),
+                      weights=np.abs(flat), minlength=len(cells))  # fmt: skip
+    return bool(np.all(per < 2.0**52))

@@ -92,7 +92,7 @@ def hidden_cells(
     age = np.minimum(graph.task_staleness[blocks], p.search_age_cap_s)
     fires = graph.fire_tasks
     snapshots = [(graph.task_pos[fires], graph.task_cells[fires]), *recent_fire]
-    exact = all(whole_counts(cells) for _, cells in snapshots)
+    exact = whole_counts(snapshots)
     near = (near_cells if exact else near_known_cells)(
         graph.task_pos[blocks], snapshots, 1.5 * p.search_block_px
     )

@@ -9,7 +9,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from solvers.milp_model import build, build_milp_model, objective
-from solvers.milp_model.kernels import discounted_coverage, dominated, dominated_sparse, near_cells
+from solvers.milp_model.kernels import (
+    _axis_range,
+    discounted_coverage,
+    dominated,
+    dominated_sparse,
+    near_cells,
+)
 from solvers.milp_model.prune import dominated as dominated_rule
 from solvers.milp_model.sensing import discounted_share
 from tests.solvers.graphs import episode_graphs
@@ -83,7 +89,7 @@ def test_models_built_with_the_rules_are_equal(monkeypatch):
         assert (a.A_ub != b.A_ub).nnz == 0
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=120, deadline=None)
 @given(
     seed=st.integers(0, 2**31 - 1),
     n_blocks=st.integers(0, 50),
@@ -91,18 +97,24 @@ def test_models_built_with_the_rules_are_equal(monkeypatch):
     n_fire=st.integers(0, 30),
     reach=st.floats(10.0, 400.0),
     whole=st.booleans(),
+    on_grid=st.booleans(),
 )
-def test_near_cells_equals_the_rule(seed, n_blocks, n_snap, n_fire, reach, whole):
-    """The bucketed kernel gives exactly (bit for bit) the readable rule's most known cells near
-    each block over the snapshots, fires on a block's edge included, with whole cell counts;
-    it refuses fractional ones (their sums would depend on the order)."""
+def test_near_cells_equals_the_rule(seed, n_blocks, n_snap, n_fire, reach, whole, on_grid):
+    """The kernel gives exactly (bit for bit) the readable rule's most known cells near each
+    block over the snapshots, with block centres on a grid (the difference-array path) or
+    scattered (the bucketed pairs), fires exactly at the reach on either side included, with
+    whole cell counts; it refuses fractional ones (their sums would depend on the order)."""
     rng = np.random.default_rng(seed)
-    centres = (rng.integers(0, 30, (n_blocks, 2)) + 0.5) * 100.0
+    if on_grid:
+        centres = (rng.integers(0, 30, (n_blocks, 2)) + 0.5) * 100.0
+    else:
+        centres = rng.uniform(0.0, 3000.0, (n_blocks, 2))
     snaps = []
     for _ in range(n_snap):
         pos = rng.uniform(-100.0, 3100.0, (n_fire, 2))
         if n_blocks and n_fire:
             pos[0] = centres[0] + reach  # exactly at the reach
+            pos[-1] = centres[-1] - np.array([reach, -reach])
         cells = rng.integers(0, 40, n_fire).astype(np.float64)
         snaps.append((pos, cells if whole else cells + 0.25))
     rule = objective.near_known_cells(centres, snaps, reach)
@@ -111,3 +123,20 @@ def test_near_cells_equals_the_rule(seed, n_blocks, n_snap, n_fire, reach, whole
     else:
         with pytest.raises(ValueError, match="whole cell counts"):
             near_cells(centres, snaps, reach)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    f=st.floats(-1e4, 1e4),
+    reach=st.floats(0.0, 500.0),
+    steps=st.lists(st.integers(-3, 3), min_size=1, max_size=12),
+)
+def test_axis_range_is_the_run_the_rule_accepts(f, reach, steps):
+    """The run of grid values within reach of a fire is exactly the values the rule's test
+    ``|g - f| <= reach`` accepts, also when grid values lie a few ulps either side of
+    ``f - reach`` and ``f + reach`` (searchsorted's guess is off there)."""
+    near = [v + k * np.spacing(v) for v in (f - reach, f + reach) for k in steps]
+    grid = np.unique(np.array([*near, f - 2 * reach - 1.0, f, f + 2 * reach + 1.0]))
+    lo, hi = _axis_range(grid, np.array([f]), reach)
+    inside = np.flatnonzero(np.abs(grid - f) <= reach)
+    assert list(range(int(lo[0]), int(hi[0]))) == inside.tolist()
