@@ -55,8 +55,8 @@ current route), as in ``greedy``.
 most that many vehicles lying close together, each with the tasks nearest to it, and each group
 is its own model (:mod:`solvers.routing.decompose`; 12 by default, so the manual's teams are one
 model per role). Each model's candidate nodes are its ``max(max_nodes, nodes_per_vehicle * V)``
-most valuable tasks that one of its ``V`` vehicles can reach (default 60); the others are not
-offered this replan. On big task graphs this is what keeps a replan within its time limit.
+most valuable tasks that one of its ``V`` vehicles can reach (default 60; among tasks of equal
+value the nearest to one of its vehicles); the others are not offered this replan. On big task graphs this is what keeps a replan within its time limit.
 Routes hold at most ``max_visits`` (4) tasks.
 
 **Search and time**: each model is a :func:`solvers.routing.solve_routes` problem (locations:
@@ -443,7 +443,12 @@ class RoutingScheduler:
         out = []
         for gv, gt in spatial_groups(start[agents], graph.task_pos[tasks], reach, self._group_size):
             ok = gt[reach[np.ix_(gv, gt)].any(axis=0)]
-            top = ok[np.argsort(-value[ok], kind="stable")[: self._n_candidates(gv.size)]]
+            # the most valuable; among equal values the nearest to a vehicle of the group (at
+            # t = 0 every search block is worth the same: task order would pick the map's
+            # first columns however far they are), then task order
+            near = _pairwise(start[agents[gv]], graph.task_pos[tasks[ok]]).min(axis=0)
+            order = np.lexsort((np.arange(ok.size), near, -value[ok]))
+            top = ok[order[: self._n_candidates(gv.size)]]
             top = np.sort(top)  # task order: the model does not depend on value ties
             if top.size:
                 out.append((agents[gv], (tasks[top], value[top])))

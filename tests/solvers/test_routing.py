@@ -12,9 +12,11 @@ from hypothesis import strategies as st
 import fcplan
 from fcplan.errors import FcplanError
 from fcplan.plan import Plan, validate_plan
+from fcplan.scenario import Role
 from fcplan.scheduling import SolveStats, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph, TaskKind, synthetic_task_graph
 from fcplan.team import Mode
+from fcplan.testing import episode_graphs as testing_graphs
 from solvers.routing import PyVRPRoutingScheduler, RoutingScheduler
 from tests.solvers.graphs import SCENARIOS, episode_graphs
 from tests.solvers.test_greedy import known_fire_graph
@@ -198,6 +200,22 @@ def test_top_n_candidates_bound_the_model():
     check_routing_plan(g, plan)
     assert plan.stats.size["nodes"] <= 2 * 15
     assert plan.stats.size["vehicles"] == 6
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_equal_values_offer_the_nearest_candidates(backend):
+    """Among candidates of equal value the model takes those nearest its vehicles: at t = 0 on
+    fcplan-bench-v1/scale-06 every one of 2,304 search blocks is worth the same, the first in
+    task order lie 2,170 px or more from every perception vehicle (beyond its prize), and still
+    every perception vehicle gets a route, to a block nearer than any of those."""
+    g = testing_graphs("fcplan-bench-v1/scale-06", (0,))[0]
+    plan = make_scheduler("routing", backend=backend, deterministic=True).plan(g)
+    check_routing_plan(g, plan)
+    perception = [a for a, r in zip(g.agent_ids, g.agent_role, strict=True) if r == Role.PERCEPTION]
+    assert perception and set(perception) <= set(plan.routes)
+    for aid in perception:
+        a, k = g.agent_index[aid], g.task_index[plan.routes[aid][0]]
+        assert np.hypot(*(g.task_pos[k] - g.agent_start_pos[a])) < 2170.0
 
 
 # ---------------------------------------------------------------------------- reproducibility
