@@ -111,13 +111,30 @@ def _pairs(
             np.concatenate([q[2] for q in parts]))  # fmt: skip
 
 
+def _smallest(key: np.ndarray, k: int) -> np.ndarray:
+    """(S, N) bool: per row the ``k`` smallest of ``key``, ties by column (the first ``k`` of a
+    stable ``argsort``, as a set), through ``np.partition`` instead of a sort of every row."""
+    n = key.shape[1]
+    if k <= 0 or n == 0:
+        return np.zeros(key.shape, dtype=bool)
+    if k >= n:
+        return np.ones(key.shape, dtype=bool)
+    cut = np.partition(key, k - 1, axis=1)[:, k - 1 : k]
+    below = key < cut
+    tie = key == cut
+    room = k - below.sum(axis=1, keepdims=True)
+    out: np.ndarray = below | (tie & (np.cumsum(tie, axis=1) <= room))
+    return out
+
+
 def _top(score: np.ndarray, allowed: np.ndarray, n: int) -> list[np.ndarray]:
     """Per row, :func:`~solvers.milp_model.routes.top_candidates` of that row."""
     ok = allowed & (score > 0)
     key = np.where(ok, -score, np.inf)
-    order = np.argsort(key, axis=1, kind="stable")[:, :n]
-    count = np.minimum(ok.sum(axis=1), n)
-    return [order[r, : count[r]] for r in range(len(order))]
+    r, c = np.nonzero(_smallest(key, n) & ok)
+    order = np.lexsort((c, key[r, c], r))
+    ends = np.cumsum(np.bincount(r, minlength=len(score))).tolist()
+    return [c[order[a:b]] for a, b in zip([0, *ends][:-1], ends, strict=True)]
 
 
 def _enumerate(
@@ -227,12 +244,9 @@ def _scored_ends(
         eta = ag.t0[rows, None] + g.start_task_distance[rows][:, ctx.blocks] / ag.speed[rows, None]
         in_end = ends[many]
         proxy = ctx.block_value[None, :] / (1.0 + eta)
-        by_eta = np.argsort(np.where(in_end, eta, np.inf), axis=1, kind="stable")
-        by_proxy = np.argsort(np.where(in_end, -proxy, np.inf), axis=1, kind="stable")
-        pick = np.zeros_like(in_end)
-        r = np.arange(len(rows))[:, None]
-        pick[r, by_eta[:, : max_ends // 2]] = True
-        pick[r, by_proxy[:, : max_ends // 2]] = True
+        half = max_ends // 2
+        pick = _smallest(np.where(in_end, eta, np.inf), half)
+        pick |= _smallest(np.where(in_end, -proxy, np.inf), half)
         ends[many] = pick & in_end
     return seen, ends
 

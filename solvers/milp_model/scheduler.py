@@ -201,7 +201,10 @@ class MilpSchedulerBase:
             seed=self.seed,
             settings=self.lns,
         )
-        idle = idle_agents(model, x)
+        # the completion of the solution (solve_model's last step) stops only at the deadline:
+        # before it, the completion ran until no route gains, so no agent is idle with work
+        done = deadline is None or time.perf_counter() < deadline
+        idle = np.zeros(0, dtype=np.int64) if done else idle_agents(model, x)
         if idle.size:  # only when the deadline passed before the warm start was complete
             names = ", ".join(graph.agent_ids[a] for a in idle.tolist())
             raise IncompletePlanError(

@@ -12,7 +12,9 @@ from hypothesis import strategies as st
 
 from fcplan.taskgraph import synthetic_task_graph
 from solvers.milp_model import MilpParams, build_milp_model
+from solvers.milp_model.batch import _smallest, _top
 from solvers.milp_model.kernels import box_pairs, discounted_pairs
+from solvers.milp_model.routes import top_candidates
 from solvers.milp_model.sensing import discounted_share
 from tests.solvers.graphs import episode_graphs
 
@@ -149,3 +151,30 @@ def test_chunked_coverage_with_a_deadline_gives_the_same_model(monkeypatch):
     whole = build_milp_model(g)
     monkeypatch.setattr(batch, "CHUNK_SEGMENTS", 7)
     _assert_same_model(build_milp_model(g, deadline=time.perf_counter() + 3600.0), whole)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(0, 6),
+    cols=st.integers(0, 40),
+    k=st.integers(0, 45),
+    levels=st.integers(1, 6),
+)
+def test_smallest_and_top_equal_a_stable_sort(seed, rows, cols, k, levels):
+    """The partition kernels pick, per row, the same set as the first ``k`` of a stable sort
+    (ties, infinities and negative zeros included), and ``_top`` the same candidates in the same
+    order as the readable rule ``top_candidates`` of each row."""
+    rng = np.random.default_rng(seed)
+    key = rng.integers(-levels, levels + 1, (rows, cols)).astype(np.float64)
+    key[rng.random((rows, cols)) < 0.2] = np.inf
+    key[key == 0] = rng.choice([0.0, -0.0], size=int((key == 0).sum()))
+    want = np.zeros(key.shape, dtype=bool)
+    want[np.arange(rows)[:, None], np.argsort(key, axis=1, kind="stable")[:, :k]] = True
+    assert np.array_equal(_smallest(key, k), want)
+    score = np.where(np.isfinite(key), -key, 0.0)
+    allowed = rng.random((rows, cols)) < 0.8
+    got = _top(score, allowed, k)
+    assert len(got) == rows
+    for r in range(rows):
+        assert got[r].tolist() == top_candidates(score[r], allowed[r], k).tolist()

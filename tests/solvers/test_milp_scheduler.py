@@ -146,8 +146,8 @@ def test_a_plan_cut_short_is_completed_or_raises(cls, monkeypatch):
     """A backend result that a limit stopped (status time_limit) with every agent idle is
     completed with routes of positive gain, so no agent that has work is left idle and the
     status says the limit stopped it; if the completion cannot run either (the deadline passed
-    before the warm start was complete), plan() raises IncompletePlanError naming the idle
-    agents, so solve() falls back."""
+    before the warm start was complete: it stopped at the deadline), plan() raises
+    IncompletePlanError naming the idle agents, so solve() falls back."""
     from solvers.milp_model import solve as solve_module
 
     g = episode_graphs(12)[1]
@@ -155,9 +155,15 @@ def test_a_plan_cut_short_is_completed_or_raises(cls, monkeypatch):
     plan = cls().plan(g)
     assert plan.stats.status == "time_limit"
     assert plan.routes and validate_plan(plan, g) is None
-    monkeypatch.setattr(solve_module, "complete", lambda model, x, deadline=None: x)
+
+    def cut(model, x, deadline=None):  # the deadline passes before the completion adds a route
+        while deadline is not None and time.perf_counter() < deadline:
+            time.sleep(0.002)
+        return x
+
+    monkeypatch.setattr(solve_module, "complete", cut)
     with pytest.raises(IncompletePlanError, match="idle"):
-        cls().plan(g)
+        cls().plan(g, time_limit=0.5)
 
 
 def _empty_part(sub, hint, positions, backend, limits, seed, settings):
