@@ -48,12 +48,11 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from solvers.milp_model.context import BuildContext, RouteSet
+from solvers.milp_model.context import BuildContext, RouteSet, projected_past
 from solvers.milp_model.kernels import discounted_pairs, dominated_sparse
 from solvers.milp_model.objective import dump_value
 from solvers.milp_model.prune import route_keys
 from solvers.milp_model.routes import _orders
-from solvers.milp_model.sensing import TAN_Y
 from solvers.milp_model.types import DUMP, SEARCH, WATCH
 
 __all__ = ["batched_route_set"]
@@ -102,7 +101,7 @@ def _pairs(
         now = time.perf_counter()
         done = min(lo + CHUNK_SEGMENTS, n)
         _check(deadline, step)
-        if done < n and start + (now - start) * n / done * 0.8 > deadline:
+        if done < n and projected_past(start, now, done, n, deadline):
             raise TimeoutError(
                 f"building the model was projected past the wall-clock limit ({step}: "
                 f"{done} of {n} segments in {now - start:.3f} s)"
@@ -209,7 +208,7 @@ class _Agents:
     """Per-agent constants of the build: speeds, one-task arrivals, altitudes, reach."""
 
     def __init__(self, ctx: BuildContext) -> None:
-        g, p, roles = ctx.graph, ctx.p, ctx.roles
+        g, roles = ctx.graph, ctx.roles
         n = g.n_agents
         self.t0 = roles.t0
         self.speed = np.maximum(g.agent_speed, 1e-9)
@@ -219,13 +218,11 @@ class _Agents:
         self.z_search = np.full(n, np.nan)
         for a in np.flatnonzero(roles.sensor).tolist():
             self.z_watch[a], self.z_search[a] = ctx.altitudes(a)
-        self.fly = self.raw_speed * np.maximum(p.search_horizon_s - roles.t0, 0.0)
-        self.half_diag = p.search_block_px / np.sqrt(2.0)
+        self._ctx = ctx
 
     def reach(self, agents: np.ndarray, z: np.ndarray, factor: float = 1.0) -> np.ndarray:
         """``BuildContext.near_blocks``'s radius for ``agents`` at altitudes ``z``."""
-        out: np.ndarray = factor * self.fly[agents] + z * (1.0 + TAN_Y) + self.half_diag
-        return out
+        return self._ctx.reach(agents, z, factor)
 
 
 def _scored_ends(

@@ -25,7 +25,7 @@ from fcplan.taskgraph import TaskGraph
 from fcplan.taskgraph.types import pairwise_distance
 from solvers.milp_model.batch import batched_route_set
 from solvers.milp_model.constraints import model_rows
-from solvers.milp_model.context import BuildContext, RouteSet
+from solvers.milp_model.context import BuildContext, RouteSet, projected_past
 from solvers.milp_model.kernels import dominated
 from solvers.milp_model.objective import (
     CELL_RATE,
@@ -181,11 +181,7 @@ def _route_set(
                 raise TimeoutError(
                     f"the wall-clock limit passed while enumerating routes (agent {a})"
                 )
-            # give up as soon as even 80 % of the build's projected length (agents cost alike,
-            # within that margin) ends past the deadline, so that a fallback still has the time
-            # the rest of the build would have wasted
-            projected = start + (now - start) * n / a * 0.8
-            if projected > deadline:
+            if projected_past(start, now, a, n, deadline):
                 raise TimeoutError(
                     f"building the model was projected to take {(now - start) * n / a:.3f} s "
                     f"({a} of {n} agents in {now - start:.3f} s), past the wall-clock limit"

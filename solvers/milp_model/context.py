@@ -28,7 +28,19 @@ from solvers.milp_model.routes import AgentRoles, agent_roles
 from solvers.milp_model.sensing import TAN_Y, best_search_altitude
 from solvers.milp_model.types import MilpParams
 
-__all__ = ["BuildContext", "RouteSet"]
+__all__ = ["PROJECTION_MARGIN", "BuildContext", "RouteSet", "projected_past"]
+
+#: A build under a deadline gives up as soon as even this share of its projected length (agents
+#: and chunks of segments cost alike, within that margin) ends past the deadline, so that a
+#: fallback still has the time the rest of the build would have wasted.
+PROJECTION_MARGIN = 0.8
+
+
+def projected_past(start: float, now: float, done: int, total: int, deadline: float) -> bool:
+    """True when a build that did ``done`` of ``total`` equal steps between ``start`` and
+    ``now`` (``perf_counter`` s) is projected to end past ``deadline`` (see
+    :data:`PROJECTION_MARGIN`)."""
+    return start + (now - start) * total / done * PROJECTION_MARGIN > deadline
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,15 +72,23 @@ class BuildContext:
         self.block_pos = graph.task_pos[self.blocks]
         self.width = max(p.slots, p.search_slots)
 
-    def near_blocks(self, agent: int, z: float, factor: float = 1.0) -> np.ndarray:
-        """Positions (in ``blocks``) of the search blocks a flight of ``agent`` at altitude ``z``
-        can cover before the look-ahead ends (``factor`` times that radius): nothing farther
-        from its start than ``v (H_s - t0)+`` plus the field of view and half a block diagonal
-        is ever in view in time, so its cover is provably 0."""
+    def reach(self, agents: np.ndarray, z: np.ndarray, factor: float = 1.0) -> np.ndarray:
+        """Radius (px, around each start) beyond which a flight of ``agents`` at altitudes ``z``
+        sees nothing before the look-ahead ends (``factor`` times the flight): ``v (H_s - t0)+``
+        plus the field of view and half a block diagonal. Nothing farther is ever in view in
+        time, so its cover is provably 0."""
         g, p = self.graph, self.p
-        fly = float(g.agent_speed[agent]) * max(p.search_horizon_s - float(self.roles.t0[agent]), 0)
-        reach = factor * fly + z * (1.0 + TAN_Y) + p.search_block_px / np.sqrt(2.0)
-        d = np.hypot(*(self.block_pos - g.agent_start_pos[agent]).T)
+        fly = g.agent_speed[agents].astype(np.float64) * np.maximum(
+            p.search_horizon_s - self.roles.t0[agents], 0.0
+        )
+        out: np.ndarray = factor * fly + z * (1.0 + TAN_Y) + p.search_block_px / np.sqrt(2.0)
+        return out
+
+    def near_blocks(self, agent: int, z: float, factor: float = 1.0) -> np.ndarray:
+        """Positions (in ``blocks``) of the search blocks within :meth:`reach` of ``agent``'s
+        start at altitude ``z``."""
+        reach = self.reach(np.array([agent]), np.array([z], dtype=np.float64), factor)[0]
+        d = np.hypot(*(self.block_pos - self.graph.agent_start_pos[agent]).T)
         return np.flatnonzero(d <= reach)
 
     def altitudes(self, agent: int) -> tuple[float, float]:
