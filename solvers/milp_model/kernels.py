@@ -3,21 +3,20 @@
 Building the model at 50-100 agents spent most of its time in two places (``python
 bench/bench_milp_build.py``; figures in ``bench/README.md``):
 
-* **Swept blocks** (:func:`discounted_coverage`): the readable rule,
+* **Swept blocks** (:func:`discounted_pairs`): the readable rule,
   :func:`solvers.milp_model.sensing.discounted_share`, works on dense (segments x blocks) arrays,
   a dozen temporaries each, although a straight flight sweeps only the blocks along its track.
-  The kernel first keeps the (segment, block) pairs whose block centre lies in the segment's
-  bounding box grown by ``a + h + s`` (the swath's half extents along and across the track plus
-  a block side: no block outside can overlap the swath, see below), then those whose block
-  overlaps the swath in the segment's frame, and applies exactly the readable rule's arithmetic
-  to those pairs only; every other entry is ``0.0``, which is what the rule gives there.
-* **Every agent's segments at once** (:func:`discounted_pairs`, used by the build across agents,
-  :mod:`solvers.milp_model.batch`): the same arithmetic with each segment's own altitude,
-  altitude bounds and speed, on the (segment, block) pairs found through a bucket grid of the
-  block centres (:func:`box_pairs`: the buckets a segment's box overlaps, one bucket of slack on
-  each side, then the exact box test) instead of a dense (segments x blocks) test, and restricted
-  to the blocks within each segment's own radius of a point (the agent's reach); it returns
-  the pairs, not a dense array.
+  The kernel finds the (segment, block) pairs whose block centre lies in the segment's bounding
+  box grown by ``a + h + s`` (the swath's half extents along and across the track plus a block
+  side: no block outside can overlap the swath, see below) through a bucket grid of the block
+  centres (:func:`box_pairs`: the buckets the box overlaps, then only the centres of each column
+  near the swath), keeps those whose block overlaps the swath in the segment's frame, and
+  applies exactly the readable rule's arithmetic to those pairs only; every other pair's value
+  is ``0.0``, which is what the rule gives there. Each segment has its own altitude, altitude
+  bounds and speed, and its own radius around a point (the agent's reach) beyond which no block
+  is taken; the kernel returns the pairs (the build across agents,
+  :mod:`solvers.milp_model.batch`). :func:`discounted_coverage` is the same kernel for one
+  agent's segments, scattered into the rule's dense array.
 * **Known cells near each block** (:func:`near_cells`): the readable rule,
   :func:`solvers.milp_model.objective.near_known_cells`, tests every (block, fire) pair of every
   snapshot of recent fire. The search blocks' centres lie on a grid, so the kernel finds along
@@ -36,7 +35,7 @@ Why the box is safe: in the segment's frame a block of side ``s`` centred at ``(
 the swath only if ``|c| < h + s / 2`` and ``-a - s / 2 < w < |PQ| + a + s / 2``; that rectangle's
 corners lie within ``(a + s / 2) + (h + s / 2)`` of the segment's ends along each world axis.
 
-Both kernels do per element the same IEEE operations in the same order as the readable rules,
+The kernels do per element the same IEEE operations in the same order as the readable rules,
 so their results are equal bit for bit (``tests/solvers/test_milp_kernels.py``, hypothesis).
 :func:`dominated_sparse` is :func:`dominated` with the covers compared through a sparse
 difference of each pair's rows, for route sets of many agents at once (no dense copy of every
@@ -61,7 +60,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from solvers.milp_model.prune import group_order
-from solvers.milp_model.sensing import SENSE_TICKS_PER_S, TAN_Y, detection_probability
+from solvers.milp_model.sensing import TAN_Y, detection_probability
 
 __all__ = [
     "box_pairs",
@@ -88,50 +87,22 @@ def discounted_coverage(
 ) -> np.ndarray:
     """(S, B) ``share * (H - t)+ / H`` of ``centres`` under the segments ``p -> q`` started at
     ``t_start`` (S,): :func:`~solvers.milp_model.sensing.discounted_share`, computed along the
-    tracks only."""
+    tracks only: :func:`discounted_pairs` with the scalars given to every segment and no
+    radius, scattered into a dense array."""
     n_s, n_b = len(p), len(centres)
     out = np.zeros((n_s, n_b))
     if n_s == 0 or n_b == 0:
         return out
-    d = q - p  # (S, 2)
-    length = np.hypot(d[:, 0], d[:, 1])
-    unit = d / np.maximum(length, 1e-9)[:, None]
-    still = length <= 1e-9
-    unit[still] = (1.0, 0.0)
-    along_h = z * (np.abs(unit[:, 0]) + TAN_Y * np.abs(unit[:, 1]))  # (S,)
-    across_h = z * (np.abs(unit[:, 1]) + TAN_Y * np.abs(unit[:, 0]))
-    prob = np.asarray(detection_probability(z, lo, hi, speed, unit))
-    prob = np.where(still, 0.0, prob)
-    reach = along_h + across_h + block + 1.0  # the box's margin (+1 px against rounding)
-    lo_xy = np.minimum(p, q) - reach[:, None]
-    hi_xy = np.maximum(p, q) + reach[:, None]
-    cx, cy = centres[:, 0], centres[:, 1]
-    box = (
-        (cx[None, :] >= lo_xy[:, 0, None])
-        & (cx[None, :] <= hi_xy[:, 0, None])
-        & (cy[None, :] >= lo_xy[:, 1, None])
-        & (cy[None, :] <= hi_xy[:, 1, None])
-    )
-    si, bi = np.nonzero(box)
-    # the readable rule's arithmetic, element by element, on the pairs in the box
-    rel0 = cx[bi] - p[si, 0]
-    rel1 = cy[bi] - p[si, 1]
-    u0, u1 = unit[si, 0], unit[si, 1]
-    w = rel0 * u0 + rel1 * u1
-    c = rel1 * u0 - rel0 * u1
-    half = 0.5 * block
-    # then only where the block overlaps the swath (elsewhere cross or along is 0, and so is out)
-    hh, ah, ln = across_h[si], along_h[si], length[si]
-    hit = np.flatnonzero(
-        (c + half > -hh) & (c - half < hh) & (w + half > -ah) & (w - half < ln + ah)
-    )
-    si, bi, w, c, hh, ah, ln = si[hit], bi[hit], w[hit], c[hit], hh[hit], ah[hit], ln[hit]
-    cross = np.clip(np.minimum(c + half, hh) - np.maximum(c - half, -hh), 0.0, block)
-    along = np.clip(np.minimum(w + half, ln + ah) - np.maximum(w - half, -ah), 0.0, block)
-    share = (cross / block) * (along / block) * prob[si]
-    when = np.clip(w, 0.0, ln) / max(speed, 1e-9)
-    late = t_start[si] + when
-    out[si, bi] = share * np.maximum(horizon - late, 0.0) / horizon
+
+    def each(v: float) -> np.ndarray:
+        return np.full(n_s, v, dtype=np.float64)
+
+    si, bi, val = discounted_pairs(
+        np.asarray(p, np.float64), np.asarray(q, np.float64), each(z), each(lo), each(hi),
+        each(speed), np.broadcast_to(np.asarray(t_start, np.float64), (n_s,)), centres, block,
+        horizon, np.zeros((n_s, 2)), each(np.inf),
+    )  # fmt: skip
+    out[si, bi] = val
     return out
 
 
@@ -279,12 +250,7 @@ def discounted_pairs(
     unit[still] = (1.0, 0.0)
     along_h = z * (np.abs(unit[:, 0]) + TAN_Y * np.abs(unit[:, 1]))
     across_h = z * (np.abs(unit[:, 1]) + TAN_Y * np.abs(unit[:, 0]))
-    # detection_probability's arithmetic with each segment's own bounds and speed
-    draws = 2.0 * along_h * SENSE_TICKS_PER_S / np.maximum(speed, 1e-9)
-    flat = hi <= lo
-    with np.errstate(divide="ignore", invalid="ignore"):
-        conf = np.where(flat, 1.0, np.clip(1.0 - 0.6 * (z - lo) / (hi - lo), 0.4, 1.0))
-    prob = np.where(still, 0.0, 1.0 - (1.0 - conf) ** draws)
+    prob = np.where(still, 0.0, detection_probability(z, lo, hi, speed, unit))
     reach = along_h + across_h + block + 1.0
     # the segment's box, cut to the square around ``origin`` that holds its radius (+1 px)
     lo_xy = np.maximum(np.minimum(p, q) - reach[:, None], origin - (radius + 1.0)[:, None])

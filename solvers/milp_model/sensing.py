@@ -52,24 +52,33 @@ SENSE_TICKS_PER_S = 10.0
 TAN_Y = math.tan(math.pi / 6)
 
 
-def _confidence(z: np.ndarray | float, lo: float, hi: float) -> np.ndarray:
-    """``c(z)`` of the module docstring (clipped to ``[0.4, 1]``)."""
+def _confidence(
+    z: np.ndarray | float, lo: np.ndarray | float, hi: np.ndarray | float
+) -> np.ndarray:
+    """``c(z)`` of the module docstring (clipped to ``[0.4, 1]``; 1 where ``hi <= lo``)."""
     z = np.asarray(z, dtype=np.float64)
-    if hi <= lo:
-        return np.ones_like(z)
-    out: np.ndarray = np.clip(1.0 - 0.6 * (z - lo) / (hi - lo), 0.4, 1.0)
+    flat = np.asarray(hi) <= np.asarray(lo)
+    if np.all(flat):
+        return np.ones(np.broadcast(z, flat).shape)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out: np.ndarray = np.where(flat, 1.0, np.clip(1.0 - 0.6 * (z - lo) / (hi - lo), 0.4, 1.0))
     return out
 
 
 def detection_probability(
-    z: np.ndarray | float, lo: float, hi: float, speed: float, u: np.ndarray
+    z: np.ndarray | float,
+    lo: np.ndarray | float,
+    hi: np.ndarray | float,
+    speed: np.ndarray | float,
+    u: np.ndarray,
 ) -> np.ndarray | float:
     """``p(z, u)``: probability that a cell flown over along unit direction(s) ``u`` (..., 2) at
-    altitude ``z`` (m, bounds ``lo..hi``) and ``speed`` px/s is sensed (module docstring)."""
+    altitude ``z`` (m, bounds ``lo..hi``) and ``speed`` px/s is sensed (module docstring); ``z``,
+    ``lo``, ``hi`` and ``speed`` broadcast against ``u[..., 0]``."""
     u = np.asarray(u, dtype=np.float64)
     z = np.asarray(z, dtype=np.float64)
     along = z * (np.abs(u[..., 0]) + TAN_Y * np.abs(u[..., 1]))
-    draws = 2.0 * along * SENSE_TICKS_PER_S / max(speed, 1e-9)
+    draws = 2.0 * along * SENSE_TICKS_PER_S / np.maximum(speed, 1e-9)
     p = 1.0 - (1.0 - _confidence(z, lo, hi)) ** draws
     return float(p) if np.ndim(p) == 0 else p
 
