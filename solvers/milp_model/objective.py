@@ -4,8 +4,7 @@ Every value is in the manual's penalty units (``0.1`` per active cell per second
 per active cell inside facility ``f`` per second), counted over the horizon ``H``:
 
 * a dump on fire task ``k`` at ``t``: ``q n_k w_k (H - t)+`` with ``w_k = 0.1 + theta sum_f
-  PC_f (1 - tau_kf / H)+`` (``tau_kf``: the graph's ``threat_time_s``), times the task's
-  freshness when ``fresh_s`` is set;
+  PC_f (1 - tau_kf / H)+`` (``tau_kf``: the graph's ``threat_time_s``);
 * a search block ``b`` of value ``g_b`` (the graph's ``task_value``: capped coverage age, more
   near known fire) hides ``kappa g_b`` undiscovered burning cells, worth ``V_b = 0.1 kappa g_b H``
   when found now; a route that sweeps it ``t`` seconds from now finds them with probability
@@ -53,8 +52,7 @@ AGE_UNIT_S = 60.0
 
 def fire_weight(graph: TaskGraph, p: MilpParams) -> np.ndarray:
     """(K,) ``w_k``: the penalty rate of one of task ``k``'s cells, facility threats included
-    (0 for search tasks), times ``exp(-(staleness - fresh_s)+ / fresh_s)`` when ``p.fresh_s``
-    is set."""
+    (0 for search tasks)."""
     fires = graph.task_cells > 0
     h = p.horizon_s
     tau = graph.threat_time_s
@@ -62,8 +60,6 @@ def fire_weight(graph: TaskGraph, p: MilpParams) -> np.ndarray:
     if tau.size and graph.facility_penalty.size:
         share = np.clip(1.0 - tau / h, 0.0, 1.0)  # inf -> 0
         w[: tau.shape[0]] += p.threat_weight * share @ graph.facility_penalty
-    if p.fresh_s is not None:
-        w *= np.exp(-np.maximum(graph.task_staleness - p.fresh_s, 0.0) / p.fresh_s)
     out: np.ndarray = np.where(fires, w, 0.0)
     return out
 

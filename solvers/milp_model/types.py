@@ -67,10 +67,6 @@ class MilpParams:
         agents).
     threat_weight : float
         Weight of the facility penalties a fire threatens (>= 0).
-    fresh_s : float or None
-        When set (s, > 0), a fire task's dump value decays once its fire has not been sensed for
-        this long, by ``exp(-(staleness - fresh_s) / fresh_s)`` (the freshness of ``greedy``,
-        ``routing`` and ``cbba``): its known cells may be gone. None (default): no decay.
     growth_cells_s : float
         Cells per second a connected fire adds while fronts run on (>= 0): what a watched dump
         stops.
@@ -112,7 +108,6 @@ class MilpParams:
     watch_candidates: int = 3
     prune_confidence: float = 0.9
     threat_weight: float = 1.0
-    fresh_s: float | None = None
     growth_cells_s: float = 2.0
     search_weight: float = 0.05
     search_age_exponent: float = 2.0
@@ -135,8 +130,6 @@ class MilpParams:
             int_setting(name, getattr(self, name), 1, 64)
         float_setting("prune_confidence", self.prune_confidence, 0.0, 1.0)
         float_setting("threat_weight", self.threat_weight, 0.0)
-        if self.fresh_s is not None:
-            float_setting("fresh_s", self.fresh_s, 0.0, lo_open=True, unit=" s")
         float_setting("growth_cells_s", self.growth_cells_s, 0.0)
         float_setting("search_weight", self.search_weight, 0.0)
         float_setting("search_age_exponent", self.search_age_exponent, 0.0, 4.0)
