@@ -29,6 +29,7 @@ from solvers.milp_model.context import BuildContext, RouteSet, projected_past
 from solvers.milp_model.kernels import dominated
 from solvers.milp_model.objective import (
     CELL_RATE,
+    FireSnapshot,
     dump_value,
     route_cover,
     straight_cover,
@@ -250,7 +251,7 @@ def build_milp_model(
     params: MilpParams | None = None,
     *,
     routes: Mapping[int, Sequence[Sequence[int]]] | None = None,
-    recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+    recent_fire: Sequence[FireSnapshot | tuple[np.ndarray, np.ndarray]] = (),
     deadline: float | None = None,
     prune: bool = True,
     batched: bool = True,
@@ -263,9 +264,10 @@ def build_milp_model(
     params : MilpParams, optional
     routes : mapping of agent row -> sequence of routes (task rows), optional
         Use exactly these routes instead of enumerating them (to score other plans).
-    recent_fire : sequence of (positions (F, 2), cells (F,))
+    recent_fire : sequence of FireSnapshot or (positions (F, 2), cells (F,))
         The fire tasks of recent graphs (:func:`solvers.milp_model.objective.hidden_cells`);
-        the schedulers pass those of the last ``recent_fire_s`` seconds.
+        the schedulers pass those of the last ``recent_fire_s`` seconds, as
+        :class:`~solvers.milp_model.objective.FireSnapshot` that keep their counts.
     deadline : float, optional
         A :func:`time.perf_counter` time: building stops with ``TimeoutError`` once it has
         passed, or once the build, projected from the agents done so far (``batched=False``) or

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fcplan.taskgraph import TaskGraph, TaskKind
-from solvers.milp_model.objective import block_values, fire_weight
+from solvers.milp_model.objective import FireSnapshot, block_values, fire_weight
 from solvers.milp_model.routes import AgentRoles, agent_roles
 from solvers.milp_model.sensing import TAN_Y, best_search_altitude
 from solvers.milp_model.types import MilpParams
@@ -61,7 +61,10 @@ class BuildContext:
     """What every agent's routes need from the graph (computed once per model)."""
 
     def __init__(
-        self, graph: TaskGraph, p: MilpParams, recent_fire: Sequence[tuple[np.ndarray, np.ndarray]]
+        self,
+        graph: TaskGraph,
+        p: MilpParams,
+        recent_fire: Sequence[FireSnapshot | tuple[np.ndarray, np.ndarray]],
     ) -> None:
         self.graph, self.p = graph, p
         self.roles: AgentRoles = agent_roles(graph)

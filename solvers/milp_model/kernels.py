@@ -69,6 +69,7 @@ __all__ = [
     "dominated",
     "dominated_sparse",
     "near_cells",
+    "near_cells_each",
     "whole_counts",
 ]
 
@@ -301,7 +302,26 @@ def near_cells(
     centres: np.ndarray, snapshots: Sequence[tuple[np.ndarray, np.ndarray]], reach: float
 ) -> np.ndarray:
     """:func:`solvers.milp_model.objective.near_known_cells` for cell counts that are whole
-    numbers (their sums are then exact in any order).
+    numbers (their sums are then exact in any order): the most over the snapshots of
+    :func:`near_cells_each`, at least 0.
+
+    Raises
+    ------
+    ValueError
+        If a cell count is not a whole number, or the counts are too large to sum exactly.
+    """
+    per = near_cells_each(centres, snapshots, reach)
+    if per.shape[0] == 0:
+        return np.zeros(len(centres))
+    out: np.ndarray = np.maximum(per.max(axis=0), 0.0)
+    return out
+
+
+def near_cells_each(
+    centres: np.ndarray, snapshots: Sequence[tuple[np.ndarray, np.ndarray]], reach: float
+) -> np.ndarray:
+    """(S, B) per snapshot ``(positions (F, 2), cells (F,))``, the known cells within ``reach``
+    (px, along each axis) of each of ``centres`` (B, 2), for whole cell counts.
 
     When the block centres lie on a grid (their distinct x and y values span at most a few
     times as many grid points as there are centres, as the task graph's search blocks do), each
@@ -314,12 +334,14 @@ def near_cells(
         If a cell count is not a whole number, or the counts are too large to sum exactly.
     """
     n_b = len(centres)
-    snaps = [(np.asarray(pos, np.float64).reshape(-1, 2), np.asarray(cells, np.float64))
-             for pos, cells in snapshots if len(cells)]  # fmt: skip
+    out = np.zeros((len(snapshots), n_b))
+    rows = [i for i, (_, cells) in enumerate(snapshots) if len(cells)]
+    snaps = [(np.asarray(snapshots[i][0], np.float64).reshape(-1, 2),
+              np.asarray(snapshots[i][1], np.float64)) for i in rows]  # fmt: skip
     if not whole_counts(snaps):
         raise ValueError("near_cells sums whole cell counts only; use near_known_cells")
     if not snaps or n_b == 0:
-        return np.zeros(n_b)
+        return out
     pos = np.concatenate([q[0] for q in snaps])
     cells = np.concatenate([q[1] for q in snaps])
     snap = np.repeat(np.arange(len(snaps)), [len(q[1]) for q in snaps])
@@ -336,7 +358,7 @@ def near_cells(
         si, bi = si[ok], bi[ok]
         flat = np.bincount(snap[si] * n_b + bi, weights=cells[si], minlength=len(snaps) * n_b)
         per = flat.reshape(len(snaps), n_b)
-    out: np.ndarray = np.maximum(per.max(axis=0), 0.0)
+    out[rows] = per
     return out
 
 

@@ -26,15 +26,16 @@ True
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
 from fcplan.taskgraph import TaskGraph
-from solvers.milp_model.kernels import discounted_coverage, near_cells, whole_counts
+from solvers.milp_model.kernels import discounted_coverage, near_cells_each, whole_counts
 from solvers.milp_model.types import MilpParams
 
 __all__ = [
+    "FireSnapshot",
     "block_values",
     "dump_value",
     "fire_weight",
@@ -76,26 +77,96 @@ def dump_value(
     return out
 
 
+class FireSnapshot:
+    """The fire tasks of one graph (positions (F, 2), cells (F,)) and, once asked for, the most
+    known cells near each of a set of block centres (:meth:`near`), kept for the next models.
+
+    The MILP schedulers keep the snapshots of the last ``recent_fire_s`` seconds (a few dozen in
+    an episode that replans several times a second) and every model counts the known cells near
+    each block in each of them: a snapshot kept by the scheduler counts them once for the blocks
+    of every model after it (they change only when the graph's blocks do). It unpacks as
+    ``(positions, cells)``.
+
+    Examples
+    --------
+    >>> s = FireSnapshot(np.array([[50.0, 50.0]]), np.array([3.0]))
+    >>> s.near(np.array([[50.0, 50.0], [500.0, 50.0]]), 150.0).tolist()
+    [3.0, 0.0]
+    """
+
+    __slots__ = ("pos", "cells", "_centres", "_reach", "_near")
+
+    def __init__(self, pos: np.ndarray, cells: np.ndarray) -> None:
+        self.pos = np.asarray(pos, np.float64).reshape(-1, 2)
+        self.cells = np.asarray(cells, np.float64)
+        self._centres: np.ndarray | None = None
+        self._reach = np.nan
+        self._near = np.zeros(0)
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        return iter((self.pos, self.cells))
+
+    def __len__(self) -> int:
+        return 2
+
+    def __getitem__(self, i: int) -> np.ndarray:
+        return (self.pos, self.cells)[i]
+
+    def counted(self, centres: np.ndarray, reach: float) -> bool:
+        """True when :meth:`near` of ``centres`` and ``reach`` is known already."""
+        c = self._centres
+        return c is not None and reach == self._reach and np.array_equal(c, centres)
+
+    def keep(self, centres: np.ndarray, reach: float, near: np.ndarray) -> None:
+        """Remember ``near`` as the counts for ``centres`` and ``reach``."""
+        self._centres, self._reach, self._near = np.array(centres, np.float64), reach, near
+
+    def near(self, centres: np.ndarray, reach: float) -> np.ndarray:
+        """(B,) the known cells of this snapshot within ``reach`` of each of ``centres``."""
+        if not self.counted(centres, reach):
+            count_near([self], centres, reach)
+        return self._near
+
+
+def count_near(snapshots: Sequence[FireSnapshot], centres: np.ndarray, reach: float) -> None:
+    """Count the known cells near ``centres`` in every snapshot not yet counted for them: the
+    fast kernel (:func:`~solvers.milp_model.kernels.near_cells_each`) for whole cell counts, all
+    such snapshots at once, and the readable rule for the others (their sums depend on order)."""
+    todo = [s for s in snapshots if not s.counted(centres, reach)]
+    whole = [s for s in todo if whole_counts([(s.pos, s.cells)])]
+    if whole:
+        each = near_cells_each(centres, [(s.pos, s.cells) for s in whole], reach)
+        for s, row in zip(whole, each, strict=True):
+            s.keep(centres, reach, row)
+    for s in todo:
+        if not s.counted(centres, reach):
+            s.keep(centres, reach, near_known_cells(centres, [(s.pos, s.cells)], reach))
+
+
 def hidden_cells(
     graph: TaskGraph,
     p: MilpParams,
     blocks: np.ndarray,
-    recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+    recent_fire: Sequence[FireSnapshot | tuple[np.ndarray, np.ndarray]] = (),
 ) -> np.ndarray:
     """(B,) undiscovered burning cells expected in the search task rows ``blocks``:
     ``kappa A60 (A_b / A60) ** alpha (1 + min(n_b, 50) / 10)`` with ``A_b`` the block's
     coverage age (its ``task_staleness``, capped at ``search_age_cap_s``), ``A60 = 60`` s and
     ``n_b`` the most known burning cells in the 3 x 3 blocks around it, now or in any of the
-    ``recent_fire`` snapshots (``(positions (F, 2), cells (F,))`` of the fire tasks of recent
-    graphs): fire spreads from known fire, and fronts a dump did not freeze run on after the
-    fire they belong to is put out."""
+    ``recent_fire`` snapshots (:class:`FireSnapshot` or ``(positions (F, 2), cells (F,))`` of
+    the fire tasks of recent graphs): fire spreads from known fire, and fronts a dump did not
+    freeze run on after the fire they belong to is put out. ``n_b`` is what
+    :func:`near_known_cells` gives over all the snapshots (the snapshots count apart, each with
+    the exact kernel where its counts are whole, so the result is the rule's bit for bit)."""
     age = np.minimum(graph.task_staleness[blocks], p.search_age_cap_s)
     fires = graph.fire_tasks
-    snapshots = [(graph.task_pos[fires], graph.task_cells[fires]), *recent_fire]
-    exact = whole_counts(snapshots)
-    near = (near_cells if exact else near_known_cells)(
-        graph.task_pos[blocks], snapshots, 1.5 * p.search_block_px
-    )
+    snapshots = [FireSnapshot(graph.task_pos[fires], graph.task_cells[fires])]
+    snapshots += [s if isinstance(s, FireSnapshot) else FireSnapshot(*s) for s in recent_fire]
+    centres, reach = graph.task_pos[blocks], 1.5 * p.search_block_px
+    count_near(snapshots, centres, reach)
+    near = np.zeros(len(blocks))
+    for s in snapshots:
+        np.maximum(near, s.near(centres, reach), out=near)
     scale = AGE_UNIT_S * (np.maximum(age, 0.0) / AGE_UNIT_S) ** p.search_age_exponent
     out: np.ndarray = p.search_weight * scale * (1.0 + np.minimum(near, 50.0) / 10.0)
     return out
@@ -107,7 +178,7 @@ def near_known_cells(
     """(B,) the most known cells within ``reach`` (px, along each axis) of each of ``centres``
     (B, 2) in any snapshot of fire tasks (positions (F, 2), cells (F,)): the readable rule, one
     dense (blocks x fires) test per snapshot. :func:`hidden_cells` uses its fast twin,
-    :func:`solvers.milp_model.kernels.near_cells`, equal to it, when the cells are whole
+    :func:`solvers.milp_model.kernels.near_cells_each`, equal to it, when the cells are whole
     numbers (they count cells), and this rule otherwise."""
     near = np.zeros(len(centres))
     for pos, cells in snapshots:
@@ -122,7 +193,7 @@ def block_values(
     graph: TaskGraph,
     p: MilpParams,
     blocks: np.ndarray,
-    recent_fire: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+    recent_fire: Sequence[FireSnapshot | tuple[np.ndarray, np.ndarray]] = (),
 ) -> np.ndarray:
     """(B,) ``V_b = 0.1 H E_b`` of the search task rows ``blocks``, with ``E_b`` their
     :func:`hidden_cells`."""

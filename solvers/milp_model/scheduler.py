@@ -4,7 +4,8 @@ that a plan cut short by a limit does not leave agents idle.
 A scheduler keeps two things between the replans of an episode (forgotten when a graph comes
 from an earlier time than the last one): its last plan, the warm start of the next solve, and
 the fire tasks of the last ``recent_fire_s`` seconds, which value the search blocks near fire
-that has just been put out.
+that has just been put out (:class:`~solvers.milp_model.objective.FireSnapshot`: each counts the
+known cells near the blocks once, for every model after it).
 
 Model size under a wall-clock limit
 -----------------------------------
@@ -53,6 +54,7 @@ from fcplan.scheduling import (
 from fcplan.taskgraph import TaskGraph
 from solvers.milp_model.build import build_milp_model
 from solvers.milp_model.decode import decode_plan
+from solvers.milp_model.objective import FireSnapshot
 from solvers.milp_model.solve import LnsSettings, SolverLimits, solve_model
 from solvers.milp_model.start import idle_agents, initial_solution
 from solvers.milp_model.types import IncompletePlanError, MilpModel, MilpParams
@@ -115,6 +117,10 @@ class MilpSchedulerBase:
     reserve_share = 0.15
     #: share of the time before the solve's deadline that building the model may take
     build_share = 0.35
+    #: share of the wall-clock limit by which the warm start must be complete (it may use part of
+    #: the reserve: at the ``scale`` tier at 0.1 s a warm start cut at the solve's deadline was
+    #: the commonest fallback)
+    start_share = 0.95
 
     def __init__(
         self,
@@ -150,7 +156,7 @@ class MilpSchedulerBase:
         self._log_factor = 0.0  # log of measured over predicted build time, averaged
         self._previous: dict[str, tuple[str, ...]] = {}
         self._previous_time = -math.inf
-        self._recent: list[tuple[float, np.ndarray, np.ndarray]] = []
+        self._recent: list[tuple[float, FireSnapshot]] = []
 
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Build the model of ``graph``, solve it and decode the plan.
@@ -182,7 +188,7 @@ class MilpSchedulerBase:
         if graph.time_s <= self._previous_time:  # a new episode: forget the last plans
             self._previous, self._recent = {}, []
         keep = graph.time_s - self.params.recent_fire_s
-        recent = [(pos, cells) for t, pos, cells in self._recent if t >= keep]
+        recent = [snap for t, snap in self._recent if t >= keep]
         step = 0 if deadline is None else self._step(graph.n_agents, deadline - t0)
         model = self._build(graph, step, recent, deadline)
         limits = SolverLimits(deadline, self.work_limit)
@@ -191,7 +197,10 @@ class MilpSchedulerBase:
             raise TimeoutError(
                 f"building the model took {time.perf_counter() - t0:.4f} s of {limit} s"
             )
-        hint = initial_solution(model, graph, self._previous, deadline=deadline)
+        # the warm start may run into the reserve: complete past the solve's deadline it is still
+        # a plan (the solve and the completion are then skipped), cut short it is a fallback
+        start_by = None if limit is None else t0 + float(limit) * self.start_share
+        hint = initial_solution(model, graph, self._previous, deadline=start_by)
         x, stats = solve_model(
             model,
             hint,
@@ -217,7 +226,8 @@ class MilpSchedulerBase:
         fires = graph.fire_tasks
         self._recent = [r for r in self._recent if r[0] >= keep]
         if fires.size:
-            self._recent.append((graph.time_s, graph.task_pos[fires], graph.task_cells[fires]))
+            snap = FireSnapshot(graph.task_pos[fires], graph.task_cells[fires])
+            self._recent.append((graph.time_s, snap))
         return plan
 
     def _predicted(self, n_agents: int, step: int) -> float:
@@ -236,7 +246,7 @@ class MilpSchedulerBase:
         self,
         graph: TaskGraph,
         step: int,
-        recent: list[tuple[np.ndarray, np.ndarray]],
+        recent: list[FireSnapshot],
         deadline: float | None,
     ) -> MilpModel:
         """Build the model of ``step``; under a deadline, learn from the time it took."""

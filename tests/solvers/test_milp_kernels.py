@@ -8,7 +8,8 @@ import scipy.sparse as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from solvers.milp_model import build, build_milp_model, objective
+from fcplan.taskgraph import TaskKind
+from solvers.milp_model import MilpParams, build, build_milp_model, objective
 from solvers.milp_model.kernels import (
     _axis_range,
     discounted_coverage,
@@ -76,7 +77,11 @@ def test_models_built_with_the_rules_are_equal(monkeypatch):
     fast = [build_milp_model(g) for n in (1, 24) for g in episode_graphs(n, (0, 200, 600))]
     monkeypatch.setattr(build, "dominated", dominated_rule)
     monkeypatch.setattr(objective, "discounted_coverage", discounted_share)
-    monkeypatch.setattr(objective, "near_cells", objective.near_known_cells)
+    monkeypatch.setattr(
+        objective,
+        "near_cells_each",
+        lambda c, snaps, r: np.array([objective.near_known_cells(c, [q], r) for q in snaps]),
+    )
     slow = [
         build_milp_model(g, batched=False)
         for n in (1, 24)
@@ -140,3 +145,23 @@ def test_axis_range_is_the_run_the_rule_accepts(f, reach, steps):
     lo, hi = _axis_range(grid, np.array([f]), reach)
     inside = np.flatnonzero(np.abs(grid - f) <= reach)
     assert list(range(int(lo[0]), int(hi[0]))) == inside.tolist()
+
+
+def test_kept_snapshots_count_as_the_rule():
+    """Block values from FireSnapshots that a scheduler keeps (counted once, for the blocks of
+    graph, then for every other block of another, then the first again) equal, bit for bit,
+    those from plain (positions, cells) snapshots and the readable rule's count over them all."""
+    graphs = episode_graphs(24, (0, 200, 400, 600))
+    snaps = [(g.task_pos[g.fire_tasks], g.task_cells[g.fire_tasks]) for g in graphs[:-1]]
+    kept = [objective.FireSnapshot(*s) for s in snaps]
+    p = MilpParams()
+    for g, step in ((graphs[-1], 1), (graphs[1], 2), (graphs[-1], 1)):
+        blocks = np.flatnonzero(g.task_kind == TaskKind.SEARCH)[::step]
+        plain = objective.hidden_cells(g, p, blocks, snaps)
+        assert objective.hidden_cells(g, p, blocks, kept).tobytes() == plain.tobytes()
+        current = (g.task_pos[g.fire_tasks], g.task_cells[g.fire_tasks])
+        near = objective.near_known_cells(g.task_pos[blocks], [current, *snaps], 150.0)
+        age = np.minimum(g.task_staleness[blocks], p.search_age_cap_s)
+        scale = objective.AGE_UNIT_S * (age / objective.AGE_UNIT_S) ** p.search_age_exponent
+        rule = p.search_weight * scale * (1.0 + np.minimum(near, 50.0) / 10.0)
+        assert plain.tobytes() == rule.tobytes()
