@@ -22,14 +22,15 @@ Autoreset           as :class:`fcplan.env.vector_motion.VectorMotionEnv`: ``"nex
 
 What is batched and what is not. The ticks of every world run in one
 :class:`fcplan.batch.BatchWorld` (team, fire, sensing, dumps, facility counts and the reward's
-counts: every per-tick array with a batch axis). Per world and per step, in a loop over the
-worlds, remain: the team's :class:`fcplan.belief.Belief` (updated every tick from the world's
-slice of the batch's tick, an exact :class:`fcplan.world.StepInfo`), the task graph
-(:class:`fcplan.taskgraph.TaskGraphBuilder`: clustering of known fire cells, a ``networkx`` view,
-per-graph distance tables), the ranked candidates and the feature tables
-(:mod:`fcplan.env.task_candidates`) and the decoding of actions into commands
-(:mod:`fcplan.env.task_actions`). These work on ragged per-world sets (clusters, tasks) through
-about a hundred small numpy calls per graph; ``bench/README.md`` measures their share.
+counts: every per-tick array with a batch axis), and the team's belief of every world in one
+:class:`fcplan.belief_batch.BatchBelief` (updated every tick from the batch's tick in a few
+numpy calls; the coverage ages of the search blocks of all worlds computed together at each
+replan). Per world and per step, in a loop over the worlds, remain: the task graph
+(:class:`fcplan.taskgraph.TaskGraphBuilder`: clustering of known fire cells, per-graph distance
+tables), the ranked candidates and the feature tables (:mod:`fcplan.env.task_candidates`) and
+the decoding of actions into commands (:mod:`fcplan.env.task_actions`). These work on ragged
+per-world sets (clusters, tasks) through about a hundred small numpy calls per graph;
+``bench/README.md`` measures their share.
 
 Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
 ``watch_altitude``, ``search_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
@@ -58,7 +59,7 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from fcplan.batch import BatchStepInfo, BatchWorld
-from fcplan.belief import Belief
+from fcplan.belief_batch import BatchBelief
 from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import (
     MappingCounts,
@@ -74,9 +75,8 @@ from fcplan.metrics import facility_penalty, penalty_rate
 from fcplan.mission import ScenarioLike
 from fcplan.plan import validate_plan
 from fcplan.scheduling import Scheduler, solve
-from fcplan.taskgraph import TaskGraphBuilder
+from fcplan.taskgraph import TaskGraphBuilder, TaskGraphParams
 from fcplan.team import Team
-from fcplan.world import StepInfo
 
 __all__ = ["VectorTaskEnv", "TeamView"]
 
@@ -150,7 +150,9 @@ class VectorTaskEnv(BatchedEnv):
         self.action_space = batch_space(self.single_action_space, b)
         self.teams = [TeamView(self.batch.team, i) for i in range(b)]
         self._seed_seqs: list[np.random.SeedSequence | None] = [None] * b
-        self.beliefs: list[Belief] = [Belief(sc) for _ in range(b)]
+        #: the team's belief of every world (one batch)
+        self.belief = BatchBelief(sc, b)
+        self._block_px = int((one.graph_params or TaskGraphParams()).search_block_px)
         self.builders = [TaskGraphBuilder(sc, one.graph_params) for _ in range(b)]
         self.graphs: list[Any] = [None] * b
         self.candidates: list[Any] = [None] * b
@@ -199,24 +201,29 @@ class VectorTaskEnv(BatchedEnv):
         mask[rows] = True
         self.batch.reset(seeds=world_seeds, mask=mask)
         self._goal[rows] = np.nan
+        self.belief.reset(rows)
         for b in rows.tolist():
-            self.beliefs[b] = Belief(self.scenario)
             self.builders[b] = TaskGraphBuilder(self.scenario, self.one.graph_params)
-            self._observe(b)
+        self._observe(rows)
         self.steps[rows] = 0
         self.returns[rows] = 0.0
         self._pending[rows] = False
 
-    def _observe(self, b: int) -> None:
-        """World ``b``'s graph, candidates and observation rows (``TaskEnv._observe``)."""
+    def _observe(self, rows: np.ndarray) -> None:
+        """The graphs, candidates and observation rows of the worlds ``rows``
+        (``TaskEnv._observe``)."""
         one = self.one
-        graph = self.builders[b].build(self.teams[b], self.beliefs[b])
-        cand = rank_candidates(graph, one.k)
-        self.graphs[b], self.candidates[b] = graph, cand
-        frac = int(self.batch.tick[b]) / max(self.scenario.n_ticks, 1)
-        self._obs["agents"][b] = agent_features(graph, cand, frac)
-        self._obs["tasks"][b] = task_features(graph, cand, self._goal[b])
-        self._obs["action_mask"][b] = cand.action_mask()
+        if not rows.size:
+            return
+        views = self.belief.views(rows, self._block_px)
+        for b, belief in zip(rows.tolist(), views, strict=True):
+            graph = self.builders[b].build(self.teams[b], belief)
+            cand = rank_candidates(graph, one.k)
+            self.graphs[b], self.candidates[b] = graph, cand
+            frac = int(self.batch.tick[b]) / max(self.scenario.n_ticks, 1)
+            self._obs["agents"][b] = agent_features(graph, cand, frac)
+            self._obs["tasks"][b] = task_features(graph, cand, self._goal[b])
+            self._obs["action_mask"][b] = cand.action_mask()
 
     def _observation(self) -> dict[str, np.ndarray]:
         return {k: v.copy() for k, v in self._obs.items()}
@@ -249,8 +256,7 @@ class VectorTaskEnv(BatchedEnv):
         self.steps += run
         self.returns += rewards
         done = run & (batch.done | (self.steps >= self.one.max_steps))
-        for b in np.flatnonzero(run).tolist():
-            self._observe(b)
+        self._observe(np.flatnonzero(run))
         infos: dict[str, Any] = {
             "tick": batch.tick.copy(),
             "illegal": illegal,
@@ -283,25 +289,8 @@ class VectorTaskEnv(BatchedEnv):
         self.batch.team.apply(b, commands)
 
     def _beliefs(self, info: BatchStepInfo) -> None:
-        """Fold the tick into the belief of every world that ran it (one exact
-        :class:`fcplan.world.StepInfo` per world: the part that is not batched)."""
-        b_all = np.arange(self.num_envs + 1)
-        cuts = [
-            np.searchsorted(part[0], b_all)
-            for part in (info.ignited, info.sensed, info.newly_sensed, info.pruned)
-        ]
-        rects = info.fov.tolist()
-        ticks = self.batch.tick.tolist()
-        tps = self.scenario.ticks_per_second
-        parts = (info.ignited[1], info.sensed[1], info.newly_sensed[1], info.pruned[1])
-        for b in np.flatnonzero(info.ran).tolist():
-            ig, se, ne, pr = (p[c[b] : c[b + 1]] for p, c in zip(parts, cuts, strict=True))
-            step = StepInfo(
-                ticks[b], ticks[b] / tps, ig, se, ne, pr, rects[b],
-                tuple(np.flatnonzero(info.dumped[b]).tolist()),
-                tuple(np.flatnonzero(info.arrived[b]).tolist()),
-            )  # fmt: skip
-            self.beliefs[b].update(step)
+        """Fold the tick into the belief of every world that ran it (one batched update)."""
+        self.belief.update(info, self.batch.tick)
 
     def _rewards(
         self, run: np.ndarray, start: np.ndarray, stop: np.ndarray, pruned: np.ndarray
