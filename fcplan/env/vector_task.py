@@ -25,12 +25,14 @@ What is batched and what is not. The ticks of every world run in one
 counts: every per-tick array with a batch axis), and the team's belief of every world in one
 :class:`fcplan.belief_batch.BatchBelief` (updated every tick from the batch's tick in a few
 numpy calls; the coverage ages of the search blocks of all worlds computed together at each
-replan). Per world and per step, in a loop over the worlds, remain: the task graph
-(:class:`fcplan.taskgraph.TaskGraphBuilder`: clustering of known fire cells, per-graph distance
-tables), the ranked candidates and the feature tables (:mod:`fcplan.env.task_candidates`) and
-the decoding of actions into commands (:mod:`fcplan.env.task_actions`). These work on ragged
-per-world sets (clusters, tasks) through about a hundred small numpy calls per graph;
-``bench/README.md`` measures their share.
+replan). The ranked candidates and the feature tables of all worlds are computed together from
+their graphs (:func:`fcplan.env.task_batch.batch_observe`: the ragged task sets padded, the
+distance tables and the feasibility rule with a batch axis; bit for bit
+:mod:`fcplan.env.task_candidates`). Per world and per step, in a loop over the worlds, remain:
+the task graph (:class:`fcplan.taskgraph.TaskGraphBuilder`: tiling and clustering of the known
+fire cells, threat, search values; about fifty small numpy calls per graph) and the decoding of
+actions into commands (:mod:`fcplan.env.task_actions`); ``bench/README.md`` measures their
+share.
 
 Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
 ``watch_altitude``, ``search_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
@@ -68,7 +70,7 @@ from fcplan.env.task_actions import (
     plan_to_actions,
     rows_commands,
 )
-from fcplan.env.task_candidates import agent_features, rank_candidates, task_features
+from fcplan.env.task_batch import batch_observe
 from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows
 from fcplan.errors import EnvError
 from fcplan.metrics import facility_penalty, penalty_rate
@@ -211,19 +213,25 @@ class VectorTaskEnv(BatchedEnv):
 
     def _observe(self, rows: np.ndarray) -> None:
         """The graphs, candidates and observation rows of the worlds ``rows``
-        (``TaskEnv._observe``)."""
-        one = self.one
+        (``TaskEnv._observe``; candidates and features of all of them at once,
+        :func:`fcplan.env.task_batch.batch_observe`)."""
         if not rows.size:
             return
         views = self.belief.views(rows, self._block_px)
-        for b, belief in zip(rows.tolist(), views, strict=True):
-            graph = self.builders[b].build(self.teams[b], belief)
-            cand = rank_candidates(graph, one.k)
+        rows_l = rows.tolist()
+        graphs = [
+            self.builders[b].build(self.teams[b], belief)
+            for b, belief in zip(rows_l, views, strict=True)
+        ]
+        frac = self.batch.tick[rows] / max(self.scenario.n_ticks, 1)
+        cands, tasks, agents = batch_observe(graphs, self.one.k, self._goal[rows], frac)
+        for b, graph, cand in zip(rows_l, graphs, cands, strict=True):
             self.graphs[b], self.candidates[b] = graph, cand
-            frac = int(self.batch.tick[b]) / max(self.scenario.n_ticks, 1)
-            self._obs["agents"][b] = agent_features(graph, cand, frac)
-            self._obs["tasks"][b] = task_features(graph, cand, self._goal[b])
-            self._obs["action_mask"][b] = cand.action_mask()
+        self._obs["agents"][rows] = agents
+        self._obs["tasks"][rows] = tasks
+        mask = self._obs["action_mask"]
+        mask[rows, :, :-1] = np.stack([c.valid for c in cands])
+        mask[rows, :, -1] = 1
 
     def _observation(self) -> dict[str, np.ndarray]:
         return {k: v.copy() for k, v in self._obs.items()}

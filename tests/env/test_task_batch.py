@@ -1,0 +1,80 @@
+"""Tests for fcplan.env.task_batch: the batched candidates and feature tables are, graph for
+graph, those of fcplan.env.task_candidates (the specification)."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fcplan.env.task_batch import batch_observe
+from fcplan.env.task_candidates import agent_features, rank_candidates, task_features
+from fcplan.env.vector_task import VectorTaskEnv
+from fcplan.scenario import load_scenario
+from fcplan.taskgraph import synthetic_task_graph
+from fcplan.team import Mode
+
+
+def _bits(a):
+    a = np.asarray(a)
+    return a.dtype, a.shape, a.tobytes()
+
+
+def _check(graphs, k, goal, frac):
+    """batch_observe equals the per-graph functions on every graph, bit for bit."""
+    cands, tasks, agents = batch_observe(graphs, k, goal, frac)
+    for b, g in enumerate(graphs):
+        ref = rank_candidates(g, k)
+        got = cands[b]
+        for name in ("rows", "valid", "start_distance", "priority", "freshness", "legal"):
+            assert _bits(getattr(got, name)) == _bits(getattr(ref, name)), (b, name)
+        assert _bits(tasks[b]) == _bits(task_features(g, ref, goal[b])), b
+        assert _bits(agents[b]) == _bits(agent_features(g, ref, float(frac[b]))), b
+
+
+def _goals(rng, n, a):
+    """Goals: some agents without one (NaN), some worlds with none at all."""
+    goal = rng.uniform(0, 1200, (n, a, 2))
+    goal[rng.random((n, a)) < 0.4] = np.nan
+    goal[: max(n // 3, 1)] = np.nan
+    return goal
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    n_graphs=st.integers(1, 6),
+    n_agents=st.integers(2, 5),
+    k=st.integers(1, 12),
+    seed=st.integers(0, 2**31 - 1),
+)
+def test_synthetic_graphs(n_graphs, n_agents, k, seed):
+    """Property: on synthetic graphs of ragged task counts (0 to 40, k above and below them),
+    random agent modes (forced returns included) and batteries, the batched candidates (rows,
+    mask, distances, priorities, freshness, legality), task features and agent features equal
+    rank_candidates, task_features and agent_features of each graph."""
+    rng = np.random.default_rng(seed)
+    graphs = []
+    for _ in range(n_graphs):
+        g = synthetic_task_graph(
+            n_agents, int(rng.integers(0, 41)), rng, battery=float(rng.uniform(60, 600))
+        )
+        mode = rng.choice([int(m) for m in Mode], size=n_agents).astype(np.int8)
+        object.__setattr__(g, "agent_mode", mode)
+        graphs.append(g)
+    _check(graphs, k, _goals(rng, n_graphs, n_agents), rng.random(n_graphs))
+
+
+def test_environment_graphs():
+    """Property: on the graphs the batched task env builds along episodes of #1 and #24 (fire
+    and fire-free graphs, shared read-only arrays), the batched tables equal the per-graph
+    ones."""
+    rng = np.random.default_rng(3)
+    for name in ("1", "24"):
+        env = VectorTaskEnv(load_scenario(name).replace(duration_s=60), num_envs=5, k=6)
+        obs, _ = env.reset(seed=7)
+        for step in range(7):
+            m = obs["action_mask"]
+            obs, *_ = env.step((rng.random(m.shape) * m).argmax(axis=2))
+            if step % 2:
+                _check(env.graphs, 6, _goals(rng, 5, m.shape[1]), rng.random(5))
+        assert any(g.fire_tasks.size for g in env.graphs)
