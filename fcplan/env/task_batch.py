@@ -32,6 +32,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -46,7 +47,7 @@ from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.taskgraph.types import FEASIBILITY_TOL_PX
 from fcplan.team import DRAIN_PER_PX, Mode
 
-__all__ = ["GraphBatch", "stack_graphs", "batch_observe"]
+__all__ = ["GraphBatch", "BatchObservation", "stack_graphs", "batch_observe"]
 
 _FIRE, _SEARCH, _RETURNING = int(TaskKind.FIRE), int(TaskKind.SEARCH), int(Mode.RETURNING)
 _MODE_TABLE = np.array([_MODE_ROWS.get(m, (np.nan,) * 4) for m in range(max(_MODE_ROWS) + 1)])
@@ -68,6 +69,9 @@ class GraphBatch:
     home: np.ndarray  # (B, A, 2)
     speed: np.ndarray  # (B, A)
     can_sense: np.ndarray  # (B, A) bool
+    mode: np.ndarray  # (B, A) int8
+    full_range: np.ndarray  # (B, A)
+    battery: np.ndarray  # (B, A)
     dist: np.ndarray  # (B, A, T) agent-task px
     home_dist: np.ndarray  # (B, A, T) task-home px
     start_dist: np.ndarray  # (B, A, T) px from where the next route starts
@@ -75,13 +79,38 @@ class GraphBatch:
     legal: np.ndarray  # (B, A, T) bool: TaskGraph.reachable (False on padding)
 
 
-def _pad(parts: list[np.ndarray], where: tuple[np.ndarray, np.ndarray], shape: tuple[int, ...],
-         fill: float, dtype: type) -> np.ndarray:  # fmt: skip
-    """Per-graph arrays of ragged length scattered into a padded ``shape`` array."""
+class BatchObservation(NamedTuple):
+    """What :func:`batch_observe` returns (``B`` graphs, ``A`` agents, ``k`` slots)."""
+
+    #: ``rank_candidates(graphs[b], k)`` of each graph
+    candidates: list[Candidates]
+    #: (B, A, k, F) float32 ``task_features`` of each graph, stacked
+    tasks: np.ndarray
+    #: (B, A, S) float32 ``agent_features`` of each graph, stacked
+    agents: np.ndarray
+    #: (B, A, k) int64 task row of each slot (``-1``: padding) and (B, A, k) bool legal slots
+    rows: np.ndarray
+    valid: np.ndarray
+    #: (B, A, k, 2) position of each slot's task and (B, A, k) bool: it is a fire (padding
+    #: slots: those of task row 0)
+    slot_pos: np.ndarray
+    slot_fire: np.ndarray
+
+
+def _pad(parts: list[np.ndarray], flat: np.ndarray, shape: tuple[int, ...], fill: float,
+         dtype: type) -> np.ndarray:  # fmt: skip
+    """Per-graph arrays of ragged length scattered into a padded ``shape`` array (``flat``:
+    the flat index ``b * T + t`` of each task of the concatenated arrays)."""
     out: np.ndarray = np.full(shape, fill, dtype=dtype)
-    if where[0].size:
-        out[where] = np.concatenate(parts)
+    if flat.size:
+        out.reshape(shape[0] * shape[1], *shape[2:])[flat] = np.concatenate(parts)
     return out
+
+
+def _stack(graphs: Sequence[TaskGraph], name: str) -> np.ndarray:
+    """``np.stack`` of the graphs' arrays ``name`` (one concatenation: cheaper)."""
+    parts = [getattr(g, name) for g in graphs]
+    return np.concatenate(parts).reshape(len(parts), *parts[0].shape)
 
 
 def _distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -100,21 +129,19 @@ def stack_graphs(graphs: Sequence[TaskGraph]) -> GraphBatch:
     n = len(graphs)
     nt = np.array([g.n_tasks for g in graphs], dtype=np.int64)
     t = max(int(nt.max(initial=0)), 1)
-    where = (
-        np.repeat(np.arange(n), nt),
-        np.arange(int(nt.sum())) - np.repeat(np.cumsum(nt) - nt, nt),
-    )
+    where = np.arange(int(nt.sum())) + np.repeat(np.arange(n) * t - (np.cumsum(nt) - nt), nt)
     kind = _pad([g.task_kind for g in graphs], where, (n, t), _SEARCH, np.int8)
     first_fire = (nt > 0) & (kind[:, 0] == _FIRE)
     n_fire = np.where(first_fire, t - np.count_nonzero(kind, axis=1), 0)
     pos = _pad([g.task_pos for g in graphs], where, (n, t, 2), 0.0, np.float64)
-    agent_pos = np.stack([g.agent_pos for g in graphs])
-    home = np.stack([g.agent_home for g in graphs])
+    agent_pos = _stack(graphs, "agent_pos")
+    home = _stack(graphs, "agent_home")
     dist, home_dist = _distance(agent_pos, pos), _distance(home, pos)
-    forced = np.stack([g.agent_mode for g in graphs]) == _RETURNING
-    can_sense = np.stack([g.agent_can_sense for g in graphs])
-    full = np.stack([g.agent_full_range for g in graphs])
-    battery = np.stack([g.agent_battery for g in graphs])
+    mode = _stack(graphs, "agent_mode")
+    forced = mode == _RETURNING
+    can_sense = _stack(graphs, "agent_can_sense")
+    full = _stack(graphs, "agent_full_range")
+    battery = _stack(graphs, "agent_battery")
     can_do = (kind == _FIRE)[:, None, :] | can_sense[:, :, None]
     legal = 2.0 * home_dist <= (full + FEASIBILITY_TOL_PX)[:, :, None]
     legal &= can_do
@@ -133,8 +160,11 @@ def stack_graphs(graphs: Sequence[TaskGraph]) -> GraphBatch:
         threat=_pad([g.task_threat for g in graphs], where, (n, t), 0.0, np.float64),
         agent_pos=agent_pos,
         home=home,
-        speed=np.stack([g.agent_speed for g in graphs]),
+        speed=_stack(graphs, "agent_speed"),
         can_sense=can_sense,
+        mode=mode,
+        full_range=full,
+        battery=battery,
         dist=dist,
         home_dist=home_dist,
         start_dist=np.where(forced[:, :, None], home_dist, dist),
@@ -163,11 +193,13 @@ def _rank(gb: GraphBatch, k: int, fresh_s: float) -> tuple[np.ndarray, ...]:
     chosen = np.where(
         s_fire, fire_rank <= take_fire[:, :, None], pos1 - fire_rank <= take_search[:, :, None]
     )
-    m = min(k, t)
-    first = np.argsort(~chosen, axis=2, kind="stable")[:, :, :m]
-    valid = np.take_along_axis(chosen, first, axis=2)
+    # the chosen tasks in priority order fill the first slots (at most k are chosen); the
+    # others are padding
+    slot = np.cumsum(chosen, axis=2)
+    slot -= 1
+    bi, ai, ti = np.nonzero(chosen)
     rows = np.full((n, a, k), -1, dtype=np.int64)
-    rows[:, :, :m] = np.where(valid, np.take_along_axis(order, first, axis=2), -1)
+    rows[bi, ai, slot[bi, ai, ti]] = order[bi, ai, ti]
     return rows, rows >= 0, prio, fresh
 
 
@@ -229,22 +261,20 @@ def _agent_table(graphs: Sequence[TaskGraph], gb: GraphBatch, rows: np.ndarray,
     w = np.array([float(g.world_size) for g in graphs])[:, None]
     known = np.array([g.known_cells for g in graphs], dtype=np.int64)
     log_known = np.where(known > 0, np.log1p(known) / 10.0, 0.0)
-    full = np.stack([g.agent_full_range for g in graphs])
-    cap = np.stack([g.agent_tank_capacity for g in graphs])
+    full = gb.full_range
+    cap = _stack(graphs, "agent_tank_capacity")
     out = np.empty((n, a, len(AGENT_FEATURES)))
     out[:, :, 0] = gb.agent_pos[:, :, 0] / w
     out[:, :, 1] = gb.agent_pos[:, :, 1] / w
-    out[:, :, 2] = np.stack([g.agent_z for g in graphs]) / 100.0
-    out[:, :, 3] = np.stack([g.agent_battery for g in graphs]) / np.maximum(
-        full * DRAIN_PER_PX, 1e-9
-    )
-    tank = np.stack([g.agent_tank for g in graphs])
+    out[:, :, 2] = _stack(graphs, "agent_z") / 100.0
+    out[:, :, 3] = gb.battery / np.maximum(full * DRAIN_PER_PX, 1e-9)
+    tank = _stack(graphs, "agent_tank")
     out[:, :, 4] = np.where(cap > 0, tank / np.maximum(cap, 1), 0.0)
     out[:, :, 5] = gb.can_sense
-    out[:, :, 6] = np.stack([g.agent_can_act for g in graphs])
-    out[:, :, 7:11] = _MODE_TABLE[np.stack([g.agent_mode for g in graphs])]
+    out[:, :, 6] = _stack(graphs, "agent_can_act")
+    out[:, :, 7:11] = _MODE_TABLE[gb.mode]
     out[:, :, 11] = time_fraction[:, None]
-    out[:, :, 12] = np.stack([g.agent_range for g in graphs]) / np.maximum(full, 1e-9)
+    out[:, :, 12] = _stack(graphs, "agent_range") / np.maximum(full, 1e-9)
     out[:, :, 13] = gb.home[:, :, 0] / w
     out[:, :, 14] = gb.home[:, :, 1] / w
     out[:, :, 15] = log_known[:, None]
@@ -262,7 +292,7 @@ def batch_observe(
     time_fraction: np.ndarray,
     *,
     fresh_s: float = 5.0,
-) -> tuple[list[Candidates], np.ndarray, np.ndarray]:
+) -> BatchObservation:
     """Candidates, task features and agent features of ``B`` graphs of one team at once.
 
     Parameters
@@ -278,12 +308,10 @@ def batch_observe(
 
     Returns
     -------
-    candidates : list of Candidates
-        ``rank_candidates(graphs[b], k, fresh_s=fresh_s)`` for each ``b``.
-    tasks : ndarray, (B, A, k, F) float32
-        ``task_features(graphs[b], candidates[b], goal[b])`` stacked.
-    agents : ndarray, (B, A, S) float32
-        ``agent_features(graphs[b], candidates[b], time_fraction[b])`` stacked.
+    BatchObservation
+        Per graph ``rank_candidates(graphs[b], k, fresh_s=fresh_s)``, ``task_features(graphs[b],
+        candidates[b], goal[b])`` and ``agent_features(graphs[b], candidates[b],
+        time_fraction[b])``, and the slots' task rows, positions and kinds.
     """
     gb = stack_graphs(graphs)
     rows, valid, prio, fresh = _rank(gb, k, fresh_s)
@@ -301,4 +329,8 @@ def batch_observe(
         )
         for b, nt in enumerate(gb.n_tasks.tolist())
     ]
-    return cands, tasks, agents
+    bi = np.arange(len(graphs))[:, None, None]
+    r = np.maximum(rows, 0)
+    slot_pos = gb.pos[bi, r]
+    slot_fire = gb.kind[bi, r] == _FIRE
+    return BatchObservation(cands, tasks, agents, rows, valid, slot_pos, slot_fire)

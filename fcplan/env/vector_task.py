@@ -25,14 +25,21 @@ What is batched and what is not. The ticks of every world run in one
 counts: every per-tick array with a batch axis), and the team's belief of every world in one
 :class:`fcplan.belief_batch.BatchBelief` (updated every tick from the batch's tick in a few
 numpy calls; the coverage ages of the search blocks of all worlds computed together at each
-replan). The ranked candidates and the feature tables of all worlds are computed together from
-their graphs (:func:`fcplan.env.task_batch.batch_observe`: the ragged task sets padded, the
-distance tables and the feasibility rule with a batch axis; bit for bit
-:mod:`fcplan.env.task_candidates`). Per world and per step, in a loop over the worlds, remain:
-the task graph (:class:`fcplan.taskgraph.TaskGraphBuilder`: tiling and clustering of the known
-fire cells, threat, search values; about fifty small numpy calls per graph) and the decoding of
-actions into commands (:mod:`fcplan.env.task_actions`); ``bench/README.md`` measures their
-share.
+replan). The task graphs' numpy work on ragged sets runs once for all worlds
+(:func:`fcplan.taskgraph.build_batch.build_graphs`: the known cells of every world binned into
+fire tiles by one sort, the tiles' boxes, counts and staleness, connected-fire labels, threat
+distances and search values on flat arrays with a world index), and so do the ranked
+candidates and the feature tables (:func:`fcplan.env.task_batch.batch_observe`: the ragged task
+sets padded, the distance tables and the feasibility rule with a batch axis) and the decoding
+of actions into one-point routes (:meth:`_commands`, applied by
+:meth:`fcplan.batch.team.BatchTeam.go_to`). Each is tested bit for bit against the per-graph or
+per-world code, which stays the specification. Per world and per step, in a loop over the
+worlds, remain the graph objects themselves (:class:`fcplan.taskgraph.TaskGraph`: task ids,
+the per-graph task arrays and distance tables, the threat's matrix product, and the whole
+builder path of a graph without known fire), which the action decoding, the schedulers
+(:meth:`expert_actions`) and the user read; a world where two agents of one role chose the same
+task is decoded by the per-world rule (:mod:`fcplan.env.task_actions`). ``bench/README.md``
+measures the shares.
 
 Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
 ``watch_altitude``, ``search_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
@@ -78,6 +85,7 @@ from fcplan.mission import ScenarioLike
 from fcplan.plan import validate_plan
 from fcplan.scheduling import Scheduler, solve
 from fcplan.taskgraph import TaskGraphBuilder, TaskGraphParams
+from fcplan.taskgraph.build_batch import build_graphs
 from fcplan.team import Team
 
 __all__ = ["VectorTaskEnv", "TeamView"]
@@ -87,15 +95,23 @@ class TeamView:
     """World ``b``'s team of a :class:`fcplan.batch.team.BatchTeam`, read as a
     :class:`fcplan.team.Team` (what the task graph builder reads)."""
 
-    range_px = Team.range_px
-
     def __init__(self, team: Any, b: int) -> None:
         self._team, self._b = team, b
+        #: the batch's range_px row of this world, set while the env builds its graph
+        self._range: np.ndarray | None = None
         one = team.one
         self.ids, self.home, self.role = one.ids, one.home, one.role
         self.can_sense, self.can_act = one.can_sense, one.can_act
         self.alt_lo, self.alt_hi, self.speed = one.alt_lo, one.alt_hi, one.speed
         self.battery_capacity, self.tank_capacity = one.battery_capacity, one.tank_capacity
+
+    def range_px(self) -> np.ndarray:
+        """:meth:`fcplan.team.Team.range_px` (the batch's, computed for all worlds at once,
+        while the env builds the graphs)."""
+        if self._range is not None:
+            return self._range
+        out: np.ndarray = Team.range_px(self)  # type: ignore[arg-type]
+        return out
 
     @property
     def pos(self) -> np.ndarray:
@@ -160,6 +176,11 @@ class VectorTaskEnv(BatchedEnv):
         self.candidates: list[Any] = [None] * b
         self.steps = np.zeros(b, dtype=np.int64)
         self.returns = np.zeros(b)
+        #: per world, agent and slot: the candidate's task row, position and kind (fire)
+        self._slot_rows = np.full((b, a, k), -1, dtype=np.int64)
+        self._slot_pos = np.zeros((b, a, k, 2))
+        self._slot_fire = np.zeros((b, a, k), dtype=bool)
+        self._role = self.batch.team.one.role.astype(np.int64)
         self._goal = np.full((b, a, 2), np.nan)
         self._obs = {
             "agents": np.zeros((b, a, *sub["agent"].shape), np.float32),
@@ -219,19 +240,25 @@ class VectorTaskEnv(BatchedEnv):
             return
         views = self.belief.views(rows, self._block_px)
         rows_l = rows.tolist()
-        graphs = [
-            self.builders[b].build(self.teams[b], belief)
-            for b, belief in zip(rows_l, views, strict=True)
-        ]
+        teams = [self.teams[b] for b in rows_l]
+        ranges = self.batch.team.range_px()
+        for b, team in zip(rows_l, teams, strict=True):
+            team._range = ranges[b]
+        graphs = build_graphs([self.builders[b] for b in rows_l], teams, views)
+        for team in teams:
+            team._range = None
         frac = self.batch.tick[rows] / max(self.scenario.n_ticks, 1)
-        cands, tasks, agents = batch_observe(graphs, self.one.k, self._goal[rows], frac)
-        for b, graph, cand in zip(rows_l, graphs, cands, strict=True):
+        seen = batch_observe(graphs, self.one.k, self._goal[rows], frac)
+        for b, graph, cand in zip(rows_l, graphs, seen.candidates, strict=True):
             self.graphs[b], self.candidates[b] = graph, cand
-        self._obs["agents"][rows] = agents
-        self._obs["tasks"][rows] = tasks
+        self._obs["agents"][rows] = seen.agents
+        self._obs["tasks"][rows] = seen.tasks
         mask = self._obs["action_mask"]
-        mask[rows, :, :-1] = np.stack([c.valid for c in cands])
+        mask[rows, :, :-1] = seen.valid
         mask[rows, :, -1] = 1
+        self._slot_rows[rows] = seen.rows
+        self._slot_pos[rows] = seen.slot_pos
+        self._slot_fire[rows] = seen.slot_fire
 
     def _observation(self) -> dict[str, np.ndarray]:
         return {k: v.copy() for k, v in self._obs.items()}
@@ -253,8 +280,7 @@ class VectorTaskEnv(BatchedEnv):
             self._reset_worlds(np.flatnonzero(resets), [None] * int(resets.sum()))
         illegal = np.zeros((self.num_envs, a), dtype=bool)
         conflict = np.zeros((self.num_envs, a), dtype=bool)
-        for b in np.flatnonzero(run).tolist():
-            self._command(b, act[b], illegal, conflict)
+        self._commands(np.flatnonzero(run), act, illegal, conflict)
         start, pruned = batch.tick.copy(), batch.fire.n_pruned.copy()
         stop = np.where(run, np.minimum(start + self.one.period, batch.n_ticks), start)
         for _ in range(int((stop - start).max(initial=0))):
@@ -280,6 +306,46 @@ class VectorTaskEnv(BatchedEnv):
             obs = self._observation()
         self._ended(done)
         return obs, rewards, np.zeros(self.num_envs, dtype=bool), done, infos
+
+    def _commands(
+        self, worlds: np.ndarray, act: np.ndarray, illegal: np.ndarray, conflict: np.ndarray
+    ) -> None:
+        """Decode the actions of ``worlds`` into commands and apply them: ``_command`` of each
+        world, as array operations over all of them.
+
+        A slot's action sends the agent to the slot's task if the slot is valid (else the no-op;
+        an action other than ``k`` is then illegal). Worlds where two agents of one role chose
+        the same task (the conflict rule) go through :meth:`_command`; the others apply their
+        one-point routes by :meth:`fcplan.batch.team.BatchTeam.go_to`. A valid slot always holds
+        a legal task (the candidates are ranked among the legal ones), so ``_command``'s plan
+        validation never applies to them.
+        """
+        one, k = self.one, self.one.k
+        if not worlds.size:
+            return
+        a = act[worlds]
+        s = np.clip(a, 0, k - 1)[:, :, None]
+        ok = (a >= 0) & (a < k)
+        ok &= np.take_along_axis(self._obs["action_mask"][worlds], s, axis=2)[:, :, 0] == 1
+        rows = np.where(ok, np.take_along_axis(self._slot_rows[worlds], s, axis=2)[:, :, 0], -1)
+        illegal[worlds] = (rows < 0) & (a != k)
+        sent = rows >= 0
+        key = rows * 8 + self._role
+        same = (key[:, :, None] == key[:, None, :]) & sent[:, :, None] & sent[:, None, :]
+        same &= ~np.eye(len(self._role), dtype=bool)
+        clash = same.any(axis=(1, 2))
+        for b in worlds[clash].tolist():
+            self._command(b, act[b], illegal, conflict)
+        sent[clash] = False
+        n, i = np.nonzero(sent)
+        w, slot = worlds[n], s[n, i, 0]
+        goals = self._slot_pos[w, i, slot]
+        team = self.batch.team
+        alt = np.where(self._slot_fire[w, i, slot], one.watch_altitude, one.search_altitude)
+        alt = np.minimum(np.maximum(alt, team.alt_lo[i]), team.alt_hi[i])
+        alt[~team.can_sense[i]] = np.nan
+        self._goal[w, i] = goals
+        team.go_to(w, i, goals, alt)
 
     def _command(self, b: int, act: np.ndarray, illegal: np.ndarray, conflict: np.ndarray) -> None:
         """Decode world ``b``'s actions into commands (``TaskEnv.step``) and apply them."""

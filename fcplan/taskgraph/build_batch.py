@@ -13,10 +13,12 @@ on ragged sets run once for all the worlds, on flat arrays with a world index:
   (one ``bincount`` with a per-world offset: sums of whole cell counts, exact in any order)
   and the search values.
 
-Per world remain: the connected-fire labels (each builder's :class:`~fcplan.taskgraph.clusters.
-TileClusters` and its memo), the threat's matrix product (each world's own rows, so that the
-product is the builder's), the task ids (strings), the per-graph arrays and distance tables and
-the graph itself; and every graph without known fire (the builder's own path, already cheap).
+The connected-fire labels of all worlds come from one :func:`scipy.ndimage.label` of their tile
+grids stacked (what :func:`~fcplan.taskgraph.clusters.label_tiles` numbers, per world; the
+builders' label memos are neither read nor filled). Per world remain: the threat's matrix
+product (each world's own rows, so that the product is the builder's), the task ids (strings),
+the per-graph arrays and distance tables and the graph itself; and every graph without known
+fire (the builder's own path, already cheap).
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from fcplan.taskgraph.build import (
     _neighbours,
     _rect_distance,
 )
+from fcplan.taskgraph.clusters import EIGHT_CONNECTED
 from fcplan.taskgraph.types import TaskGraph, TaskKind, pairwise_distance
 
 __all__ = ["build_graphs"]
@@ -144,6 +147,7 @@ def _fire_graphs(
         1.0 + np.minimum(near, 50) / 10.0
     )
     ids = [f"fire:{x}:{y}" for x, y in pos.astype(np.int64).tolist()]
+    clusters = _labels(world, tile_x, tile_y, cuts, int(ntx), int(nty))
     known_cells = np.add.reduceat(counts, cuts[:-1]).tolist()
     out = []
     for j, (b, team, bel, tc) in enumerate(zip(builders, teams, beliefs, tcs, strict=True)):
@@ -151,7 +155,7 @@ def _fire_graphs(
         fire_ids = tuple(ids[s:e])
         if len(set(fire_ids)) != len(fire_ids):
             fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))
-        cluster = b._clusters(tile_x[s:e], tile_y[s:e], int(ntx), int(nty))
+        cluster = clusters[s:e]
         threat = close[s:e].copy() @ consts.fac_pen if n_fac else np.zeros(e - s)
         agent_pos = team.pos.copy()
         fields, views = _fields(
@@ -159,6 +163,24 @@ def _fire_graphs(
             threat_time[s:e], fb[s:e], ages[j], search_value[j], fire_ids, known_cells[j],
         )  # fmt: skip
         out.append(b._finish(team, tc, bel.tick, agent_pos, tile, fields, views))
+    return out
+
+
+def _labels(world: np.ndarray, tx: np.ndarray, ty: np.ndarray, cuts: np.ndarray, ntx: int,
+            nty: int) -> np.ndarray:  # fmt: skip
+    """Every world's :func:`fcplan.taskgraph.clusters.label_tiles` of its tiles (in raster order
+    within each world) by one :func:`scipy.ndimage.label` of the worlds' tile grids stacked
+    with an empty row between two worlds (no tile of one touches another's): scipy numbers the
+    components by their first tile in raster order, so a world's components are numbered in its
+    own order after the earlier worlds' and its labels are the global ones minus its first."""
+    from scipy.ndimage import label
+
+    rows = world * (ntx + 1) + tx
+    grid = np.zeros((int(world[-1]) + 1) * (ntx + 1) * (nty + 1), dtype=bool)
+    grid[rows * (nty + 1) + ty] = True
+    labels, _ = label(grid.reshape(-1, nty + 1), structure=EIGHT_CONNECTED)
+    out: np.ndarray = labels[rows, ty].astype(np.int64)
+    out -= np.repeat(out[cuts[:-1]], np.diff(cuts))
     return out
 
 

@@ -22,7 +22,8 @@ def _bits(a):
 
 def _check(graphs, k, goal, frac):
     """batch_observe equals the per-graph functions on every graph, bit for bit."""
-    cands, tasks, agents = batch_observe(graphs, k, goal, frac)
+    obs = batch_observe(graphs, k, goal, frac)
+    cands, tasks, agents = obs.candidates, obs.tasks, obs.agents
     for b, g in enumerate(graphs):
         ref = rank_candidates(g, k)
         got = cands[b]
@@ -30,6 +31,11 @@ def _check(graphs, k, goal, frac):
             assert _bits(getattr(got, name)) == _bits(getattr(ref, name)), (b, name)
         assert _bits(tasks[b]) == _bits(task_features(g, ref, goal[b])), b
         assert _bits(agents[b]) == _bits(agent_features(g, ref, float(frac[b]))), b
+        assert _bits(obs.rows[b]) == _bits(ref.rows) and _bits(obs.valid[b]) == _bits(ref.valid)
+        for i, slot in zip(*np.nonzero(ref.valid), strict=True):
+            t = ref.rows[i, slot]
+            assert _bits(obs.slot_pos[b, i, slot]) == _bits(g.task_pos[t])
+            assert obs.slot_fire[b, i, slot] == (g.task_kind[t] == 0)
 
 
 def _goals(rng, n, a):

@@ -7,11 +7,14 @@ import dataclasses
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from fcplan.env.vector_task import VectorTaskEnv
 from fcplan.scenario import load_scenario
 from fcplan.taskgraph import TaskGraph, TaskGraphBuilder, TaskGraphParams
-from fcplan.taskgraph.build_batch import build_graphs
+from fcplan.taskgraph.build_batch import _labels, build_graphs
+from fcplan.taskgraph.clusters import label_tiles
 
 _VIEWS = ("agent_task_distance", "task_home_distance", "can_do")
 
@@ -65,3 +68,32 @@ def test_build_graphs_equal_per_world_builds(name, params):
             _same_graph(got[b], want)
             fires += want.fire_tasks.size > 0
     assert fires > 0
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    worlds=st.integers(1, 5),
+    nx=st.integers(1, 30),
+    ny=st.integers(1, 30),
+    most=st.integers(1, 400),
+)
+def test_stacked_labels_equal_label_tiles(seed, worlds, nx, ny, most):
+    """Property: the stacked-grid labels of several worlds' tiles (raster order, 1 to a few
+    hundred tiles each: every path of label_tiles, tiles on the grids' borders) equal
+    label_tiles of each world's tiles."""
+    rng = np.random.default_rng(seed)
+    parts, want = [], []
+    for _ in range(worlds):
+        n = int(rng.integers(1, min(most, nx * ny) + 1))
+        flat = np.sort(rng.choice(nx * ny, n, replace=False))
+        tx, ty = np.divmod(flat, ny)
+        parts.append((tx, ty))
+        want.append(label_tiles(tx, ty, nx, ny))
+    world = np.concatenate([np.full(len(p[0]), j) for j, p in enumerate(parts)])
+    tx = np.concatenate([p[0] for p in parts])
+    ty = np.concatenate([p[1] for p in parts])
+    cuts = np.searchsorted(world, np.arange(worlds + 1))
+    got = _labels(world, tx, ty, cuts, nx, ny)
+    for j in range(worlds):
+        np.testing.assert_array_equal(got[cuts[j] : cuts[j + 1]], want[j], strict=True)
