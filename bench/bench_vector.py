@@ -194,7 +194,6 @@ _TASK_PARTS = [
     (vtask.TaskGraphBuilder, "build", "  graphs: builder's own path (no fire)"),
     (vtask, "batch_observe", "  candidates, features (batched)"),
     (vtask.VectorTaskEnv, "_commands", "actions to commands (batched)"),
-    (vtask.VectorTaskEnv, "_command", "  per-world decoding (conflicts)"),
     (vtask.VectorTaskEnv, "_rewards", "rewards"),
 ]
 

@@ -91,10 +91,12 @@ class BatchObservation(NamedTuple):
     #: (B, A, k) int64 task row of each slot (``-1``: padding) and (B, A, k) bool legal slots
     rows: np.ndarray
     valid: np.ndarray
-    #: (B, A, k, 2) position of each slot's task and (B, A, k) bool: it is a fire (padding
-    #: slots: those of task row 0)
+    #: (B, A, k, 2) position of each slot's task, (B, A, k) bool: it is a fire, and (B, A, k)
+    #: seconds of flight to it from where the agent's next route starts (``start_distance /
+    #: agent_speed``, the conflict rule's arrival time; padding slots: those of task row 0)
     slot_pos: np.ndarray
     slot_fire: np.ndarray
+    slot_eta: np.ndarray
 
 
 def _pad(parts: list[np.ndarray], flat: np.ndarray, shape: tuple[int, ...], fill: float,
@@ -333,4 +335,5 @@ def batch_observe(
     r = np.maximum(rows, 0)
     slot_pos = gb.pos[bi, r]
     slot_fire = gb.kind[bi, r] == _FIRE
-    return BatchObservation(cands, tasks, agents, rows, valid, slot_pos, slot_fire)
+    slot_eta = np.take_along_axis(gb.start_dist, r, axis=2) / gb.speed[:, :, None]
+    return BatchObservation(cands, tasks, agents, rows, valid, slot_pos, slot_fire, slot_eta)

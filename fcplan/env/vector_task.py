@@ -36,10 +36,8 @@ of actions into one-point routes (:meth:`_commands`, applied by
 per-world code, which stays the specification. Per world and per step, in a loop over the
 worlds, remain the graph objects themselves (:class:`fcplan.taskgraph.TaskGraph`: task ids,
 the per-graph task arrays and distance tables, the threat's matrix product, and the whole
-builder path of a graph without known fire), which the action decoding, the schedulers
-(:meth:`expert_actions`) and the user read; a world where two agents of one role chose the same
-task is decoded by the per-world rule (:mod:`fcplan.env.task_actions`). ``bench/README.md``
-measures the shares.
+builder path of a graph without known fire), which the schedulers (:meth:`expert_actions`) and
+the user read. ``bench/README.md`` measures the shares.
 
 Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
 ``watch_altitude``, ``search_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
@@ -180,7 +178,9 @@ class VectorTaskEnv(BatchedEnv):
         self._slot_rows = np.full((b, a, k), -1, dtype=np.int64)
         self._slot_pos = np.zeros((b, a, k, 2))
         self._slot_fire = np.zeros((b, a, k), dtype=bool)
+        self._slot_eta = np.zeros((b, a, k))
         self._role = self.batch.team.one.role.astype(np.int64)
+        self._lower = np.tri(a, k=-1, dtype=bool)  # [i, j]: j < i
         self._goal = np.full((b, a, 2), np.nan)
         self._obs = {
             "agents": np.zeros((b, a, *sub["agent"].shape), np.float32),
@@ -259,6 +259,7 @@ class VectorTaskEnv(BatchedEnv):
         self._slot_rows[rows] = seen.rows
         self._slot_pos[rows] = seen.slot_pos
         self._slot_fire[rows] = seen.slot_fire
+        self._slot_eta[rows] = seen.slot_eta
 
     def _observation(self) -> dict[str, np.ndarray]:
         return {k: v.copy() for k, v in self._obs.items()}
@@ -314,11 +315,13 @@ class VectorTaskEnv(BatchedEnv):
         world, as array operations over all of them.
 
         A slot's action sends the agent to the slot's task if the slot is valid (else the no-op;
-        an action other than ``k`` is then illegal). Worlds where two agents of one role chose
-        the same task (the conflict rule) go through :meth:`_command`; the others apply their
-        one-point routes by :meth:`fcplan.batch.team.BatchTeam.go_to`. A valid slot always holds
-        a legal task (the candidates are ranked among the legal ones), so ``_command``'s plan
-        validation never applies to them.
+        an action other than ``k`` is then illegal). When agents of one role chose the same task,
+        the first to arrive keeps it (ties: the lower agent row) and the others lose it
+        (:func:`fcplan.env.task_actions.decode_actions`' rule: agent ``i`` loses when another
+        agent ``j`` of its group comes before it in (arrival time, row) order). The one-point
+        routes are applied by :meth:`fcplan.batch.team.BatchTeam.go_to`. A valid slot always
+        holds a legal task (the candidates are ranked among the legal ones), so ``_command``'s
+        plan validation never applies to them.
         """
         one, k = self.one, self.one.k
         if not worlds.size:
@@ -331,12 +334,18 @@ class VectorTaskEnv(BatchedEnv):
         illegal[worlds] = (rows < 0) & (a != k)
         sent = rows >= 0
         key = rows * 8 + self._role
+        # same[:, i, j]: agents i and j (i != j) were both sent to one task with one role
         same = (key[:, :, None] == key[:, None, :]) & sent[:, :, None] & sent[:, None, :]
         same &= ~np.eye(len(self._role), dtype=bool)
-        clash = same.any(axis=(1, 2))
-        for b in worlds[clash].tolist():
-            self._command(b, act[b], illegal, conflict)
-        sent[clash] = False
+        if same.any():
+            eta = np.take_along_axis(self._slot_eta[worlds], s, axis=2)[:, :, 0]
+            ei, ej = eta[:, :, None], eta[:, None, :]
+            first = (ej < ei) | ((ej == ei) & self._lower)  # [:, i, j]: j comes before i
+            lose = (same & first).any(axis=2)
+            sent &= ~lose
+            conflict[worlds] = lose
+        else:
+            conflict[worlds] = False
         n, i = np.nonzero(sent)
         w, slot = worlds[n], s[n, i, 0]
         goals = self._slot_pos[w, i, slot]
@@ -348,7 +357,9 @@ class VectorTaskEnv(BatchedEnv):
         team.go_to(w, i, goals, alt)
 
     def _command(self, b: int, act: np.ndarray, illegal: np.ndarray, conflict: np.ndarray) -> None:
-        """Decode world ``b``'s actions into commands (``TaskEnv.step``) and apply them."""
+        """Decode world ``b``'s actions into commands (``TaskEnv.step``) and apply them: the
+        per-world rule, which :meth:`_commands` computes for all worlds at once (the tests
+        compare them)."""
         one, graph, cand = self.one, self.graphs[b], self.candidates[b]
         rows, ill, con = decode_actions(graph, cand, act.tolist(), illegal="noop")
         illegal[b], conflict[b] = ill, con

@@ -36,6 +36,8 @@ def _check(graphs, k, goal, frac):
             t = ref.rows[i, slot]
             assert _bits(obs.slot_pos[b, i, slot]) == _bits(g.task_pos[t])
             assert obs.slot_fire[b, i, slot] == (g.task_kind[t] == 0)
+            eta = ref.start_distance[[i], [t]] / g.agent_speed[[i]]  # (decode_actions' arrival)
+            assert _bits(obs.slot_eta[b, i, slot]) == _bits(eta[0])
 
 
 def _goals(rng, n, a):
@@ -84,3 +86,40 @@ def test_environment_graphs():
             if step % 2:
                 _check(env.graphs, 6, _goals(rng, 5, m.shape[1]), rng.random(5))
         assert any(g.fire_tasks.size for g in env.graphs)
+
+
+def test_batched_decoding_equals_per_world_command():
+    """Property: VectorTaskEnv._commands (all worlds at once, conflicts resolved as arrays)
+    leaves every world as the per-world decoding VectorTaskEnv._command does: the same illegal
+    and conflict flags, goals, team arrays and next observations, on actions that often send
+    two agents of one role to the same slot, pick masked slots, the no-op or out-of-range
+    values."""
+    sc = load_scenario("1").replace(duration_s=60)
+    fast, slow = (VectorTaskEnv(sc, num_envs=6, k=4) for _ in range(2))
+
+    def per_world(worlds, act, illegal, conflict):
+        for b in worlds.tolist():
+            slow._command(b, act[b], illegal, conflict)
+
+    slow._commands = per_world  # type: ignore[method-assign]
+    obs_f, _ = fast.reset(seed=5)
+    obs_s, _ = slow.reset(seed=5)
+    rng = np.random.default_rng(1)
+    conflicts = 0
+    for _ in range(12):
+        act = rng.integers(-1, 6, (6, 4))
+        act[:, 0] = np.where(rng.random(6) < 0.6, 0, act[:, 0])
+        act[:, 1] = np.where(rng.random(6) < 0.6, 0, act[:, 1])
+        act[:, 2] = np.where(rng.random(6) < 0.6, act[:, 3], act[:, 2])
+        obs_f, _, _, _, inf_f = fast.step(act)
+        obs_s, _, _, _, inf_s = slow.step(act)
+        for name in ("illegal", "conflict", "tick"):
+            assert _bits(inf_f[name]) == _bits(inf_s[name]), name
+        for name in obs_f:
+            assert _bits(obs_f[name]) == _bits(obs_s[name]), name
+        assert _bits(fast._goal) == _bits(slow._goal)
+        for name in ("pos", "z_target", "goal", "has_goal", "mode", "routes", "route_len"):
+            u, v = getattr(fast.batch.team, name), getattr(slow.batch.team, name)
+            assert _bits(u) == _bits(v), name
+        conflicts += int(inf_f["conflict"].sum())
+    assert conflicts > 0
