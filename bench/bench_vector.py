@@ -187,9 +187,13 @@ def single_task(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
 
 _TASK_PARTS = [
     (bworld.BatchWorld, "step", "sim"),
-    (vtask.VectorTaskEnv, "_beliefs", "beliefs (per world)"),
-    (vtask.VectorTaskEnv, "_observe", "graph, candidates, features (per world)"),
-    (vtask.VectorTaskEnv, "_command", "actions to commands (per world)"),
+    (vtask.VectorTaskEnv, "_beliefs", "beliefs (batched)"),
+    (vtask.VectorTaskEnv, "_observe", "graph, candidates, features"),
+    (vtask.BatchBelief, "views", "  belief reads (coverage ages)"),
+    (vtask, "build_graphs", "  graphs (build_graphs)"),
+    (vtask.TaskGraphBuilder, "build", "  graphs: builder's own path (no fire)"),
+    (vtask, "batch_observe", "  candidates, features (batched)"),
+    (vtask.VectorTaskEnv, "_commands", "actions to commands (batched)"),
     (vtask.VectorTaskEnv, "_rewards", "rewards"),
 ]
 

@@ -12,7 +12,9 @@ mask of a tick do not change at all (a held world).
 
 Commands: the motion level writes ``goal``, ``has_goal``, ``mode``, ``armed`` and ``z_target``
 directly (as :class:`fcplan.env.motion.MotionEnv` does on one team); route commands go through
-:meth:`BatchTeam.apply`, :meth:`fcplan.team.Team.apply` for one world.
+:meth:`BatchTeam.apply`, :meth:`fcplan.team.Team.apply` for one world, or, for one-point routes
+to many (world, agent) pairs at once (the task level), :meth:`BatchTeam.go_to`, the same writes
+as masked array updates.
 
 Examples
 --------
@@ -161,6 +163,41 @@ class BatchTeam:
             self.mode[b, i] = _ACTIVE
             self.has_goal[b, i] = True
             self.goal[b, i] = route[0]
+
+    def range_px(self) -> np.ndarray:
+        """(B, N) :meth:`fcplan.team.Team.range_px` of every world (the same element-wise
+        operations)."""
+        d = self.home - self.pos
+        return np.maximum(self.battery / DRAIN_PER_PX - np.hypot(d[..., 0], d[..., 1]), 0.0)
+
+    def go_to(
+        self, worlds: np.ndarray, agents: np.ndarray, goals: np.ndarray, altitudes: np.ndarray
+    ) -> None:
+        """:meth:`apply` of ``Command(route=(goals[n],), altitude=altitudes[n])`` to agent row
+        ``agents[n]`` of world ``worlds[n]``, for many distinct (world, agent) pairs at once
+        (NaN altitude: None). The same writes as :meth:`apply`, as masked array updates."""
+        if not len(worlds):
+            return
+        goals = np.asarray(goals, dtype=np.float64).reshape(-1, 2)
+        if not np.isfinite(goals).all():
+            n = int(np.flatnonzero(~np.isfinite(goals).all(axis=1))[0])
+            raise PlanError(f"agent {self.ids[agents[n]]}: route has a non-finite coordinate")
+        alt = np.asarray(altitudes, dtype=np.float64)
+        up = ~np.isnan(alt) & self.can_sense[agents]
+        i = agents[up]
+        self.z_target[worlds[up], i] = np.minimum(
+            np.maximum(alt[up], self.alt_lo[i]), self.alt_hi[i]
+        )
+        self.routes[worlds, agents, 0] = goals  # (routes hold at least one point)
+        self.route_len[worlds, agents] = 1
+        self.goal_index[worlds, agents] = 0
+        self.patrol[worlds, agents] = False
+        self.hover_s[worlds, agents] = 0.0
+        go = self.mode[worlds, agents] != _RETURNING
+        w, a = worlds[go], agents[go]
+        self.mode[w, a] = _ACTIVE
+        self.has_goal[w, a] = True
+        self.goal[w, a] = goals[go]
 
     def _set_route(self, b: int, i: int, route: np.ndarray) -> None:
         if len(route) > self.routes.shape[2]:

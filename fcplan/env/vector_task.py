@@ -22,14 +22,22 @@ Autoreset           as :class:`fcplan.env.vector_motion.VectorMotionEnv`: ``"nex
 
 What is batched and what is not. The ticks of every world run in one
 :class:`fcplan.batch.BatchWorld` (team, fire, sensing, dumps, facility counts and the reward's
-counts: every per-tick array with a batch axis). Per world and per step, in a loop over the
-worlds, remain: the team's :class:`fcplan.belief.Belief` (updated every tick from the world's
-slice of the batch's tick, an exact :class:`fcplan.world.StepInfo`), the task graph
-(:class:`fcplan.taskgraph.TaskGraphBuilder`: clustering of known fire cells, a ``networkx`` view,
-per-graph distance tables), the ranked candidates and the feature tables
-(:mod:`fcplan.env.task_candidates`) and the decoding of actions into commands
-(:mod:`fcplan.env.task_actions`). These work on ragged per-world sets (clusters, tasks) through
-about a hundred small numpy calls per graph; ``bench/README.md`` measures their share.
+counts: every per-tick array with a batch axis), and the team's belief of every world in one
+:class:`fcplan.belief_batch.BatchBelief` (updated every tick from the batch's tick in a few
+numpy calls; the coverage ages of the search blocks of all worlds computed together at each
+replan). The task graphs' numpy work on ragged sets runs once for all worlds
+(:func:`fcplan.taskgraph.build_batch.build_graphs`: the known cells of every world binned into
+fire tiles by one sort, the tiles' boxes, counts and staleness, connected-fire labels, threat
+distances and search values on flat arrays with a world index), and so do the ranked
+candidates and the feature tables (:func:`fcplan.env.task_batch.batch_observe`: the ragged task
+sets padded, the distance tables and the feasibility rule with a batch axis) and the decoding
+of actions into one-point routes (:meth:`_commands`, applied by
+:meth:`fcplan.batch.team.BatchTeam.go_to`). Each is tested bit for bit against the per-graph or
+per-world code, which stays the specification. Per world and per step, in a loop over the
+worlds, remain the graph objects themselves (:class:`fcplan.taskgraph.TaskGraph`: task ids,
+the per-graph task arrays and distance tables, the threat's matrix product, and the whole
+builder path of a graph without known fire), which the schedulers (:meth:`expert_actions`) and
+the user read. ``bench/README.md`` measures the shares.
 
 Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
 ``watch_altitude``, ``search_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
@@ -58,7 +66,7 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from fcplan.batch import BatchStepInfo, BatchWorld
-from fcplan.belief import Belief
+from fcplan.belief_batch import BatchBelief
 from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import (
     MappingCounts,
@@ -67,16 +75,16 @@ from fcplan.env.task_actions import (
     plan_to_actions,
     rows_commands,
 )
-from fcplan.env.task_candidates import agent_features, rank_candidates, task_features
+from fcplan.env.task_batch import batch_observe
 from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows
 from fcplan.errors import EnvError
 from fcplan.metrics import facility_penalty, penalty_rate
 from fcplan.mission import ScenarioLike
 from fcplan.plan import validate_plan
 from fcplan.scheduling import Scheduler, solve
-from fcplan.taskgraph import TaskGraphBuilder
+from fcplan.taskgraph import TaskGraphBuilder, TaskGraphParams
+from fcplan.taskgraph.build_batch import build_graphs
 from fcplan.team import Team
-from fcplan.world import StepInfo
 
 __all__ = ["VectorTaskEnv", "TeamView"]
 
@@ -85,15 +93,23 @@ class TeamView:
     """World ``b``'s team of a :class:`fcplan.batch.team.BatchTeam`, read as a
     :class:`fcplan.team.Team` (what the task graph builder reads)."""
 
-    range_px = Team.range_px
-
     def __init__(self, team: Any, b: int) -> None:
         self._team, self._b = team, b
+        #: the batch's range_px row of this world, set while the env builds its graph
+        self._range: np.ndarray | None = None
         one = team.one
         self.ids, self.home, self.role = one.ids, one.home, one.role
         self.can_sense, self.can_act = one.can_sense, one.can_act
         self.alt_lo, self.alt_hi, self.speed = one.alt_lo, one.alt_hi, one.speed
         self.battery_capacity, self.tank_capacity = one.battery_capacity, one.tank_capacity
+
+    def range_px(self) -> np.ndarray:
+        """:meth:`fcplan.team.Team.range_px` (the batch's, computed for all worlds at once,
+        while the env builds the graphs)."""
+        if self._range is not None:
+            return self._range
+        out: np.ndarray = Team.range_px(self)  # type: ignore[arg-type]
+        return out
 
     @property
     def pos(self) -> np.ndarray:
@@ -150,12 +166,21 @@ class VectorTaskEnv(BatchedEnv):
         self.action_space = batch_space(self.single_action_space, b)
         self.teams = [TeamView(self.batch.team, i) for i in range(b)]
         self._seed_seqs: list[np.random.SeedSequence | None] = [None] * b
-        self.beliefs: list[Belief] = [Belief(sc) for _ in range(b)]
+        #: the team's belief of every world (one batch)
+        self.belief = BatchBelief(sc, b)
+        self._block_px = int((one.graph_params or TaskGraphParams()).search_block_px)
         self.builders = [TaskGraphBuilder(sc, one.graph_params) for _ in range(b)]
         self.graphs: list[Any] = [None] * b
         self.candidates: list[Any] = [None] * b
         self.steps = np.zeros(b, dtype=np.int64)
         self.returns = np.zeros(b)
+        #: per world, agent and slot: the candidate's task row, position and kind (fire)
+        self._slot_rows = np.full((b, a, k), -1, dtype=np.int64)
+        self._slot_pos = np.zeros((b, a, k, 2))
+        self._slot_fire = np.zeros((b, a, k), dtype=bool)
+        self._slot_eta = np.zeros((b, a, k))
+        self._role = self.batch.team.one.role.astype(np.int64)
+        self._lower = np.tri(a, k=-1, dtype=bool)  # [i, j]: j < i
         self._goal = np.full((b, a, 2), np.nan)
         self._obs = {
             "agents": np.zeros((b, a, *sub["agent"].shape), np.float32),
@@ -199,24 +224,42 @@ class VectorTaskEnv(BatchedEnv):
         mask[rows] = True
         self.batch.reset(seeds=world_seeds, mask=mask)
         self._goal[rows] = np.nan
+        self.belief.reset(rows)
         for b in rows.tolist():
-            self.beliefs[b] = Belief(self.scenario)
             self.builders[b] = TaskGraphBuilder(self.scenario, self.one.graph_params)
-            self._observe(b)
+        self._observe(rows)
         self.steps[rows] = 0
         self.returns[rows] = 0.0
         self._pending[rows] = False
 
-    def _observe(self, b: int) -> None:
-        """World ``b``'s graph, candidates and observation rows (``TaskEnv._observe``)."""
-        one = self.one
-        graph = self.builders[b].build(self.teams[b], self.beliefs[b])
-        cand = rank_candidates(graph, one.k)
-        self.graphs[b], self.candidates[b] = graph, cand
-        frac = int(self.batch.tick[b]) / max(self.scenario.n_ticks, 1)
-        self._obs["agents"][b] = agent_features(graph, cand, frac)
-        self._obs["tasks"][b] = task_features(graph, cand, self._goal[b])
-        self._obs["action_mask"][b] = cand.action_mask()
+    def _observe(self, rows: np.ndarray) -> None:
+        """The graphs, candidates and observation rows of the worlds ``rows``
+        (``TaskEnv._observe``; candidates and features of all of them at once,
+        :func:`fcplan.env.task_batch.batch_observe`)."""
+        if not rows.size:
+            return
+        views = self.belief.views(rows, self._block_px)
+        rows_l = rows.tolist()
+        teams = [self.teams[b] for b in rows_l]
+        ranges = self.batch.team.range_px()
+        for b, team in zip(rows_l, teams, strict=True):
+            team._range = ranges[b]
+        graphs = build_graphs([self.builders[b] for b in rows_l], teams, views)
+        for team in teams:
+            team._range = None
+        frac = self.batch.tick[rows] / max(self.scenario.n_ticks, 1)
+        seen = batch_observe(graphs, self.one.k, self._goal[rows], frac)
+        for b, graph, cand in zip(rows_l, graphs, seen.candidates, strict=True):
+            self.graphs[b], self.candidates[b] = graph, cand
+        self._obs["agents"][rows] = seen.agents
+        self._obs["tasks"][rows] = seen.tasks
+        mask = self._obs["action_mask"]
+        mask[rows, :, :-1] = seen.valid
+        mask[rows, :, -1] = 1
+        self._slot_rows[rows] = seen.rows
+        self._slot_pos[rows] = seen.slot_pos
+        self._slot_fire[rows] = seen.slot_fire
+        self._slot_eta[rows] = seen.slot_eta
 
     def _observation(self) -> dict[str, np.ndarray]:
         return {k: v.copy() for k, v in self._obs.items()}
@@ -238,8 +281,7 @@ class VectorTaskEnv(BatchedEnv):
             self._reset_worlds(np.flatnonzero(resets), [None] * int(resets.sum()))
         illegal = np.zeros((self.num_envs, a), dtype=bool)
         conflict = np.zeros((self.num_envs, a), dtype=bool)
-        for b in np.flatnonzero(run).tolist():
-            self._command(b, act[b], illegal, conflict)
+        self._commands(np.flatnonzero(run), act, illegal, conflict)
         start, pruned = batch.tick.copy(), batch.fire.n_pruned.copy()
         stop = np.where(run, np.minimum(start + self.one.period, batch.n_ticks), start)
         for _ in range(int((stop - start).max(initial=0))):
@@ -249,8 +291,7 @@ class VectorTaskEnv(BatchedEnv):
         self.steps += run
         self.returns += rewards
         done = run & (batch.done | (self.steps >= self.one.max_steps))
-        for b in np.flatnonzero(run).tolist():
-            self._observe(b)
+        self._observe(np.flatnonzero(run))
         infos: dict[str, Any] = {
             "tick": batch.tick.copy(),
             "illegal": illegal,
@@ -267,8 +308,58 @@ class VectorTaskEnv(BatchedEnv):
         self._ended(done)
         return obs, rewards, np.zeros(self.num_envs, dtype=bool), done, infos
 
+    def _commands(
+        self, worlds: np.ndarray, act: np.ndarray, illegal: np.ndarray, conflict: np.ndarray
+    ) -> None:
+        """Decode the actions of ``worlds`` into commands and apply them: ``_command`` of each
+        world, as array operations over all of them.
+
+        A slot's action sends the agent to the slot's task if the slot is valid (else the no-op;
+        an action other than ``k`` is then illegal). When agents of one role chose the same task,
+        the first to arrive keeps it (ties: the lower agent row) and the others lose it
+        (:func:`fcplan.env.task_actions.decode_actions`' rule: agent ``i`` loses when another
+        agent ``j`` of its group comes before it in (arrival time, row) order). The one-point
+        routes are applied by :meth:`fcplan.batch.team.BatchTeam.go_to`. A valid slot always
+        holds a legal task (the candidates are ranked among the legal ones), so ``_command``'s
+        plan validation never applies to them.
+        """
+        one, k = self.one, self.one.k
+        if not worlds.size:
+            return
+        a = act[worlds]
+        s = np.clip(a, 0, k - 1)[:, :, None]
+        ok = (a >= 0) & (a < k)
+        ok &= np.take_along_axis(self._obs["action_mask"][worlds], s, axis=2)[:, :, 0] == 1
+        rows = np.where(ok, np.take_along_axis(self._slot_rows[worlds], s, axis=2)[:, :, 0], -1)
+        illegal[worlds] = (rows < 0) & (a != k)
+        sent = rows >= 0
+        key = rows * 8 + self._role
+        # same[:, i, j]: agents i and j (i != j) were both sent to one task with one role
+        same = (key[:, :, None] == key[:, None, :]) & sent[:, :, None] & sent[:, None, :]
+        same &= ~np.eye(len(self._role), dtype=bool)
+        if same.any():
+            eta = np.take_along_axis(self._slot_eta[worlds], s, axis=2)[:, :, 0]
+            ei, ej = eta[:, :, None], eta[:, None, :]
+            first = (ej < ei) | ((ej == ei) & self._lower)  # [:, i, j]: j comes before i
+            lose = (same & first).any(axis=2)
+            sent &= ~lose
+            conflict[worlds] = lose
+        else:
+            conflict[worlds] = False
+        n, i = np.nonzero(sent)
+        w, slot = worlds[n], s[n, i, 0]
+        goals = self._slot_pos[w, i, slot]
+        team = self.batch.team
+        alt = np.where(self._slot_fire[w, i, slot], one.watch_altitude, one.search_altitude)
+        alt = np.minimum(np.maximum(alt, team.alt_lo[i]), team.alt_hi[i])
+        alt[~team.can_sense[i]] = np.nan
+        self._goal[w, i] = goals
+        team.go_to(w, i, goals, alt)
+
     def _command(self, b: int, act: np.ndarray, illegal: np.ndarray, conflict: np.ndarray) -> None:
-        """Decode world ``b``'s actions into commands (``TaskEnv.step``) and apply them."""
+        """Decode world ``b``'s actions into commands (``TaskEnv.step``) and apply them: the
+        per-world rule, which :meth:`_commands` computes for all worlds at once (the tests
+        compare them)."""
         one, graph, cand = self.one, self.graphs[b], self.candidates[b]
         rows, ill, con = decode_actions(graph, cand, act.tolist(), illegal="noop")
         illegal[b], conflict[b] = ill, con
@@ -283,25 +374,8 @@ class VectorTaskEnv(BatchedEnv):
         self.batch.team.apply(b, commands)
 
     def _beliefs(self, info: BatchStepInfo) -> None:
-        """Fold the tick into the belief of every world that ran it (one exact
-        :class:`fcplan.world.StepInfo` per world: the part that is not batched)."""
-        b_all = np.arange(self.num_envs + 1)
-        cuts = [
-            np.searchsorted(part[0], b_all)
-            for part in (info.ignited, info.sensed, info.newly_sensed, info.pruned)
-        ]
-        rects = info.fov.tolist()
-        ticks = self.batch.tick.tolist()
-        tps = self.scenario.ticks_per_second
-        parts = (info.ignited[1], info.sensed[1], info.newly_sensed[1], info.pruned[1])
-        for b in np.flatnonzero(info.ran).tolist():
-            ig, se, ne, pr = (p[c[b] : c[b + 1]] for p, c in zip(parts, cuts, strict=True))
-            step = StepInfo(
-                ticks[b], ticks[b] / tps, ig, se, ne, pr, rects[b],
-                tuple(np.flatnonzero(info.dumped[b]).tolist()),
-                tuple(np.flatnonzero(info.arrived[b]).tolist()),
-            )  # fmt: skip
-            self.beliefs[b].update(step)
+        """Fold the tick into the belief of every world that ran it (one batched update)."""
+        self.belief.update(info, self.batch.tick)
 
     def _rewards(
         self, run: np.ndarray, start: np.ndarray, stop: np.ndarray, pruned: np.ndarray
