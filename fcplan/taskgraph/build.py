@@ -42,6 +42,7 @@ True
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -284,7 +285,6 @@ class TaskGraphBuilder:
         """Task fields and views of a graph with known fire: fire tiles, then search blocks."""
         nb = self._nb
         fire_pos, counts, fire_stale, cluster = self._fire_tiles(belief, tile)
-        n_fire = len(fire_pos)
         threat, threat_time = self._threat(fire_pos)
 
         # search value: age (capped) times (1 + nearby known fire)
@@ -302,34 +302,10 @@ class TaskGraphBuilder:
         )
 
         # ids from the truncated position (astype truncates toward zero, as int() does)
-        fire_ids = tuple([f"fire:{x}:{y}" for x, y in fire_pos.astype(np.int64).tolist()])
-        # keep ids unique when two tiles round to the same point
-        if len(set(fire_ids)) != len(fire_ids):
-            fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))
-
-        search_pos = self._search_pos
-        n_search = len(search_pos)
-        task_kind = np.full(n_fire + n_search, int(TaskKind.SEARCH), dtype=np.int8)
-        task_kind[:n_fire] = int(TaskKind.FIRE)
-        minus_s = self._search_only["task_cluster"]
-        task_pos = np.concatenate([fire_pos, search_pos])
-        # both (A, K) distance tables in one pass, as TaskGraph._agent_distances computes them
-        both = pairwise_distance(np.concatenate([agent_pos, tc.home]), task_pos)
-        n_a = len(agent_pos)
-        fields = dict(
-            task_ids=fire_ids + self._search_ids,
-            task_kind=task_kind,
-            task_pos=task_pos,
-            task_value=np.concatenate([counts * (1.0 + threat), search_value]),
-            task_cells=_cat_int(counts, self._search_only["task_cells"]),
-            task_staleness=np.concatenate([fire_stale, search_age]),
-            task_threat=np.concatenate([threat, np.zeros(n_search)]),
-            task_cluster=_cat_int(cluster, minus_s),
-            task_block=_cat_int(n_fire + fb, minus_s),
-            threat_time_s=threat_time,
-            known_cells=int(counts.sum()),
-        )
-        return fields, {"agent_task_distance": both[:n_a], "task_home_distance": both[n_a:]}
+        fire_ids = unique_ids([f"fire:{x}:{y}" for x, y in fire_pos.astype(np.int64).tolist()])
+        return graph_fields(self, tc, agent_pos, fire_pos, counts, fire_stale, cluster, threat,
+                            threat_time, fb, search_age, search_value, fire_ids,
+                            int(counts.sum()))  # fmt: skip
 
     def _finish(
         self,
@@ -486,3 +462,47 @@ def _search_grid(w: int, blk: int) -> np.ndarray:
         [np.minimum((bx + 0.5) * blk, w - 1.0), np.minimum((by + 0.5) * blk, w - 1.0)], axis=1
     )
     return _frozen(pos)
+
+
+def unique_ids(ids: Sequence[str]) -> tuple[str, ...]:
+    """``ids`` as a tuple, each suffixed with ``#k`` (its position) when two are equal (two fire
+    tiles whose positions truncate to the same point)."""
+    out = tuple(ids)
+    if len(set(out)) != len(out):
+        out = tuple(f"{fid}#{k}" for k, fid in enumerate(out))
+    return out
+
+
+def graph_fields(b: TaskGraphBuilder, tc: Any, agent_pos: np.ndarray, fire_pos: np.ndarray,
+                 counts: np.ndarray, fire_stale: np.ndarray, cluster: np.ndarray,
+                 threat: np.ndarray, threat_time: np.ndarray, fb: np.ndarray,
+                 search_age: np.ndarray, search_value: np.ndarray, fire_ids: tuple[str, ...],
+                 known_cells: int) -> tuple[dict[str, Any], dict[str, Any]]:  # fmt: skip
+    """A graph's task fields (fire tiles, then ``b``'s search blocks) and its distance views,
+    from its fire tiles' positions, cells, staleness, clusters, threats and blocks ``fb`` and
+    the blocks' ages and values (:meth:`TaskGraphBuilder._fire_fields` and the batched build,
+    :func:`fcplan.taskgraph.build_batch.build_graphs`)."""
+    n_fire = len(fire_pos)
+    search_pos = b._search_pos
+    n_search = len(search_pos)
+    task_kind = np.full(n_fire + n_search, int(TaskKind.SEARCH), dtype=np.int8)
+    task_kind[:n_fire] = int(TaskKind.FIRE)
+    minus_s = b._search_only["task_cluster"]
+    task_pos = np.concatenate([fire_pos, search_pos])
+    # both (A, K) distance tables in one pass, as TaskGraph._agent_distances computes them
+    both = pairwise_distance(np.concatenate([agent_pos, tc.home]), task_pos)
+    n_a = len(agent_pos)
+    fields = dict(
+        task_ids=fire_ids + b._search_ids,
+        task_kind=task_kind,
+        task_pos=task_pos,
+        task_value=np.concatenate([counts * (1.0 + threat), search_value]),
+        task_cells=_cat_int(counts, b._search_only["task_cells"]),
+        task_staleness=np.concatenate([fire_stale, search_age]),
+        task_threat=np.concatenate([threat, np.zeros(n_search)]),
+        task_cluster=_cat_int(cluster, minus_s),
+        task_block=_cat_int(n_fire + fb, minus_s),
+        threat_time_s=threat_time,
+        known_cells=known_cells,
+    )
+    return fields, {"agent_task_distance": both[:n_a], "task_home_distance": both[n_a:]}

@@ -30,12 +30,13 @@ import numpy as np
 
 from fcplan.taskgraph.build import (
     TaskGraphBuilder,
-    _cat_int,
     _neighbours,
     _rect_distance,
+    graph_fields,
+    unique_ids,
 )
 from fcplan.taskgraph.clusters import EIGHT_CONNECTED
-from fcplan.taskgraph.types import TaskGraph, TaskKind, pairwise_distance
+from fcplan.taskgraph.types import TaskGraph
 
 __all__ = ["build_graphs"]
 
@@ -152,13 +153,11 @@ def _fire_graphs(
     out = []
     for j, (b, team, bel, tc) in enumerate(zip(builders, teams, beliefs, tcs, strict=True)):
         s, e = int(cuts[j]), int(cuts[j + 1])
-        fire_ids = tuple(ids[s:e])
-        if len(set(fire_ids)) != len(fire_ids):
-            fire_ids = tuple(f"{fid}#{k}" for k, fid in enumerate(fire_ids))
+        fire_ids = unique_ids(ids[s:e])
         cluster = clusters[s:e]
         threat = close[s:e].copy() @ consts.fac_pen if n_fac else np.zeros(e - s)
         agent_pos = team.pos.copy()
-        fields, views = _fields(
+        fields, views = graph_fields(
             b, tc, agent_pos, pos[s:e], counts[s:e], stale[s:e], cluster, threat,
             threat_time[s:e], fb[s:e], ages[j], search_value[j], fire_ids, known_cells[j],
         )  # fmt: skip
@@ -182,34 +181,3 @@ def _labels(world: np.ndarray, tx: np.ndarray, ty: np.ndarray, cuts: np.ndarray,
     out: np.ndarray = labels[rows, ty].astype(np.int64)
     out -= np.repeat(out[cuts[:-1]], np.diff(cuts))
     return out
-
-
-def _fields(b: TaskGraphBuilder, tc: Any, agent_pos: np.ndarray, fire_pos: np.ndarray,
-            counts: np.ndarray, fire_stale: np.ndarray, cluster: np.ndarray, threat: np.ndarray,
-            threat_time: np.ndarray, fb: np.ndarray, search_age: np.ndarray,
-            search_value: np.ndarray, fire_ids: tuple[str, ...],
-            known_cells: int) -> tuple[dict[str, Any], dict[str, Any]]:  # fmt: skip
-    """One world's task fields and views (the end of ``TaskGraphBuilder._fire_fields``)."""
-    n_fire = len(fire_pos)
-    search_pos = b._search_pos
-    n_search = len(search_pos)
-    task_kind = np.full(n_fire + n_search, int(TaskKind.SEARCH), dtype=np.int8)
-    task_kind[:n_fire] = int(TaskKind.FIRE)
-    minus_s = b._search_only["task_cluster"]
-    task_pos = np.concatenate([fire_pos, search_pos])
-    both = pairwise_distance(np.concatenate([agent_pos, tc.home]), task_pos)
-    n_a = len(agent_pos)
-    fields = dict(
-        task_ids=fire_ids + b._search_ids,
-        task_kind=task_kind,
-        task_pos=task_pos,
-        task_value=np.concatenate([counts * (1.0 + threat), search_value]),
-        task_cells=_cat_int(counts, b._search_only["task_cells"]),
-        task_staleness=np.concatenate([fire_stale, search_age]),
-        task_threat=np.concatenate([threat, np.zeros(n_search)]),
-        task_cluster=_cat_int(cluster, minus_s),
-        task_block=_cat_int(n_fire + fb, minus_s),
-        threat_time_s=threat_time,
-        known_cells=known_cells,
-    )
-    return fields, {"agent_task_distance": both[:n_a], "task_home_distance": both[n_a:]}
