@@ -17,7 +17,9 @@ Bit-identity with :class:`fcplan.fire.Fire` of the same seed:
 * the wind of the next ``L`` steps is drawn ahead per world by the single fire's own kernels
   (:func:`fcplan._fast.fire.draw_ahead`, ``draw_ahead_tables``) on buffers of the same shape,
   block by block at the steps where the single fire refills (step ``1 + k L``): the sines,
-  cosines and ``C/R`` come from the same calls on the same arrays;
+  cosines and ``C/R`` come from the same calls on the same arrays; in the tables model the
+  worlds refilling at one step draw their table indices with the same call each, and the
+  lookups are one gather for all of them (tested bit-equal to the kernel);
 * the per-step arithmetic is the rule's, ``C = terrain * fuel * (C/R)``, ``x += C sin``,
   ``y += C cos``, element by element (correctly rounded operations only); ``C/R`` of the fresh
   model with more than :data:`fcplan.farsite.INTERP_MAX` fronts is computed the way the single

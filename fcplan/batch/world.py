@@ -362,6 +362,8 @@ class BatchWorld:
         if rows.size == 0:
             return
         k = self.tick[rows] - 1
+        if rows.size == self.num and k[0] == k[-1] and (k == k[0]).all():
+            k, rows = int(k[0]), slice(None)  # type: ignore[assignment]  # (all at one tick)
         c = self._counts
         c[0, rows, k] = self.fire.n_burning[rows]
         c[1, rows, k] = self.fire.n_pruned[rows]

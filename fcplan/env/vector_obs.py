@@ -17,7 +17,8 @@ counts behind the scaled channels. All ``B N`` crops are one fancy-indexed gathe
 the channels last, each window row is one run of ``7 view`` floats, and the gather runs about
 twice as fast as from channel-first maps (``bench/README.md``). The staleness
 ``min(1, seen + tick scale)`` is then computed on the crops only, as the same float32 operations
-as the single map's.
+as the single map's. The true burning layer behind :meth:`BatchMotionObs.state` is brought up to
+date only when read (the fire's changes are queued per tick, as the single map queues them).
 
 Examples
 --------
