@@ -102,7 +102,7 @@ def single_env(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
 _PARTS = [
     (bworld.BatchWorld, "step", "sim"),
     (bworld.BatchWorld, "_fire_steps", "sim: fire"),
-    (bfire.BatchFire, "_refill", "sim: fire: wind blocks"),
+    (bfire.BatchFire, "_refill_worlds", "sim: fire: wind blocks"),
     (bfire.BatchFire, "_terrain", "sim: fire: terrain"),
     (bfire.BatchFire, "ignite", "sim: fire: ignition"),
     (bworld.BatchWorld, "_sense", "sim: sensing"),

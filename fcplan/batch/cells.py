@@ -49,6 +49,7 @@ SENSED = 4
 #: the bits of a cell's byte holding its fire state
 STATE_BITS = 3
 _LX = np.arange(BLOCK, dtype=np.int64)
+_ONE = np.int32(1)
 
 
 class CellGrid:
@@ -76,6 +77,9 @@ class CellGrid:
         self.nb = nb = -(-self.world_size // BLOCK)
         self.per_world = nb * nb * BLOCK * BLOCK
         self.state = np.zeros((self.num, nb * nb, BLOCK * BLOCK), dtype=np.uint8)
+        # written once now: the memory is mapped here rather than page by page by the first
+        # fires, inside the first steps (each world's fires spread over its whole block range)
+        self.state.fill(0)
         self.flat_state = self.state.reshape(-1)
         self.blocks = np.zeros((self.num, nb * nb), dtype=np.int32)
         self.flat_blocks = self.blocks.reshape(-1)
@@ -99,10 +103,13 @@ class CellGrid:
         """Add ``sign`` per cell ``(x, y)`` of ``world`` to the burning counts of its block and
         super-block (cells that started or stopped burning)."""
         ufunc = np.add if sign > 0 else np.subtract
-        ufunc.at(self.flat_blocks, self.block_index(world, x, y), 1)
+        # (the one as an int32 scalar: a Python int sends ufunc.at down a path 20x slower)
+        ufunc.at(self.flat_blocks, self.block_index(world, x, y), _ONE)
         ns = self.ns
         ufunc.at(
-            self.flat_supers, world * (ns * ns) + (x >> _SUPER_SHIFT) * ns + (y >> _SUPER_SHIFT), 1
+            self.flat_supers,
+            world * (ns * ns) + (x >> _SUPER_SHIFT) * ns + (y >> _SUPER_SHIFT),
+            _ONE,
         )
 
     def touch(self, worlds: np.ndarray, lo: tuple, hi: tuple) -> None:
@@ -167,41 +174,51 @@ def scan_boxes(
     hit = test(grid.state.reshape(-1, BLOCK * BLOCK)[blk]).reshape(-1, BLOCK, BLOCK)
     cx = (bx << _SHIFT)[:, None] + _LX  # (K, 16) cell x of each block row
     cy = (by << _SHIFT)[:, None] + _LX
-    in_x = (cx >= x0[rep, None]) & (cx <= x1[rep, None])
-    in_y = (cy >= y0[rep, None]) & (cy <= y1[rep, None])
-    hit &= in_x[:, :, None]
-    hit &= in_y[:, None, :]
-    k, i, j = np.nonzero(hit)
-    if k.size == 0:
+    # (only the blocks that stick out of their box need the box's bounds)
+    edge = np.flatnonzero(
+        (cx[:, 0] < x0[rep]) | (cx[:, -1] > x1[rep]) | (cy[:, 0] < y0[rep]) | (cy[:, -1] > y1[rep])
+    )
+    if edge.size:
+        re = rep[edge]
+        in_x = (cx[edge] >= x0[re, None]) & (cx[edge] <= x1[re, None])
+        in_y = (cy[edge] >= y0[re, None]) & (cy[edge] <= y1[re, None])
+        hit[edge] &= in_x[:, :, None] & in_y[:, None, :]
+    at = np.flatnonzero(hit)
+    if at.size == 0:
         return _EMPTY, _EMPTY, _EMPTY
-    key = (rep[k] * w + cx[k, i]) * w + cy[k, j]
+    k = at >> (2 * _SHIFT)
+    # one sortable key per hit: box, then x, then y, in bit fields
+    shift = int(w - 1).bit_length()
+    key = (rep[k] << (2 * shift)) | ((cx[k, 0] + ((at >> _SHIFT) & _LOW)) << shift)
+    key |= cy[k, 0] + (at & _LOW)
     key.sort()
-    ww = w * w
-    pair, rem = np.divmod(key, ww)
-    x, y = np.divmod(rem, w)
-    return pair, x, y
-
-
-def _ragged(lo_x: np.ndarray, hi_x: np.ndarray, lo_y: np.ndarray, hi_y: np.ndarray) -> tuple:
-    """Every ``(i, x, y)`` with ``lo_x[i] <= x <= hi_x[i]``, ``lo_y[i] <= y <= hi_y[i]``."""
-    ny = hi_y - lo_y + 1
-    count = (hi_x - lo_x + 1) * ny
-    rep = np.repeat(np.arange(lo_x.size), count)
-    local = np.arange(rep.size) - np.repeat(np.cumsum(count) - count, count)
-    n = ny[rep]
-    return rep, lo_x[rep] + local // n, lo_y[rep] + local % n
+    mask = (1 << shift) - 1
+    return key >> (2 * shift), (key >> shift) & mask, key & mask
 
 
 def _blocks_with_fire(grid: CellGrid, world: np.ndarray, x0: np.ndarray, x1: np.ndarray,
                       y0: np.ndarray, y1: np.ndarray) -> tuple:  # fmt: skip
     """``(box, bx, by)`` of every block holding a burning cell inside each box: the super-blocks
-    of the box first (4 x 4 blocks each), then the blocks of the super-blocks with fire."""
+    of the box first (4 x 4 blocks each, as one padded grid per box), then the blocks of the
+    super-blocks with fire."""
     ns, nb = grid.ns, grid.nb
+    if world.size == 0:
+        return _EMPTY, _EMPTY, _EMPTY
     bx0, bx1, by0, by1 = x0 >> _SHIFT, x1 >> _SHIFT, y0 >> _SHIFT, y1 >> _SHIFT
     k = _SUPER_SHIFT - _SHIFT
-    rep, sx, sy = _ragged(bx0 >> k, bx1 >> k, by0 >> k, by1 >> k)
-    hot = np.flatnonzero(grid.flat_supers[world[rep] * (ns * ns) + sx * ns + sy])
-    rep, sx, sy = rep[hot], sx[hot], sy[hot]
+    sx0, sy0 = bx0 >> k, by0 >> k
+    nx, ny = (bx1 >> k) - sx0 + 1, (by1 >> k) - sy0 + 1
+    kx, ky = int(nx.max()), int(ny.max())
+    ax, ay = np.arange(kx), np.arange(ky)
+    sx = np.minimum(sx0[:, None] + ax, ns - 1)  # (P, kx); clipped: masked out below
+    sy = np.minimum(sy0[:, None] + ay, ns - 1)
+    cell = ((world * ns)[:, None] + sx) * ns  # (P, kx)
+    hot = grid.flat_supers[cell[:, :, None] + sy[:, None, :]] > 0
+    hot &= (ax < nx[:, None])[:, :, None] & (ay < ny[:, None])[:, None, :]
+    at = np.flatnonzero(hot)
+    rep = at // (kx * ky)
+    sx = sx0[rep] + (at // ky) % kx
+    sy = sy0[rep] + at % ky
     bx = ((sx << k)[:, None] + _SUB[0]).reshape(-1)
     by = ((sy << k)[:, None] + _SUB[1]).reshape(-1)
     rep = np.repeat(rep, SUPER * SUPER)

@@ -17,7 +17,9 @@ Bit-identity with :class:`fcplan.fire.Fire` of the same seed:
 * the wind of the next ``L`` steps is drawn ahead per world by the single fire's own kernels
   (:func:`fcplan._fast.fire.draw_ahead`, ``draw_ahead_tables``) on buffers of the same shape,
   block by block at the steps where the single fire refills (step ``1 + k L``): the sines,
-  cosines and ``C/R`` come from the same calls on the same arrays;
+  cosines and ``C/R`` come from the same calls on the same arrays; in the tables model the
+  worlds refilling at one step draw their table indices with the same call each, and the
+  lookups are one gather for all of them (tested bit-equal to the kernel);
 * the per-step arithmetic is the rule's, ``C = terrain * fuel * (C/R)``, ``x += C sin``,
   ``y += C cos``, element by element (correctly rounded operations only); ``C/R`` of the fresh
   model with more than :data:`fcplan.farsite.INTERP_MAX` fronts is computed the way the single
@@ -84,6 +86,8 @@ class BatchFire:
         regions = scenario.regions
         self.num, self.grid = int(num), grid
         self.world_size = w = scenario.world_size
+        self._shift = int(w - 1).bit_length()
+        self._mask = (1 << self._shift) - 1
         self.ticks_per_second = scenario.ticks_per_second
         n_per = np.array([int(r.fronts) for r in regions], dtype=np.int64)
         self.region = np.repeat(np.arange(len(regions), dtype=np.int64), n_per)
@@ -171,8 +175,9 @@ class BatchFire:
         if np.count_nonzero(waking):
             parts.append(self._wake(waking))
         row = (self.n_steps - 1) % self.pre_len
-        for b in np.flatnonzero(take & (row == 0)).tolist():
-            self._refill(b)
+        due = np.flatnonzero(take & (row == 0))
+        if due.size:
+            self._refill_worlds(due)
         moving = self.alive & ~self.frozen
         moving &= self.region_active[:, self.region]
         moving &= take[:, None]
@@ -218,6 +223,29 @@ class BatchFire:
         draw_ahead(
             rng, self.pre_z[b], self.pre_sc[b], ratio, self._wind, self._theta, *sd, interp_ratio
         )
+
+    def _refill_worlds(self, worlds: np.ndarray) -> None:
+        """:meth:`_refill` of each world of ``worlds`` (distinct): in the tables model the draws
+        are one generator call per world and the table lookups one gather for all of them (the
+        same values :func:`~fcplan._fast.fire.draw_ahead_tables` picks), else world by world."""
+        if not self.tables or worlds.size == 1:
+            for b in worlds.tolist():
+                self._refill(b)
+            return
+        shape = self.pre_z.shape[1:]
+        w = self.world_size
+        rngs = [self.rngs[b] for b in worlds.tolist()]
+        idx = np.stack([g.integers(0, w, size=shape) for g in rngs if g is not None])
+        idx += self._tab_base
+        n_tab = self._tab.shape[2]
+        at = (worlds * (4 * n_tab))[:, None, None]
+        i_u, i_dir = idx[:, :, 0] + at, idx[:, :, 1] + at
+        tab = self._tab.reshape(-1)
+        assert self.pre_ratio is not None
+        self.pre_z[worlds, :, 0] = tab[i_u]
+        self.pre_ratio[worlds] = tab[i_u + 3 * n_tab]
+        self.pre_sc[worlds, :, 0] = tab[i_dir + n_tab]
+        self.pre_sc[worlds, :, 1] = tab[i_dir + 2 * n_tab]
 
     def _ratio(self, wb: np.ndarray, f: np.ndarray, r: np.ndarray) -> np.ndarray:
         """C/R of moving fronts ``(wb, f)`` on their rows ``r`` of the wind drawn ahead."""
@@ -278,12 +306,12 @@ class BatchFire:
     def ignite(self, wb: np.ndarray, x: np.ndarray, y: np.ndarray) -> Cells:
         """Set the unburnt cells among ``(wb, x, y)`` burning; return them (unique, sorted by
         world then flat index)."""
-        grid, w = self.grid, self.world_size
+        grid = self.grid
         if wb.size == 0:
             return _EMPTY, _EMPTY, _EMPTY
-        key = unique((wb * w + x) * w + y)
-        wb, rem = np.divmod(key, w * w)
-        x, y = np.divmod(rem, w)
+        sh = self._shift  # (a sortable key per cell: world, x, y in bit fields)
+        key = unique((wb << (2 * sh)) | (x << sh) | y)
+        wb, x, y = key >> (2 * sh), (key >> sh) & self._mask, key & self._mask
         g = grid.index(wb, x, y)
         fresh = grid.flat_state[g] & STATE_BITS == UNBURNT
         if not fresh.all():

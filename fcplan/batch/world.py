@@ -131,6 +131,8 @@ class BatchWorld:
         self.fire = BatchFire(scenario, b, self.grid)
         self.team = BatchTeam(scenario, b)
         self._sensing = np.flatnonzero(self.team.can_sense)
+        self._shift = int(w - 1).bit_length()  # (bit fields of sortable (world, x, y) keys)
+        self._mask = (1 << self._shift) - 1
         self._sense_streams = UniformBlocks(b)
         self._prune_streams = UniformBlocks(b)
         self.controller_rngs: list[np.random.Generator | None] = [None] * b
@@ -243,7 +245,9 @@ class BatchWorld:
         lab = self.facility_labels[flat]
         inside = lab >= 0
         if np.count_nonzero(inside):
-            np.add.at(into.reshape(-1), wb[inside] * self.n_facilities + lab[inside], sign)
+            np.add.at(
+                into.reshape(-1), wb[inside] * self.n_facilities + lab[inside], np.int64(sign)
+            )
 
     # ------------------------------------------------------------------ sensing and dumps
     def _boxes(self, rects: np.ndarray, box: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -277,10 +281,13 @@ class BatchWorld:
         if self.tps != 10:  # (Python floats: the single world's own power function)
             conf = np.array([per_tick_probability(float(c), self.tps) for c in conf.tolist()])
         keep = u < conf[pair]
-        wb, flat = wb[keep], x[keep] * self.world_size + y[keep]
-        key = unique(wb * self.world_size**2 + flat)
-        wb, flat = np.divmod(key, self.world_size**2)
-        g = self.grid.index(wb, *np.divmod(flat, self.world_size))
+        wb, x, y = wb[keep], x[keep], y[keep]
+        if np.count_nonzero(pw[1:] == pw[:-1]):  # two agents of a world may see the same cell
+            sh = self._shift
+            key = unique((wb << (2 * sh)) | (x << sh) | y)
+            wb, x, y = key >> (2 * sh), (key >> sh) & self._mask, key & self._mask
+        flat = x * self.world_size + y
+        g = self.grid.index(wb, x, y)
         new = (self.grid.flat_state[g] & SENSED) == 0
         if np.count_nonzero(new):
             self.grid.flat_state[g[new]] |= SENSED
@@ -355,6 +362,8 @@ class BatchWorld:
         if rows.size == 0:
             return
         k = self.tick[rows] - 1
+        if rows.size == self.num and k[0] == k[-1] and (k == k[0]).all():
+            k, rows = int(k[0]), slice(None)  # type: ignore[assignment]  # (all at one tick)
         c = self._counts
         c[0, rows, k] = self.fire.n_burning[rows]
         c[1, rows, k] = self.fire.n_pruned[rows]

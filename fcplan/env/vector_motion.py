@@ -106,6 +106,7 @@ class VectorMotionEnv(BatchedEnv):
         self.views = BatchMotionObs(sc, b, cell_px=int(cell_px), view=int(view), stale_s=stale_s)
         self.agent_ids = list(self.batch.team.ids)
         self._actions_table()
+        self._rows = np.arange(b)[:, None]
         n, v = len(self.agent_ids), int(view)
         n_max = self.views.n_max
         self.single_observation_space = spaces.Dict(
@@ -212,7 +213,7 @@ class VectorMotionEnv(BatchedEnv):
         """Write the legal actions of the worlds ``run`` into the teams (``MotionEnv.step``)."""
         team, views = self.batch.team, self.views
         j = np.arange(act.shape[1])
-        legal = np.take_along_axis(views.masks, act[:, :, None], axis=2)[:, :, 0]
+        legal = views.masks[self._rows, j, act]
         kind = np.where(legal & run[:, None], self._kind[j, act], _STAY)
         move = kind == _MOVE
         if np.count_nonzero(move):

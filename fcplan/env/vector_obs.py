@@ -9,15 +9,19 @@ once, exactly what :class:`fcplan.env.motion_obs.MotionObs` builds for one world
 Coarse maps. Every world keeps the seven observation channels of its coarse cells, padded by
 ``view // 2`` cells as in :class:`fcplan.env.motion_grid.CoarseMaps`, *channel last*:
 :attr:`BatchMotionObs.maps` is ``(B, H, H, 7)`` float32 holding known (scaled, clipped), pruned
-(scaled, clipped), ``seen`` (minus the tick each cell was last covered, times the staleness scale;
-``+inf`` never), agents (0/1), and the scenario's static outside, lake and facility shares (the
-same in every world, copied once). ``counts`` ``(B, H, H, 2)`` holds the known and pruned cell
-counts behind the scaled channels. All ``B N`` crops are one fancy-indexed gather of
-``sliding_window_view(maps)``, which yields them directly in the ``(7, view, view)`` layout; with
-the channels last, each window row is one run of ``7 view`` floats, and the gather runs about
-twice as fast as from channel-first maps (``bench/README.md``). The staleness
-``min(1, seen + tick scale)`` is then computed on the crops only, as the same float32 operations
-as the single map's.
+(scaled, clipped), a staleness slot, agents (0/1), and the scenario's static outside, lake and
+facility shares (the same in every world, copied once). ``counts`` ``(B, H, H, 2)`` holds the
+known and pruned cell counts behind the scaled channels. ``seen`` (minus the tick each cell was
+last covered, times the staleness scale; ``+inf`` never) is kept apart, :attr:`BatchMotionObs.seen`
+``(B, H, H)``, so that covering the fields of view each tick writes a compact array. All ``B N``
+crops are one fancy-indexed gather of ``sliding_window_view(maps)``, which yields them directly in
+the ``(7, view, view)`` layout; with the channels last, each window row is one run of ``7 view``
+floats, and the gather runs about twice as fast as from channel-first maps
+(``bench/README.md``). The staleness ``min(1, seen + tick scale)`` is then computed on the
+crops of ``seen`` only (a second, compact gather), as the same float32 operations as the single
+map's, and written into the crops' staleness slot. The true burning layer behind
+:meth:`BatchMotionObs.state` is brought up to date only when read (the fire's changes are queued
+per tick, as the single map queues them).
 
 Examples
 --------
@@ -51,6 +55,7 @@ __all__ = ["BatchMotionObs", "role_letters"]
 #: the channels of :attr:`BatchMotionObs.maps` that differ between worlds
 D_KNOWN, D_PRUNED, D_SEEN, D_AGENTS = range(4)
 _ONE32 = np.float32(1.0)
+_PENDING_MAX = 1 << 16  # (queued fire cells of the burning layer before it is updated)
 _ACTIVE = 1
 
 
@@ -93,9 +98,14 @@ class BatchMotionObs:
         self.maps[..., 4:] = np.moveaxis(self.static, 0, 2)
         self.counts = np.zeros((self.num, h, h, 2), dtype=np.float32)
         self.burning = np.zeros((self.num, h, h), dtype=np.float32)  # (state(): true fire)
+        self._pending: list[tuple[np.ndarray, np.ndarray, float]] = []  # (see _flush)
+        self._n_pending = 0
         v = self.view
         #: (B, H - v + 1, H - v + 1, 7, v, v) windows: a crop is ``windows[b, cx, cy]``
         self.windows = sliding_window_view(self.maps, (v, v), axis=(1, 2))
+        #: (B, H, H) float32: the ``seen`` channel, kept apart (module docstring)
+        self.seen = np.full((self.num, h, h), np.inf, dtype=np.float32)
+        self._seen_windows = sliding_window_view(self.seen, (v, v), axis=(1, 2))
         self._inv_c = 1.0 / self.cell_px
         letters = role_letters(sc)
         self.letters = letters
@@ -108,6 +118,8 @@ class BatchMotionObs:
         self.free = np.zeros((self.num, n), dtype=bool)
         self.masks = np.zeros((self.num, n, self.n_max), dtype=bool)
         self._mask_cols = self._mask_columns(letters)
+        self._agent_col = np.arange(n)[:, None]
+        self._world_of = np.repeat(np.arange(self.num), n)  # (B N,) world of each agent
 
     @staticmethod
     def _mask_columns(letters: list[str]) -> np.ndarray:
@@ -123,8 +135,9 @@ class BatchMotionObs:
     def reset_worlds(self, rows: np.ndarray) -> None:
         """Fresh maps for the worlds ``rows``: no fire known, nothing seen, no agent placed."""
         self.maps[rows, :, :, :4] = 0.0
-        self.maps[rows, :, :, D_SEEN] = np.inf
+        self.seen[rows] = np.inf
         self.counts[rows] = 0.0
+        self._flush()
         self.burning[rows] = 0.0
         self._ever[rows] = False
 
@@ -143,27 +156,45 @@ class BatchMotionObs:
         cell = wb * (self.h * self.h) + self._plane(flat)
         ic = cell * 2 + layer
         counts = self.counts.reshape(-1)
-        np.add.at(counts, ic, sign)
+        np.add.at(counts, ic, np.float32(sign))  # (a float32 scalar: ufunc.at's fast path)
         self.maps.reshape(-1)[cell * N_FOV + layer] = np.minimum(counts[ic] * self._inv_c, 1.0)
 
     def update(self, info: BatchStepInfo, batch: BatchWorld) -> None:
         """Fold one batch tick into the maps (:meth:`fcplan.env.motion_grid.CoarseMaps.update`)."""
         self._add(D_KNOWN, *info.newly_sensed, 1.0)
-        hh = self.h * self.h
         wb, flat = info.ignited
         if wb.size:
-            np.add.at(self.burning.reshape(-1), wb * hh + self._plane(flat), 1.0)
+            self._pending.append((wb, flat, 1.0))
+            self._n_pending += wb.size
         wb, flat = info.pruned
         if wb.size:
-            np.add.at(self.burning.reshape(-1), wb * hh + self._plane(flat), -1.0)
+            self._pending.append((wb, flat, -1.0))
+            self._n_pending += wb.size
             self._add(D_PRUNED, wb, flat, 1.0)
             x, y = np.divmod(flat, self.world_size)
             sensed = (batch.grid.flat_state[batch.grid.index(wb, x, y)] & SENSED) > 0
             self._add(D_KNOWN, wb[sensed], flat[sensed], -1.0)
+        if self._n_pending > _PENDING_MAX:
+            self._flush()
         ran = info.ran
         if np.count_nonzero(ran):
             stamp = (batch.tick * self.seen_scale).astype(np.float32)
             self._cover(info.fov[:, self._sensing], -stamp, ran)
+
+    def _flush(self) -> None:
+        """Bring :attr:`burning` up to date: the ignited and pruned cells of the ticks since the
+        last call, queued by :meth:`update` (only :meth:`state` reads the layer), go in with one
+        ``np.add.at`` (exact: the counts are whole numbers)."""
+        if not self._pending:
+            return
+        wb, flat, sign = zip(*self._pending, strict=True)
+        self._pending.clear()
+        self._n_pending = 0
+        cell = np.concatenate(wb) * (self.h * self.h) + self._plane(np.concatenate(flat))
+        one = np.concatenate(
+            [np.full(a.size, g, np.float32) for a, g in zip(wb, sign, strict=True)]
+        )
+        np.add.at(self.burning.reshape(-1), cell, one)
 
     def _cover(self, rects: np.ndarray, value: np.ndarray, ran: np.ndarray) -> None:
         """Mark the coarse cells overlapping each rectangle ``rects[b, j]`` of the worlds ``ran``
@@ -185,7 +216,7 @@ class BatchMotionObs:
         i = i0[rep] + local // nj[rep] + r
         j = j0[rep] + local % nj[rep] + r
         wr = wb[rep]
-        self.maps.reshape(-1)[((wr * h + i) * h + j) * N_FOV + D_SEEN] = value[wr]
+        self.seen.reshape(-1)[(wr * h + i) * h + j] = value[wr]
 
     # ------------------------------------------------------------------ observations
     def agent_arrays(self, batch: BatchWorld) -> tuple[np.ndarray, np.ndarray]:
@@ -224,8 +255,7 @@ class BatchMotionObs:
         cond[..., 5] = zt < team.alt_hi - 1e-9
         cond[..., 6] = zt > team.alt_lo + 1e-9
         cond[..., 7] = free & (team.tank > 0)
-        cols = np.broadcast_to(self._mask_cols, (self.num, *self._mask_cols.shape))
-        masks = np.take_along_axis(cond, cols, axis=2)
+        masks = cond[:, self._agent_col, self._mask_cols]
         self.free, self.masks = free, masks
         return v.astype(np.float32), masks.view(np.int8)
 
@@ -250,13 +280,14 @@ class BatchMotionObs:
         cx = (pos[..., 0] // self.cell_px).astype(np.int64)
         cy = (pos[..., 1] // self.cell_px).astype(np.int64)
         shared = self._place_agents(cx, cy)
-        b = np.repeat(np.arange(self.num), self.n)
         v = self.view
-        fov = self.windows[b, cx.reshape(-1), cy.reshape(-1)]  # (one gather of B N crops)
+        fov = self.windows[self._world_of, cx.reshape(-1), cy.reshape(-1)]  # (one gather)
         stamp = (batch.tick * self.seen_scale).astype(np.float32)
-        stale = fov[:, D_SEEN]
-        stale += np.repeat(stamp, self.n)[:, None, None]
-        np.minimum(stale, _ONE32, out=stale)
+        seen = self._seen_windows[self._world_of, cx.reshape(-1), cy.reshape(-1)]
+        seen = seen.reshape(self.num, self.n, v * v)
+        seen += stamp[:, None, None]
+        stale = fov.reshape(self.num, self.n, N_FOV, v * v)[:, :, D_SEEN]
+        np.minimum(seen, _ONE32, out=stale)
         fov[:, D_AGENTS, self.radius, self.radius] = shared.reshape(-1)
         fov = fov.reshape(self.num, self.n, N_FOV, v, v)
         return {"fov": fov, "agent": vec, "action_mask": masks}
@@ -264,18 +295,19 @@ class BatchMotionObs:
     def state(self, batch: BatchWorld) -> np.ndarray:
         """(B, 8, nc, nc) float32 global state of every world (``MotionObs.state``)."""
         r, nc, inv_c = self.radius, self.nc, 1.0 / self.cell_px
+        self._flush()
         inner = slice(r, r + nc)
         s = np.zeros((self.num, 8, nc, nc), dtype=np.float32)
         np.minimum(self.burning[:, inner, inner] * inv_c, 1.0, out=s[:, 0])
         np.minimum(self.counts[:, inner, inner, 0] * inv_c, 1.0, out=s[:, 1])
         np.minimum(self.counts[:, inner, inner, 1] * inv_c, 1.0, out=s[:, 2])
         stamp = (batch.tick * self.seen_scale).astype(np.float32)
-        np.minimum(self.maps[:, inner, inner, D_SEEN] + stamp[:, None, None], _ONE32, out=s[:, 3])
+        np.minimum(self.seen[:, inner, inner] + stamp[:, None, None], _ONE32, out=s[:, 3])
         team = batch.team
         cell = np.clip((team.pos // self.cell_px).astype(np.int64), 0, nc - 1)
         rows = np.broadcast_to(np.arange(self.num)[:, None], cell.shape[:2])
         for k, can in ((4, team.can_sense), (5, team.can_act)):
-            np.add.at(s[:, k], (rows[:, can], cell[:, can, 0], cell[:, can, 1]), 1.0)
+            np.add.at(s[:, k], (rows[:, can], cell[:, can, 0], cell[:, can, 1]), _ONE32)
         s[:, 6] = self.static[1, inner, inner]
         s[:, 7] = self.static[2, inner, inner]
         return s
