@@ -16,7 +16,6 @@ from fcplan.scenario import Role
 from fcplan.scheduling import SolveStats, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph, TaskKind, synthetic_task_graph
 from fcplan.team import Mode
-from fcplan.testing import episode_graphs as testing_graphs
 from solvers.routing import PyVRPRoutingScheduler, RoutingScheduler
 from tests.solvers.graphs import SCENARIOS, episode_graphs
 from tests.solvers.test_greedy import known_fire_graph
@@ -208,7 +207,7 @@ def test_equal_values_offer_the_nearest_candidates(backend):
     fcplan-bench-v1/scale-06 every one of 2,304 search blocks is worth the same, the first in
     task order lie 2,170 px or more from every perception vehicle (beyond its prize), and still
     every perception vehicle gets a route, to a block nearer than any of those."""
-    g = testing_graphs("fcplan-bench-v1/scale-06", (0,))[0]
+    g = episode_graphs("fcplan-bench-v1/scale-06", (0,))[0]
     plan = make_scheduler("routing", backend=backend, deterministic=True).plan(g)
     check_routing_plan(g, plan)
     perception = [a for a, r in zip(g.agent_ids, g.agent_role, strict=True) if r == Role.PERCEPTION]
