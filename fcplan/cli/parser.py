@@ -47,6 +47,7 @@ import fcplan.cli.scenario as scenario
 import fcplan.cli.scenarios as scenarios
 import fcplan.cli.schedulers as schedulers
 import fcplan.cli.sweep as sweep
+import fcplan.cli.verify as verify
 from fcplan.cli.util import CliError, Parser
 from fcplan.errors import FcplanError
 
@@ -68,6 +69,7 @@ COMMANDS = (
     sweep,
     report,
     leaderboard,
+    verify,
     replay,
     import_legacy,
 )

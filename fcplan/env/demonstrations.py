@@ -55,7 +55,6 @@ True
 from __future__ import annotations
 
 import json
-import platform
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -76,6 +75,7 @@ from fcplan.env.task_actions import MappingCounts
 from fcplan.env.task_candidates import AGENT_FEATURES, TASK_FEATURES
 from fcplan.errors import FcplanError
 from fcplan.mission import ScenarioLike, as_scenario
+from fcplan.provenance import library_versions
 from fcplan.scheduling import Scheduler, make_scheduler, parse_scheduler_spec
 
 __all__ = [
@@ -181,15 +181,7 @@ def load_demonstrations(path: str | Path) -> Demonstrations:
 
 
 def _versions() -> dict[str, str]:
-    from importlib.metadata import PackageNotFoundError, version
-
-    out = {"python": platform.python_version()}
-    for dist in ("fcplan", "numpy", "scipy", "pettingzoo", "gymnasium", "ortools"):
-        try:
-            out[dist] = version(dist)
-        except PackageNotFoundError:
-            out[dist] = "not installed"
-    return out
+    return library_versions(("fcplan", "numpy", "scipy", "pettingzoo", "gymnasium", "ortools"))
 
 
 def _scheduler(spec: str | Scheduler) -> tuple[Scheduler, str, dict[str, Any]]:

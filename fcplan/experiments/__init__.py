@@ -30,6 +30,9 @@ cores, and summarises the outcomes with confidence intervals.
   HTML: tables with confidence intervals, the statistics of the study, plots
   (:mod:`~fcplan.experiments.plots`); it refuses to pool different studies written into one
   folder (:mod:`~fcplan.experiments.studies`).
+* :mod:`~fcplan.experiments.verify`: :func:`verify_results` plays a sample of a folder's stored
+  episodes again and says which schedulers' results today's code no longer reproduces (stale
+  after a change of behaviour); every row also names its code (:mod:`fcplan.provenance`).
 
 Sweeps and comparisons run their episodes on the same backends
 (:mod:`~fcplan.experiments.backends`: in-process, a local process pool restarted when a worker
@@ -51,6 +54,7 @@ from fcplan.experiments.report import report
 from fcplan.experiments.results import ResultsError, load_results
 from fcplan.experiments.stats import MeanCI, mean_ci, paired_mean_ci
 from fcplan.experiments.sweep import SweepSummary, sweep
+from fcplan.experiments.verify import Verification, verify_results
 
 __all__ = [
     "compare",
@@ -67,4 +71,6 @@ __all__ = [
     "load_results",
     "ResultsError",
     "report",
+    "verify_results",
+    "Verification",
 ]

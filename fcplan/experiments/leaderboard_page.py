@@ -246,6 +246,12 @@ def markdown(board: Leaderboard, command: str = "") -> str:
         "",
         f"Libraries: {libs or 'not recorded'}.",
         "",
+        "Code (episodes per commit of fcplan): "
+        + ", ".join(f"{k} ({_count(n, 'episode')})" for k, n in m.get("code", {}).items())
+        + ". Results that span commits hold only if no change in between altered a scheduler's "
+        "behaviour: `fcplan verify RESULTS` plays a sample of the stored episodes again and names "
+        "the schedulers whose results today's code no longer reproduces.",
+        "",
     ]
     missing = _missing_tiers(board)
     if missing:

@@ -25,7 +25,9 @@ Row columns (one per episode; :func:`fcplan.experiments.load_results` reads them
   optimality gap on its own model, NaN where it proves none), ``replan_tasks``, ``replan_agents``;
 * ``status`` (``ok`` | ``failed``), ``error`` (``""`` or ``"ExcType: message"``),
   ``episode_wall_s`` (including scheduler construction), ``host``, ``finished_at`` (UTC ISO
-  time), ``versions`` (JSON: fcplan, python, numpy and the solver libraries in this worker).
+  time), ``versions`` (JSON: fcplan, python, numpy and the solver libraries in this worker),
+  ``code`` (JSON: the source digest, git commit and dirty flag of the code that played it,
+  :func:`fcplan.provenance.code_identity`).
 
 Examples
 --------
@@ -39,12 +41,10 @@ Examples
 
 from __future__ import annotations
 
-import contextlib
 import datetime as _dt
 import functools
 import json
 import math
-import platform
 import socket
 import time
 from collections.abc import Callable
@@ -52,7 +52,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["play_episode", "library_versions"]
+from fcplan import provenance
+
+__all__ = ["play_episode", "library_versions", "code_version"]
 
 _LIBRARIES = ("fcplan", "numpy", "scipy", "networkx", "ortools", "highspy", "cvxpy")
 
@@ -60,13 +62,13 @@ _LIBRARIES = ("fcplan", "numpy", "scipy", "networkx", "ortools", "highspy", "cvx
 @functools.cache
 def library_versions() -> str:
     """JSON text: the Python version and installed versions of fcplan and solver libraries."""
-    from importlib import metadata
+    return json.dumps(provenance.library_versions(_LIBRARIES), sort_keys=True)
 
-    out = {"python": platform.python_version()}
-    for lib in _LIBRARIES:
-        with contextlib.suppress(metadata.PackageNotFoundError):
-            out[lib] = metadata.version(lib)
-    return json.dumps(out, sort_keys=True)
+
+@functools.cache
+def code_version() -> str:
+    """JSON text: :func:`fcplan.provenance.code_identity` (source digest, git commit, dirty)."""
+    return json.dumps(provenance.code_identity(), sort_keys=True)
 
 
 def _base_row(spec: Any) -> dict[str, Any]:
@@ -164,5 +166,6 @@ def play_episode(spec: Any, runtime: dict[str, Callable[..., Any]] | None = None
         host=socket.gethostname(),
         finished_at=_dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         versions=library_versions(),
+        code=code_version(),
     )
     return row

@@ -18,7 +18,6 @@ Examples
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Mapping
 from dataclasses import asdict, is_dataclass
 from typing import Any
@@ -26,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from fcplan.errors import FcplanError
+from fcplan.provenance import library_versions
 from fcplan.trace import TRACE_FIELDS, TraceField
 
 __all__ = [
@@ -110,13 +110,7 @@ def jsonable(x: Any) -> Any:
 
 def versions() -> dict[str, str]:
     """Versions of fcplan, numpy and Python (kept in every header)."""
-    import fcplan
-
-    return {
-        "fcplan": fcplan.__version__,
-        "numpy": np.__version__,
-        "python": ".".join(map(str, sys.version_info[:3])),
-    }
+    return library_versions(("fcplan", "numpy"))
 
 
 def cast_entries(arrays: Mapping[str, Any]) -> dict[str, np.ndarray]:

@@ -50,7 +50,7 @@ def test_every_command_has_its_module_in_help_order(capsys):
     sub = parser.build_parser()._subparsers._group_actions[0]
     assert list(sub.choices) == [
         "scenarios", "scenario", "schedulers", "run", "compare", "play", "sweep", "report",
-        "leaderboard", "replay", "import-legacy",
+        "leaderboard", "verify", "replay", "import-legacy",
     ]  # fmt: skip
     assert tuple(m.__name__ for m in parser.COMMANDS) == COMMAND_MODULES
     for module in parser.COMMANDS:
@@ -71,6 +71,7 @@ def test_run_defaults_point_at_the_command_modules():
         ("sweep", "x.toml"): "fcplan.cli.sweep",
         ("report", "dir"): "fcplan.cli.report",
         ("leaderboard", "dir"): "fcplan.cli.leaderboard",
+        ("verify", "dir"): "fcplan.cli.verify",
         ("replay", "x.npz"): "fcplan.cli.replay",
         ("import-legacy", "dir"): "fcplan.cli.import_legacy",
     }

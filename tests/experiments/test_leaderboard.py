@@ -281,6 +281,28 @@ def test_page_from_a_real_sweep_names_suite_versions_and_wall_time(real_results)
     assert doc["tiers"][0]["stats"]["greedy"]["episodes"] == 4
 
 
+def test_page_names_the_code_each_episode_came_from(real_results):
+    """The page counts the episodes per code version (the commit of the rows' ``code``) and
+    points at `fcplan verify`; rows without the column are counted as not recorded."""
+    from fcplan.provenance import code_identity
+
+    ident = code_identity()
+    name = (
+        ident["commit"][:10] + ("+dirty" if ident["dirty"] else "")
+        if ident["commit"]
+        else f"source {ident['source']}"
+    )
+    rows = read_episodes(real_results)
+    assert leaderboard(rows).meta["code"] == {name: 16}
+    for r in rows[:3]:
+        del r["code"]
+    board = leaderboard(rows)
+    assert board.meta["code"] == {name: 13, "not recorded": 3}
+    page = markdown(board)
+    assert f"{name} (13 episodes), not recorded (3 episodes)" in page
+    assert "`fcplan verify RESULTS`" in page
+
+
 def test_compare_json_gives_the_same_tier(tmp_path):
     """A `fcplan compare --json` file is read like a results folder (its wall time is the
     comparison's)."""
