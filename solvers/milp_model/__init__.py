@@ -16,8 +16,9 @@ a cell put out or found ``t`` seconds from now stops costing (or can be put out)
 
 Routes (set partitioning)
 -------------------------
-For every agent, every route of at most ``slots`` fire tasks (dumps, capped by the tank), of one
-fire task to **watch** (a camera agent without water hovers over it at ``watch_altitude``), or of
+For every agent, every route of at most ``slots`` fire tasks (dumps, capped by the tank; a
+hybrid flies them at ``dump_altitude``, by default the top of its bounds: a dump puts out every
+sensed burning cell in view, and the view grows with the altitude), of one fire task to **watch** (a camera agent without water hovers over it at ``watch_altitude``), or of
 at most ``search_slots`` search blocks (flown at the altitude of best detection rate,
 :func:`~solvers.milp_model.sensing.best_search_altitude`) is enumerated over the agent's best
 ``fire_candidates`` / ``watch_candidates`` / ``search_candidates`` tasks

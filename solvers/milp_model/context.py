@@ -95,11 +95,20 @@ class BuildContext:
         return np.flatnonzero(d <= reach)
 
     def altitudes(self, agent: int) -> tuple[float, float]:
-        """(watch, search) altitudes of a camera agent, clipped to its bounds."""
+        """(fire, search) altitudes of a camera agent, clipped to its bounds. The fire altitude is
+        ``dump_altitude`` (default the top of the bounds) for an agent with water, whose fire
+        routes dump: a dump puts out the sensed burning cells in view, and the view grows with
+        the altitude. For a camera agent without water, whose fire routes watch, it is
+        ``watch_altitude`` (low: reliable sensing)."""
         g, p = self.graph, self.p
+        z_fire = p.watch_altitude
+        if bool(self.roles.dumper[agent]):
+            z_fire = (
+                float(g.agent_alt_range[agent][1]) if p.dump_altitude is None else p.dump_altitude
+            )
         lo, hi = (float(v) for v in g.agent_alt_range[agent])
         speed = float(g.agent_speed[agent])
         z_search = (
             best_search_altitude(lo, hi, speed) if p.search_altitude is None else p.search_altitude
         )
-        return g.clip_altitude(agent, p.watch_altitude), g.clip_altitude(agent, z_search)
+        return g.clip_altitude(agent, z_fire), g.clip_altitude(agent, z_search)

@@ -40,8 +40,8 @@ def decode_plan(
     """Turn a solution vector into a :class:`Plan`.
 
     Each chosen route becomes its agent's route (task ids in visiting order); agents with a
-    camera fly at the route's altitude (``watch_altitude`` for a watch or a dump route,
-    the search altitude for a search route, clipped to their bounds). Agents with no route
+    camera fly at the route's altitude (``watch_altitude`` for a watch route, ``dump_altitude``
+    for a hybrid's dump route, the search altitude for a search route, clipped to their bounds). Agents with no route
     chosen are not mentioned (they keep their current route).
 
     Parameters

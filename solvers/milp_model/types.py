@@ -87,6 +87,11 @@ class MilpParams:
         Steps of a block's detected share in the cover variables (1..1000; 100: percent).
     watch_altitude : float
         Altitude (m) of an agent watching a fire (clipped to its bounds).
+    dump_altitude : float or None
+        Altitude (m) of a camera agent with water (a hybrid) on a dump route, clipped to its
+        bounds. A dump puts out the sensed burning cells in the agent's field of view, which is
+        ``2 z x 1.15 z`` px at altitude ``z``; None (default): the top of the agent's bounds, the
+        widest dump.
     search_altitude : float or None
         Altitude (m) of a searching agent; None: the altitude of its best detection rate
         (:func:`solvers.milp_model.sensing.best_search_altitude`).
@@ -116,6 +121,7 @@ class MilpParams:
     search_block_px: float = 100.0
     cover_levels: int = 10
     watch_altitude: float = 35.0
+    dump_altitude: float | None = None
     search_altitude: float | None = None
     max_routes: int = 20_000
     max_scored_ends: int = 256
@@ -138,6 +144,8 @@ class MilpParams:
         float_setting("search_block_px", self.search_block_px, 0.0, lo_open=True, unit=" px")
         int_setting("cover_levels", self.cover_levels, 1, 1000)
         float_setting("watch_altitude", self.watch_altitude, 0.0, unit=" m")
+        if self.dump_altitude is not None:
+            float_setting("dump_altitude", self.dump_altitude, 0.0, unit=" m")
         if self.search_altitude is not None:
             float_setting("search_altitude", self.search_altitude, 0.0, unit=" m")
         int_setting("max_routes", self.max_routes, 1)

@@ -395,6 +395,31 @@ def test_decoded_routes_follow_route_order_and_altitudes():
             assert plan.altitudes[a] == pytest.approx(g.clip_altitude(i, want))
 
 
+def test_hybrids_dump_from_the_top_of_their_bounds():
+    """A hybrid with water flies its dump routes at the top of its altitude bounds (a dump puts
+    out every sensed burning cell in view, and the view grows with the altitude), or at
+    ``dump_altitude`` when set; with an empty tank its fire routes are watches, at the watch
+    altitude. Perception agents watch at the watch altitude either way."""
+    g = next(g for g in episode_graphs("open_world_example") if g.fire_tasks.size)
+    hybrids = np.flatnonzero(g.agent_can_act & g.agent_can_sense & (g.agent_tank > 0))
+    assert hybrids.size
+    for dump_z in (None, 40.0):
+        m = build_milp_model(g, MilpParams(dump_altitude=dump_z))
+        for a in hybrids.tolist():
+            want = g.agent_alt_range[a][1] if dump_z is None else g.clip_altitude(a, dump_z)
+            dumps = (m.route_agent == a) & (m.route_kind == DUMP)
+            assert dumps.any() and np.allclose(m.altitude[dumps], want)
+        watchers = (m.route_kind == WATCH) & ~g.agent_can_act[m.route_agent]
+        z = np.array([g.clip_altitude(a, 35.0) for a in m.route_agent[watchers].tolist()])
+        assert np.allclose(m.altitude[watchers], z)
+    dry = dataclasses.replace(g, agent_tank=np.where(g.agent_can_sense, 0, g.agent_tank))
+    m = build_milp_model(dry, MilpParams())
+    for a in hybrids.tolist():
+        fire_routes = (m.route_agent == a) & (m.route_kind != SEARCH)
+        assert not ((m.route_agent == a) & (m.route_kind == DUMP)).any()
+        assert np.allclose(m.altitude[fire_routes], g.clip_altitude(a, 35.0))
+
+
 @settings(max_examples=15, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1))
 def test_plan_objective_scores_other_schedulers_below_the_optimum(seed):
