@@ -34,13 +34,14 @@ from __future__ import annotations
 import functools
 import hashlib
 import importlib.util
+import json
 import platform
 import subprocess
 from collections.abc import Iterable
 from importlib import metadata
 from pathlib import Path
 
-__all__ = ["PACKAGES", "code_identity", "library_versions", "source_files"]
+__all__ = ["PACKAGES", "code_identity", "count_code_versions", "library_versions", "source_files"]
 
 #: The packages whose code decides a result (the simulator, metrics and the built-in schedulers).
 PACKAGES = ("fcplan", "solvers")
@@ -141,3 +142,36 @@ def code_identity() -> dict[str, str | bool | None]:
             status = _git(Path(top), "status", "--porcelain", "--", *rel)
             dirty = None if status is None else bool(status)
     return {"source": source, "commit": commit, "dirty": dirty}
+
+
+def count_code_versions(codes: Iterable[object]) -> dict[str, int]:
+    """How many results came from each code version, most first.
+
+    Parameters
+    ----------
+    codes : iterable
+        The results' ``code`` values (JSON text of :func:`code_identity`; anything else, e.g.
+        a missing value of a row written before the column existed, counts as not recorded).
+
+    Returns
+    -------
+    dict
+        ``{name: count}``: the commit's first 10 digits (``+dirty`` when its files differed),
+        else ``source <digest>``, else ``not recorded``.
+
+    Examples
+    --------
+    >>> count_code_versions(['{"commit": "0123456789abcdef", "dirty": true}', None, None])
+    {'not recorded': 2, '0123456789+dirty': 1}
+    """
+    out: dict[str, int] = {}
+    for code in codes:
+        name = "not recorded"
+        if isinstance(code, str):
+            doc = json.loads(code)
+            if doc.get("commit"):
+                name = str(doc["commit"])[:10] + ("+dirty" if doc.get("dirty") else "")
+            elif doc.get("source"):
+                name = f"source {doc['source']}"
+        out[name] = out.get(name, 0) + 1
+    return dict(sorted(out.items(), key=lambda kv: (-kv[1], kv[0])))

@@ -79,6 +79,7 @@ from fcplan.experiments.oracle_reference import (
 from fcplan.experiments.stats import MeanCI, PairedComparison, mean_ci
 from fcplan.experiments.tables import REPORT_COLUMNS, higher_is_better
 from fcplan.metrics import metric_spec
+from fcplan.provenance import count_code_versions
 from fcplan.scenario.suite import suite_of
 
 __all__ = [
@@ -541,23 +542,6 @@ def _settings(rows: list[dict[str, Any]]) -> str:
     return "; ".join(o for o in out if o)
 
 
-def _code_versions(rows: list[dict[str, Any]]) -> dict[str, int]:
-    """Episodes per code version (``code`` column, :func:`fcplan.provenance.code_identity`): the
-    commit's first 10 digits (``+dirty`` when its files differed), else ``source <digest>``;
-    ``not recorded`` for rows written before the column existed."""
-    out: dict[str, int] = {}
-    for r in rows:
-        name = "not recorded"
-        if isinstance(r.get("code"), str):
-            doc = json.loads(r["code"])
-            if doc.get("commit"):
-                name = str(doc["commit"])[:10] + ("+dirty" if doc.get("dirty") else "")
-            elif doc.get("source"):
-                name = f"source {doc['source']}"
-        out[name] = out.get(name, 0) + 1
-    return dict(sorted(out.items(), key=lambda kv: (-kv[1], kv[0])))
-
-
 def _meta(rows: list[dict[str, Any]], wall: float | None) -> dict[str, Any]:
     versions = sorted({str(r["versions"]) for r in rows if isinstance(r.get("versions"), str)})
     done = [str(r["finished_at"]) for r in rows if isinstance(r.get("finished_at"), str)]
@@ -575,7 +559,7 @@ def _meta(rows: list[dict[str, Any]], wall: float | None) -> dict[str, Any]:
         "wall_time_s": wall if wall is not None else busy,
         "episode_time_s": float(sum(float(r.get("episode_wall_s") or 0.0) for r in rows)),
         "hosts": sorted({str(r["host"]) for r in rows if r.get("host")}),
-        "code": _code_versions(rows),
+        "code": count_code_versions(r.get("code") for r in rows),
         "suites": sorted({tier_of(str(r["scenario"]))[0] for r in rows} - {""}),
     }
 

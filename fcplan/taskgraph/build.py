@@ -235,30 +235,9 @@ class TaskGraphBuilder:
         nty = int(np.ceil(w / th)) + 1
         known = belief.known
         kx, ky = np.divmod(known, w)  # known = flat x * W + y
-        if tw.is_integer() and th.is_integer() and tw >= 1.0 and th >= 1.0:
-            # whole-px tiles (the default): integer floor division, the same as the float one
-            key = kx // int(tw)
-            key *= nty
-            key += ky // int(th)  # tile row-major (ty < nty)
-        else:
-            key = (kx // tw).astype(np.int64) * nty + (ky // th).astype(np.int64)
-        order = np.argsort(key, kind="stable")
-        ks = key[order]
-        first = np.empty(len(ks), dtype=bool)
-        first[:1] = True
-        np.not_equal(ks[1:], ks[:-1], out=first[1:])
-        starts = first.nonzero()[0]
-        xs, ys = kx[order], ky[order]
+        order, ks, starts, pos, counts = tile_runs(tile_keys(kx, ky, tile, nty), kx, ky)
         seen = belief.last_seen.ravel()[known[order]]
         last = np.maximum.reduceat(seen, starts)
-        # tile centre: the middle of the cells' bounding box ((lo + hi) / 2 of whole px: exact)
-        pos = np.empty((len(starts), 2))
-        np.add(np.minimum.reduceat(xs, starts), np.maximum.reduceat(xs, starts), out=pos[:, 0])
-        np.add(np.minimum.reduceat(ys, starts), np.maximum.reduceat(ys, starts), out=pos[:, 1])
-        pos /= 2.0
-        counts = np.empty_like(starts)  # tile sizes: gaps between starts
-        np.subtract(starts[1:], starts[:-1], out=counts[:-1])
-        counts[-1] = len(ks) - starts[-1]
         stale = (belief.tick - last) / self._tps
         tile_x, tile_y = np.divmod(ks[starts], nty)
         return pos, counts, stale, self._clusters(tile_x, tile_y, ntx, nty)
@@ -462,6 +441,43 @@ def _search_grid(w: int, blk: int) -> np.ndarray:
         [np.minimum((bx + 0.5) * blk, w - 1.0), np.minimum((by + 0.5) * blk, w - 1.0)], axis=1
     )
     return _frozen(pos)
+
+
+def tile_keys(kx: np.ndarray, ky: np.ndarray, tile: tuple[float, float], nty: int) -> np.ndarray:
+    """(n,) int64 row-major tile index of cells at whole-px ``(kx, ky)`` for tiles of
+    ``tile = (tw, th)`` px (``ty < nty``): integer floor division for whole-px tiles (the
+    default; the same as the float one), else the float division."""
+    tw, th = tile
+    if tw.is_integer() and th.is_integer() and tw >= 1.0 and th >= 1.0:
+        key: np.ndarray = kx // int(tw)
+        key *= nty
+        key += ky // int(th)
+        return key
+    out: np.ndarray = (kx // tw).astype(np.int64) * nty + (ky // th).astype(np.int64)
+    return out
+
+
+def tile_runs(
+    key: np.ndarray, kx: np.ndarray, ky: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Cells grouped into runs of equal ``key`` (their tiles): the stable ``order`` of the
+    cells, the sorted keys, the ``starts`` of the runs, each run's centre (the middle of its
+    cells' bounding box, ``(lo + hi) / 2`` of whole px: exact) and its cell count."""
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    first = np.empty(len(ks), dtype=bool)
+    first[:1] = True
+    np.not_equal(ks[1:], ks[:-1], out=first[1:])
+    starts = first.nonzero()[0]
+    xs, ys = kx[order], ky[order]
+    pos = np.empty((len(starts), 2))
+    np.add(np.minimum.reduceat(xs, starts), np.maximum.reduceat(xs, starts), out=pos[:, 0])
+    np.add(np.minimum.reduceat(ys, starts), np.maximum.reduceat(ys, starts), out=pos[:, 1])
+    pos /= 2.0
+    counts = np.empty_like(starts)  # run lengths: gaps between starts
+    np.subtract(starts[1:], starts[:-1], out=counts[:-1])
+    counts[-1] = len(ks) - starts[-1]
+    return order, ks, starts, pos, counts
 
 
 def unique_ids(ids: Sequence[str]) -> tuple[str, ...]:

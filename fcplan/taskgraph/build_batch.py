@@ -33,6 +33,8 @@ from fcplan.taskgraph.build import (
     _neighbours,
     _rect_distance,
     graph_fields,
+    tile_keys,
+    tile_runs,
     unique_ids,
 )
 from fcplan.taskgraph.clusters import EIGHT_CONNECTED
@@ -84,29 +86,11 @@ def _tiles(
     allk = np.concatenate(known)
     seen_all = np.concatenate([b.last_seen.ravel()[k] for b, k in zip(beliefs, known, strict=True)])
     kx, ky = np.divmod(allk, w)
-    if tw.is_integer() and th.is_integer() and tw >= 1.0 and th >= 1.0:
-        key = kx // int(tw)
-        key *= nty
-        key += ky // int(th)
-    else:
-        key = (kx // tw).astype(np.int64) * nty + (ky // th).astype(np.int64)
+    key = tile_keys(kx, ky, tile, nty)
     n_tiles = ntx * nty
     key += np.repeat(np.arange(m, dtype=np.int64) * n_tiles, sizes)
-    order = np.argsort(key, kind="stable")  # by world, then the builder's order
-    ks = key[order]
-    first = np.empty(len(ks), dtype=bool)
-    first[:1] = True
-    np.not_equal(ks[1:], ks[:-1], out=first[1:])
-    starts = first.nonzero()[0]
-    xs, ys = kx[order], ky[order]
+    order, ks, starts, pos, counts = tile_runs(key, kx, ky)  # by world, then the builder's order
     last = np.maximum.reduceat(seen_all[order], starts)
-    pos = np.empty((len(starts), 2))
-    np.add(np.minimum.reduceat(xs, starts), np.maximum.reduceat(xs, starts), out=pos[:, 0])
-    np.add(np.minimum.reduceat(ys, starts), np.maximum.reduceat(ys, starts), out=pos[:, 1])
-    pos /= 2.0
-    counts = np.empty_like(starts)
-    np.subtract(starts[1:], starts[:-1], out=counts[:-1])
-    counts[-1] = len(ks) - starts[-1]
     world, tkey = np.divmod(ks[starts], n_tiles)
     ticks = np.array([b.tick for b in beliefs], dtype=np.int64)
     stale = (ticks[world] - last) / bld._tps
