@@ -64,7 +64,7 @@ NOT_RUN = {
         "the leaderboard's scale-tier study (hours of CPU)"
     ),
     "fcplan sweep bench/suite_v2_hard.toml --results bench/results/bench-v2 --jobs 2": (
-        "the leaderboard's v2 hard-tier study (960 episodes, hours of CPU)"
+        "the leaderboard's v2 hard-tier study (1,080 episodes, hours of CPU)"
     ),
     "fcplan leaderboard bench/results/bench-v2 -o docs/leaderboard.md": (
         "rewrites docs/leaderboard.md from the committed results (a minute); tests/experiments "
