@@ -162,8 +162,12 @@ def kill_worker(folder: Path) -> Trial:
 
 
 def two_sweeps(folder: Path) -> tuple[Trial, Trial]:
-    """A second sweep into a folder a first one is writing: the second refuses at once."""
-    config, results = write_config(folder, duration=600.0), folder / "results"
+    """A second sweep into a folder a first one is writing: the second refuses at once.
+
+    The first sweep's episodes must outlast the second's start-up (about a second): at 600
+    simulated seconds a greedy episode took under a second, so the first could finish its six
+    before the second looked at the folder; at 3,600 s the five left take about ten."""
+    config, results = write_config(folder, duration=3600.0), folder / "results"
     first = start_sweep(config, results)
     workers = _running(first, results)
     second = start_sweep(config, results, jobs=1)
