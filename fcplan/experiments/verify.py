@@ -218,7 +218,7 @@ def verify_results(
     schedulers : iterable of str, optional
         Only these labels (default: every label in the folder).
     seed : int
-        Seed of the draw (the same seed checks the same episodes).
+        Seed of the draw (the same seed on the same folder checks the same episodes).
     jobs : int
         Worker processes for the replays.
     progress : callable, optional
