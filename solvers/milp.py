@@ -22,11 +22,15 @@ Limits and determinism
   35 % of the time (the configured model at the manual's team sizes; fewer candidates at the
   ``scale`` tier's); CP-SAT gets what is left after building it and its own arrays
   (``max_time_in_seconds``). If building used it all, or is projected to (from the segments
-  valued so far), :meth:`plan` raises ``TimeoutError`` at once, leaving the fallback its time.
+  valued so far), the solve is skipped and the plan finished past the deadline from the
+  smallest model (``finish_late``, below).
 * **No idle team**: the search starts from a complete first solution (the previous plan's
   routes still in the model, then routes of largest gain, :mod:`solvers.milp_model.start`) given
-  as a hint. If a limit stops CP-SAT with no solution, or with agents idle that a route would
-  improve, :meth:`plan` raises :class:`solvers.milp_model.IncompletePlanError`, so
+  as a hint; a part CP-SAT leaves without a solution keeps it. If the clock ran out before that
+  first solution was complete, :meth:`plan` completes it past the deadline and says so
+  (``finish_late=True``, the default: ``size["late"] = 1``,
+  :mod:`solvers.milp_model.scheduler`); with ``finish_late=False`` it raises
+  (``TimeoutError`` or :class:`solvers.milp_model.IncompletePlanError`), so
   :func:`fcplan.scheduling.solve` falls back to greedy for that replan (``status="fallback"``).
 
 CP-SAT needs integral rows, which the model has, and gets the objective as integers: the
@@ -75,6 +79,9 @@ class MilpScheduler(MilpSchedulerBase):
         CP-SAT ``max_deterministic_time`` (deterministic seconds) per replan.
     seed : int
         CP-SAT's random seed (one worker).
+    finish_late : bool
+        Finish a plan the wall clock cut short past the deadline (default True) instead of
+        raising so that the caller falls back (:mod:`solvers.milp_model.scheduler`).
     **model_settings
         Fields of :class:`solvers.milp_model.MilpParams` (``slots``, ``search_slots``,
         ``horizon_s``, ``fire_candidates``, ``search_candidates``, ``watch_candidates``,

@@ -26,11 +26,14 @@ optimality; HiGHS's default is 1e-4).
   limit after that (about 30 % kept back for completing, checking and decoding the plan: HiGHS
   checks its clock less often than CP-SAT). A limited solve whose point is worse than the warm
   start keeps the warm start (HiGHS takes no hint through cvxpy).
-* **No idle team**: HiGHS may stop at a limit with its trivial all-zero point; a solution that
-  leaves agents idle with routes to fly, or none at all, raises
-  :class:`solvers.milp_model.IncompletePlanError`, so :func:`fcplan.scheduling.solve` falls back
-  to greedy (``status="fallback"``). (cvxpy passes no MIP start to HiGHS, so this backend has no
-  warm start.)
+* **No idle team**: HiGHS may stop at a limit with its trivial all-zero point, or find nothing
+  (:class:`solvers.milp_model.IncompletePlanError`); the part then keeps the scheduler's warm
+  start (the previous plan's routes, then routes of largest gain), computed before the solve,
+  and the solution is completed. If the clock ran out before even that was complete, the plan
+  is finished past the deadline (``finish_late``, :mod:`solvers.milp_model.scheduler`), or,
+  with ``finish_late=False``, the scheduler raises and :func:`fcplan.scheduling.solve` falls
+  back to greedy (``status="fallback"``). (cvxpy passes no MIP start to HiGHS, so HiGHS itself
+  starts from nothing.)
 
 What cvxpy exposes after the solve: ``problem.status`` (``optimal``; ``user_limit`` when a limit
 stopped HiGHS with a solution; ``infeasible``...), ``problem.value``, and
@@ -78,6 +81,9 @@ class MilpCvxpyScheduler(MilpSchedulerBase):
         HiGHS ``mip_max_nodes`` per replan.
     seed : int
         HiGHS's ``random_seed`` (one thread).
+    finish_late : bool
+        Finish a plan the wall clock cut short past the deadline (default True) instead of
+        raising so that the caller falls back (:mod:`solvers.milp_model.scheduler`).
     **model_settings
         Fields of :class:`solvers.milp_model.MilpParams`, as for ``milp``.
     """

@@ -53,23 +53,7 @@ def test_builtin_schedulers_conform(name):
     assert report.graphs == 2 * len(SUBSET) and report.failures == []
 
 
-#: schedulers that fail the time-out check as they are (not this branch's code; issue 15)
-TIMEOUT_XFAIL = {
-    "milp": "issue 15: CP-SAT finds no solution at 1 us and the scheduler raises (solve falls back)",
-    "milp-cvxpy": "issue 15: HiGHS finds nothing at 1 us; the scheduler raises or returns an "
-    "empty plan (solve falls back)",
-}
-
-
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(reason=TIMEOUT_XFAIL[n], strict=True))
-        if n in TIMEOUT_XFAIL
-        else n
-        for n in BUILTIN
-    ],
-)
+@pytest.mark.parametrize("name", BUILTIN)
 def test_builtin_schedulers_answer_a_time_out(name):
     """At a limit nobody can meet (1 us) every built-in scheduler, in its wall-clock mode, still
     answers with a valid plan that leaves no role with work idle (or, for schedulers that

@@ -22,6 +22,21 @@ time so far). The step a plan came from is in its stats
 (``size["model_step"]``, 0: the configured model). At the manual's team sizes the configured
 model fits 0.1 s; at the ``scale`` tier's 18-30 agents it does not (``bench/README.md``).
 
+When the clock runs out first
+-----------------------------
+A wall-clock limit can pass before the plan is complete: the build overran (a load spike, a
+prediction too low), or it left no time, or the warm start was cut short. With
+``finish_late=True`` (the default) the scheduler then finishes its own plan past the deadline
+instead of giving up: it builds the smallest model step without a deadline if it has no model,
+and completes the warm start (the previous plan's routes, then routes of largest gain) without
+one; the solve is skipped. The plan is the MILP's own construction on its own objective, so
+nothing falls back to greedy, at the cost of an overrun on that replan (the smallest model's
+build and the construction: a few ms on the manual's teams, some tens at the ``scale`` tier).
+Such a plan says so: ``size["late"] = 1`` and a ``message`` naming what ran out. With
+``finish_late=False`` it raises as before (``TimeoutError``, :class:`IncompletePlanError`) and
+:func:`fcplan.scheduling.solve` falls back to greedy for that replan. The deterministic mode has
+no deadline, so it never finishes late.
+
 Examples
 --------
 >>> import numpy as np
@@ -56,13 +71,13 @@ from solvers.milp_model.build import build_milp_model
 from solvers.milp_model.decode import decode_plan
 from solvers.milp_model.objective import FireSnapshot
 from solvers.milp_model.solve import LnsSettings, SolverLimits, solve_model
-from solvers.milp_model.start import idle_agents, initial_solution
+from solvers.milp_model.start import complete, idle_agents, initial_solution
 from solvers.milp_model.types import IncompletePlanError, MilpModel, MilpParams
 
 __all__ = ["MilpSchedulerBase"]
 
 
-_LNS = ("exact_routes", "lns_routes", "lns_rounds")
+_LNS = ("exact_routes", "lns_routes", "lns_rounds", "finish_late")
 
 #: The model sizes a wall-clock limit steps down through: each caps the configured settings.
 MODEL_STEPS: tuple[dict[str, int], ...] = (
@@ -75,6 +90,16 @@ MODEL_STEPS: tuple[dict[str, int], ...] = (
 #: Build seconds per agent of each step at the ``scale`` tier (``python bench/bench_milp_build.py
 #: --designs scale-tier --set ...``, 2026-11-29, bench/README.md): the prediction's priors.
 STEP_COST_S = (3.5e-3, 2.6e-3, 1.6e-3, 0.8e-3)
+
+
+def _finished_late(stats: SolveStats, objective: float, late: list[str]) -> SolveStats:
+    """``stats`` of a plan finished past the deadline (module docstring): ``size["late"] = 1``,
+    the reasons in the message, the objective of the completed solution."""
+    bound = max(stats.bound, objective)
+    gap = (bound - objective) / max(abs(objective), 1e-9)
+    why = "; ".join(m for m in [*late, stats.message] if m)
+    return replace(stats, size=dict(stats.size, late=1), objective=objective, bound=bound,
+                   gap=gap, message=f"finished past the deadline: {why}")  # fmt: skip
 
 
 class MilpSchedulerBase:
@@ -98,6 +123,10 @@ class MilpSchedulerBase:
         Parts of the model with at most ``exact_routes`` routes are solved at once; larger ones
         by large-neighbourhood search, at most ``lns_rounds`` rounds freeing at most
         ``lns_routes`` routes each (:mod:`solvers.milp_model.solve`).
+    finish_late : bool
+        Under a wall-clock limit, finish the plan past the deadline when the clock runs out
+        before it is complete (default True), instead of raising so that the caller falls
+        back (module docstring, "When the clock runs out first").
     **model_settings
         Fields of :class:`MilpParams`.
     """
@@ -131,9 +160,11 @@ class MilpSchedulerBase:
         exact_routes: int = LnsSettings.exact_routes,
         lns_routes: int = LnsSettings.lns_routes,
         lns_rounds: int = LnsSettings.lns_rounds,
+        finish_late: bool = True,
         **model_settings: Any,
     ) -> None:
         self.deterministic = bool_setting("deterministic", deterministic)
+        self.finish_late = bool_setting("finish_late", finish_late)
         self.time_limit = float_setting("time_limit", time_limit, 0.0, lo_open=True, unit=" s")
         work = self.default_work_limit if work_limit is None else work_limit
         if self.work_limit_kind is int:
@@ -165,14 +196,18 @@ class MilpSchedulerBase:
         included, about 15 % kept back for what follows the solve); without one the call stops on the work
         limit only (``deterministic=True``) or on the ``time_limit`` setting.
 
+        If the limit passes before the plan is complete, the plan is finished past it
+        (``finish_late``, module docstring: ``size["late"] = 1``).
+
         Raises
         ------
         TimeoutError
-            If building the model used up the wall-clock limit (checked between the build's
-            steps and its chunks of segments).
+            With ``finish_late=False``: if building the model used up the wall-clock limit
+            (checked between the build's steps and its chunks of segments).
         IncompletePlanError
-            If a limit stopped the solver with no plan, or with agents left idle that a route
-            would have improved (the plan came from the limit, not from a decision).
+            With ``finish_late=False``: if a limit stopped the solver with no plan, or with
+            agents left idle that a route would have improved (the plan came from the limit,
+            not from a decision).
         """
         t0 = time.perf_counter()
         if time_limit is not None:
@@ -190,16 +225,25 @@ class MilpSchedulerBase:
         keep = graph.time_s - self.params.recent_fire_s
         recent = [snap for t, snap in self._recent if t >= keep]
         step = 0 if deadline is None else self._step(graph.n_agents, deadline - t0)
-        model = self._build(graph, step, recent, deadline)
+        late: list[str] = []  # what the clock cut short (module docstring)
+        try:
+            model = self._build(graph, step, recent, deadline)
+        except TimeoutError as exc:
+            if not self.finish_late:
+                raise
+            late.append(str(exc))
+            step = len(MODEL_STEPS) - 1
+            model = self._build(graph, step, recent, None)
         limits = SolverLimits(deadline, self.work_limit)
         left = limits.seconds_left()
-        if left is not None and left <= 0:
-            raise TimeoutError(
-                f"building the model took {time.perf_counter() - t0:.4f} s of {limit} s"
-            )
+        if left is not None and left <= 0 and not late:
+            why = f"building the model took {time.perf_counter() - t0:.4f} s of {limit} s"
+            if not self.finish_late:
+                raise TimeoutError(why)
+            late.append(why)
         # the warm start may run into the reserve: complete past the solve's deadline it is still
-        # a plan (the solve and the completion are then skipped), cut short it is a fallback
-        start_by = None if limit is None else t0 + float(limit) * self.start_share
+        # a plan (the solve and the completion are then skipped), cut short it is finished late
+        start_by = None if limit is None or late else t0 + float(limit) * self.start_share
         hint = initial_solution(model, graph, self._previous, deadline=start_by)
         x, stats = solve_model(
             model,
@@ -216,10 +260,14 @@ class MilpSchedulerBase:
         idle = np.zeros(0, dtype=np.int64) if done else idle_agents(model, x)
         if idle.size:  # only when the deadline passed before the warm start was complete
             names = ", ".join(graph.agent_ids[a] for a in idle.tolist())
-            raise IncompletePlanError(
-                f"the wall-clock limit left agents {names} idle with routes to fly"
-            )
+            why = f"the wall-clock limit left agents {names} idle with routes to fly"
+            if not self.finish_late:
+                raise IncompletePlanError(why)
+            late.append(why)
+            x = complete(model, x)
         stats = replace(stats, size=dict(stats.size, solver=self.solver_name, model_step=step))
+        if late:
+            stats = _finished_late(stats, model.objective(x), late)
         plan = decode_plan(model, x, graph, stats)
         self._previous = dict(plan.routes)
         self._previous_time = graph.time_s

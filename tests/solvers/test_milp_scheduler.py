@@ -127,33 +127,55 @@ def test_warm_start_does_not_change_the_optimum():
 
 # ---------------------------------------------------------------------------------------- limits
 @pytest.mark.parametrize("name", NAMES)
-def test_tiny_time_limit_team_still_acts(name):
-    """With a 1e-6 s limit the scheduler has no plan; solve() falls back to greedy (status
-    'fallback', reason recorded) and the team still acts: its plan has routes whenever greedy's
-    has."""
+def test_tiny_time_limit_finishes_its_own_plan_late(name):
+    """With a 1e-6 s limit the clock has run out before anything is built: the scheduler
+    finishes its own plan past the deadline (the smallest model, the warm start, no solve), so
+    solve() keeps it: not a fallback, status time_limit, size["late"] = 1, the reason in the
+    message, a valid plan with routes, and no role with work left idle."""
+    from fcplan.scheduling import idle_team
+    from solvers.milp_model.scheduler import MODEL_STEPS
+
     sched = make_scheduler(name)
-    greedy = make_scheduler("greedy")
     for g in episode_graphs(24) + episode_graphs("open_world_example"):
+        plan = solve(sched, g, time_limit=1e-6, rng=np.random.default_rng(0))
+        validate_plan(plan, g)
+        st = plan.stats
+        assert st.status == "time_limit" and st.size["late"] == 1
+        assert st.size["model_step"] == len(MODEL_STEPS) - 1
+        assert st.message.startswith("finished past the deadline")
+        assert plan.n_assignments > 0 and not idle_team(plan, g)
+        assert st.bound >= st.objective
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_tiny_time_limit_without_finish_late_falls_back(name):
+    """With finish_late=False a 1e-6 s limit leaves the scheduler without a plan; it raises and
+    solve() falls back to greedy (status 'fallback', reason recorded): the team still acts,
+    with greedy's assignments."""
+    sched = make_scheduler(name, finish_late=False)
+    greedy = make_scheduler("greedy")
+    for g in episode_graphs(24):
         plan = solve(sched, g, time_limit=1e-6, rng=np.random.default_rng(0))
         validate_plan(plan, g)
         assert plan.stats.status == "fallback" and plan.stats.message
         assert plan.n_assignments == greedy.plan(g, time_limit=None, rng=None).n_assignments
-        assert plan.n_assignments > 0
 
 
 @pytest.mark.parametrize("cls", [MilpScheduler, MilpCvxpyScheduler])
-def test_a_plan_cut_short_is_completed_or_raises(cls, monkeypatch):
+def test_a_plan_cut_short_is_completed_late_or_raises(cls, monkeypatch):
     """A backend result that a limit stopped (status time_limit) with every agent idle is
     completed with routes of positive gain, so no agent that has work is left idle and the
     status says the limit stopped it; if the completion cannot run either (the deadline passed
-    before the warm start was complete: it stopped at the deadline), plan() raises
-    IncompletePlanError naming the idle agents, so solve() falls back."""
+    before the warm start was complete: it stopped at the deadline), plan() completes it past
+    the deadline (size["late"] = 1, the idle agents named in the message), or, with
+    finish_late=False, raises IncompletePlanError naming them, so solve() falls back."""
+    from fcplan.scheduling import idle_team
     from solvers.milp_model import solve as solve_module
 
     g = episode_graphs(12)[1]
     monkeypatch.setattr(solve_module, "_solve_part", _empty_part)
     plan = cls().plan(g)
-    assert plan.stats.status == "time_limit"
+    assert plan.stats.status == "time_limit" and "late" not in plan.stats.size
     assert plan.routes and validate_plan(plan, g) is None
 
     def cut(model, x, deadline=None):  # the deadline passes before the completion adds a route
@@ -162,8 +184,11 @@ def test_a_plan_cut_short_is_completed_or_raises(cls, monkeypatch):
         return x
 
     monkeypatch.setattr(solve_module, "complete", cut)
+    late = cls().plan(g, time_limit=0.5)
+    assert late.stats.size["late"] == 1 and "idle with routes to fly" in late.stats.message
+    assert late.routes and validate_plan(late, g) is None and not idle_team(late, g)
     with pytest.raises(IncompletePlanError, match="idle"):
-        cls().plan(g, time_limit=0.5)
+        cls(finish_late=False).plan(g, time_limit=0.5)
 
 
 def _empty_part(sub, hint, positions, backend, limits, seed, settings):
@@ -171,9 +196,12 @@ def _empty_part(sub, hint, positions, backend, limits, seed, settings):
     return np.zeros_like(hint), "time_limit", 0.0, {}
 
 
-def test_model_building_past_the_limit_raises(monkeypatch):
-    """In wall-clock mode, when building the model uses up the limit plan() raises TimeoutError
-    (solve() then falls back) instead of overrunning."""
+def test_model_building_past_the_limit_finishes_late_or_raises(monkeypatch):
+    """In wall-clock mode, when building the model uses up the limit, plan() builds the
+    smallest model without a deadline and finishes its plan late (size["late"] = 1, the
+    smallest step); with finish_late=False it raises TimeoutError (solve() then falls back)."""
+    from solvers.milp_model.scheduler import MODEL_STEPS
+
     real = scheduler_module.build_milp_model
 
     def slow(graph, params, **kw):
@@ -181,8 +209,18 @@ def test_model_building_past_the_limit_raises(monkeypatch):
         return real(graph, params, **kw)
 
     monkeypatch.setattr(scheduler_module, "build_milp_model", slow)
+    g = episode_graphs(12)[1]
+    plan = MilpScheduler().plan(g, time_limit=0.02)
+    assert plan.stats.size["late"] == 1 and plan.stats.size["model_step"] == len(MODEL_STEPS) - 1
+    assert plan.routes and validate_plan(plan, g) is None
     with pytest.raises(TimeoutError):
-        MilpScheduler().plan(episode_graphs(12)[1], time_limit=0.02)
+        MilpScheduler(finish_late=False).plan(g, time_limit=0.02)
+
+
+def test_deterministic_plans_never_finish_late():
+    """The deterministic mode has no deadline, so no plan carries the late marker."""
+    for g in episode_graphs(24):
+        assert "late" not in MilpScheduler().plan(g).stats.size
 
 
 @pytest.mark.parametrize("name", NAMES)
