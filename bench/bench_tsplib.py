@@ -32,11 +32,14 @@ Usage::
     nice python bench/bench_tsplib.py --first-solutions --limits 0.1 1
     nice python bench/bench_tsplib.py --deterministic
     nice python bench/bench_tsplib.py --cpu-limits 0.1 1 --seeds 5
+    nice python bench/bench_tsplib.py --cpu-limits 1 --seeds 20 --first-seed 10 \
+        --instances validation --phases 1 2 3     # choose a setting on the validation set
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import time
 from pathlib import Path
@@ -49,6 +52,8 @@ from solvers.routing.tsplib import OPTIMA, read_coords, tour_length, tsplib_dist
 DATA = Path(__file__).resolve().parent.parent / "tests" / "solvers" / "data" / "tsplib"
 #: the instances of the table (ulysses22 and att48 are also shipped, for the tests)
 INSTANCES = ("eil51", "berlin52", "st70", "eil76", "kroA100", "rd100", "ch130")
+#: the validation set (``--instances validation``): settings are chosen on these, not the table
+VALIDATION = ("pr76", "kroC100", "kroD100", "eil101", "lin105")
 CONFIGS = ("core-ortools", "core-pyvrp", "ortools-gls", "pyvrp")
 FIRST_SOLUTIONS = (
     "PATH_CHEAPEST_ARC",
@@ -109,23 +114,34 @@ def pyvrp_alone(xy: np.ndarray, dist: np.ndarray, limit: float, seed: int = 0) -
 
 
 def pyvrp_cpu(
-    dist: np.ndarray, limit: float, seed: int, perturbation: tuple[int, int] | None = None
+    dist: np.ndarray,
+    limit: float,
+    seed: int,
+    perturbation: tuple[int, int] | None = None,
+    phases: int | None = None,
 ) -> float:
     """The core's PyVRP model and parameters of a tour, stopped after ``limit`` CPU seconds
-    (``perturbation``: another (least, most) perturbation range than the core's)."""
+    (``perturbation``: another (least, most) perturbation range than the core's; ``phases``:
+    searches the budget is split into, each from the previous one's best, as the core does)."""
     import pyvrp
 
     from solvers.routing.core import RoutingInstance
-    from solvers.routing.pyvrp_backend import TOUR_PERTURBATION, _data
+    from solvers.routing.pyvrp_backend import TOUR_PERTURBATION, TOUR_PHASES, _better, _data
 
     start = time.process_time()
     inst = RoutingInstance.of(dist, [0])
     pert = TOUR_PERTURBATION if perturbation is None else perturbation
     params = pyvrp.SolveParams(perturbation=pyvrp.search.PerturbationParams(*pert))
-    res = pyvrp.solve(_data(inst, PyVRPOptions().scale),
-                      lambda _: time.process_time() - start >= limit, seed=seed,
-                      collect_stats=False, params=params)  # fmt: skip
-    tour = [0] + [int(inst.tasks[a.idx]) for r in res.best.routes() for a in r if a.is_client()]
+    data = _data(inst, PyVRPOptions().scale)
+    phases = TOUR_PHASES if phases is None else phases
+    best = None
+    for phase in range(phases):
+        until = start + limit * (phase + 1) / phases
+        res = pyvrp.solve(data, lambda _, t=until: time.process_time() >= t, seed=seed + phase,
+                          collect_stats=False, params=params, initial_solution=best)  # fmt: skip
+        if best is None or _better(res.best, best):
+            best = res.best
+    tour = [0] + [int(inst.tasks[a.idx]) for r in best.routes() for a in r if a.is_client()]
     return tour_length(dist, tour)
 
 
@@ -154,19 +170,36 @@ def main() -> None:
     ap.add_argument("--cpu-limits", type=float, nargs="+")
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--repeats", type=int, default=1, help="runs of every wall-clock cell")
-    ap.add_argument("--perturbations", nargs="+", default=None, metavar="LO,HI",
-                    help="with --cpu-limits: one table per PyVRP perturbation range")  # fmt: skip
+    ap.add_argument(
+        "--perturbations",
+        nargs="+",
+        default=None,
+        metavar="LO,HI",
+        help="with --cpu-limits: one table per PyVRP perturbation range",
+    )
+    ap.add_argument(
+        "--phases",
+        type=int,
+        nargs="+",
+        default=None,
+        help="with --cpu-limits: one table per number of search phases",
+    )
+    ap.add_argument("--first-seed", type=int, default=0, help="with --cpu-limits")
     args = ap.parse_args()
+    if args.instances == ["validation"]:
+        args.instances = list(VALIDATION)
     configs = list(FIRST_SOLUTIONS) if args.first_solutions else args.configs
     print(f"# load average at start: {os.getloadavg()[0]:.2f} (2 cores)")
     if args.cpu_limits:
         ranges: list[tuple[int, int] | None] = [None]  # the core's own range
         if args.perturbations:
             ranges = [(int(r.split(",")[0]), int(r.split(",")[1])) for r in args.perturbations]
-        for pert in ranges:
+        seeds = range(args.first_seed, args.first_seed + args.seeds)
+        for pert, phases in itertools.product(ranges, args.phases or [None]):
             what = "" if pert is None else f", perturbation {pert[0]}-{pert[1]}"
+            what += "" if phases is None else f", {phases} phase(s)"
             print(f"## core-pyvrp stopped on CPU time{what}: gap (%) mean / max over "
-                  f"{args.seeds} seeds")  # fmt: skip
+                  f"seeds {seeds.start}-{seeds.stop - 1}")  # fmt: skip
             print(f"{'instance':<9} {'optimum':>7}  " + "  ".join(
                 f"{f'{lim:g} cpu s':>14}" for lim in args.cpu_limits))  # fmt: skip
             for name in args.instances:
@@ -175,8 +208,8 @@ def main() -> None:
                 cells = []
                 for lim in args.cpu_limits:
                     gaps = [
-                        100 * (pyvrp_cpu(dist, lim, s, pert) / OPTIMA[name] - 1)
-                        for s in range(args.seeds)
+                        100 * (pyvrp_cpu(dist, lim, s, pert, phases) / OPTIMA[name] - 1)
+                        for s in seeds
                     ]
                     cells.append(f"{np.mean(gaps):>6.2f} / {max(gaps):>5.2f}")
                 print(f"{name:<9} {OPTIMA[name]:>7}  " + "  ".join(f"{c:>14}" for c in cells),

@@ -274,3 +274,28 @@ def test_deterministic_mode_is_identical_across_processes():
     ]
     assert runs[0] == runs[1]
     assert runs[0].count("ortools") == 1 and runs[0].count("pyvrp") == 1
+
+
+def test_pyvrp_searches_a_tour_in_two_phases_and_keeps_the_better():
+    """On a tour (one vehicle through required tasks only) the PyVRP backend splits its
+    deterministic budget into TOUR_PHASES searches (their iterations add up to the option's),
+    the second started from the first's best, so the result is never worse than one search of
+    half the budget; a prize-collecting model runs one search of the whole budget."""
+    from solvers.routing import pyvrp_backend
+    from solvers.routing.pyvrp_backend import TOUR_PHASES, solve_pyvrp
+
+    assert TOUR_PHASES == 2
+    rng = np.random.default_rng(3)
+    dist = euclid(rng.uniform(0, 1000, (30, 2)))
+    tour = RoutingInstance.of(dist, [0])
+    res = solve_pyvrp(tour, PyVRPOptions(iterations=301), None, None)
+    assert res.work["iterations"] == 301
+    one = pyvrp_backend.TOUR_PHASES
+    try:
+        pyvrp_backend.TOUR_PHASES = 1
+        half = solve_pyvrp(tour, PyVRPOptions(iterations=151), None, None)
+    finally:
+        pyvrp_backend.TOUR_PHASES = one
+    assert res.objective <= half.objective + 1e-9
+    prizes = RoutingInstance.of(dist, [0], prizes=np.full(30, 50.0))
+    assert solve_pyvrp(prizes, PyVRPOptions(iterations=301), None, None).work["iterations"] == 301
