@@ -49,7 +49,11 @@ from typing import Any
 
 import numpy as np
 
-from fcplan.experiments.oracle_reference import fraction_on_pairs, reference_scores
+from fcplan.experiments.oracle_reference import (
+    complete_variants,
+    fraction_on_pairs,
+    reference_scores,
+)
 from fcplan.experiments.stats import (
     Friedman,
     PairedComparison,
@@ -235,6 +239,7 @@ def oracle_fractions(
         for k, d in paired_scores(rows, names, metric, pair_key).items()
     }
     sign = 1.0 if higher_is_better(metric) else -1.0
+    refs = complete_variants({r: scores[r] for r in refs})
     ref = reference_scores([scores[r] for r in refs], sign)
     zero = scores[baseline] if baseline in schedulers and scores.get(baseline) else None
     scenario = {pair_key(r): str(r.get("scenario", "")) for r in rows}

@@ -71,6 +71,7 @@ import numpy as np
 from fcplan.errors import FcplanError
 from fcplan.experiments.analysis import metric_label, paired_table
 from fcplan.experiments.oracle_reference import (
+    complete_variants,
     fraction_of_oracle,
     fraction_on_pairs,
     on_top,
@@ -236,6 +237,8 @@ class TierResult:
     per_scenario: dict[str, dict[str, tuple[float, float, int]]] = field(default_factory=dict)
     """Scenario -> scheduler label -> (mean headline metric, mean OFS %, episodes): which
     scenarios of the tier tell the schedulers apart."""
+    reference: tuple[str, ...] = ()
+    """The oracle variants that make up the reference (:func:`complete_variants`)."""
 
 
 @dataclass
@@ -472,8 +475,9 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
     scores = {k: _scores(by[k], metric) for k in labels}
     refs = {IDLE: scores[IDLE]} if by.get(IDLE) else {}
     oracles = [k for k in labels if k.startswith(ORACLE) and by[k]]
-    if oracles:
-        refs[ORACLE] = reference_scores([scores[k] for k in oracles], sign)
+    used = complete_variants({k: scores[k] for k in oracles})
+    if used:
+        refs[ORACLE] = reference_scores([scores[k] for k in used], sign)
     stats = {
         k: _scheduler_stats(by[k], sum(r["scheduler"] == k for r in rows) - len(by[k]),
                             metric, scenarios, refs, scores[k])
@@ -508,6 +512,7 @@ def _tier(suite: str, tier: str, rows: list[dict[str, Any]], metric: str) -> Tie
         instances=instances,
         settings={k: _settings(by[k]) for k in order if _settings(by[k])},
         per_scenario={sc: _scenario_means(by, order, sc, metric) for sc in scenarios},
+        reference=tuple(used),
     )
 
 

@@ -122,8 +122,8 @@ def _tier_section(t: TierResult, label: str, digits: int) -> list[str]:
     ]
     rank = 0
     for k in t.order:
-        if not is_policy(k):
-            r = "ref" if k.startswith(ORACLE) else "base"
+        if not is_policy(k):  # an oracle variant still being played is not in the reference
+            r = ("ref" if k in t.reference else "-") if k.startswith(ORACLE) else "base"
         elif t.stats[k].instances < t.instances:
             r = "-"  # partial: not ranked
         else:
@@ -264,7 +264,8 @@ def markdown(board: Leaderboard, command: str = "") -> str:
         "* **fraction of oracle**: `sum (s - idle) / sum (oracle - idle)` over the (scenario, "
         "seed) pairs where the scheduler, the clairvoyant reference and the `idle` team all "
         "completed: the share of the oracle's improvement over doing nothing. The reference "
-        "on a pair is the best of the oracle variants run on it (each `ref` row). A ratio of means, "
+        "on a pair is the best of the oracle variants run on it (each `ref` row; a variant "
+        "joins once it has played every pair of the most complete one). A ratio of means, "
         "so that pairs where little was at stake do not dominate; 95 % interval by a bootstrap "
         "of seeds within each scenario. Above 1: better than the oracle on these pairs (the "
         "oracle is a reference, not a bound).",

@@ -9,7 +9,10 @@ best-known solution is in a routing benchmark.
 A scheduler's **fraction of the oracle** (:func:`fraction_of_oracle`) is ``F = sum_i (s_i -
 idle_i) / sum_i (oracle_i - idle_i)`` over the pairs ``i`` where it, the reference and the idle
 team all completed: a ratio of means, with a bootstrap interval that resamples seeds within each
-scenario (the module docstring of :mod:`fcplan.experiments.leaderboard` explains the choice).
+scenario (the module docstring of :mod:`fcplan.experiments.leaderboard` explains the choice;
+scenarios with a single pair are resampled together). The reference is made of the variants that
+have played every pair of the most complete one (:func:`complete_variants`): one still being
+played joins when it has caught up.
 :func:`on_top` is the tier check's test that the reference is at least as good as a policy.
 
 Examples
@@ -31,6 +34,7 @@ import numpy as np
 
 __all__ = [
     "BOOTSTRAP_DRAWS",
+    "complete_variants",
     "fraction_of_oracle",
     "fraction_on_pairs",
     "on_top",
@@ -76,6 +80,10 @@ def fraction_of_oracle(
     if strata is not None:
         labels = np.asarray([str(x) for x in strata])
         groups = [np.flatnonzero(labels == u) for u in dict.fromkeys(labels.tolist())]
+        # a stratum of one pair resamples to itself, adding no spread: such strata are pooled
+        # (all of them singletons: the plain bootstrap), else the interval shrinks to a point
+        alone = [g for g in groups if g.size == 1]
+        groups = [g for g in groups if g.size > 1] + ([np.concatenate(alone)] if alone else [])
     rng = np.random.default_rng(seed)
     picks = np.concatenate(
         [g[rng.integers(0, g.size, size=(draws, g.size))] for g in groups], axis=1
@@ -117,6 +125,28 @@ def fraction_on_pairs(
         strata=[stratum(k) for k in keys],
     )
     return frac, keys
+
+
+def complete_variants(variants: Mapping[str, Mapping[K, float]]) -> list[str]:
+    """The oracle variants that make up the reference: those that have played every pair of the
+    variant with the most pairs (in ``variants``' order).
+
+    :func:`reference_scores` keeps only the pairs every variant it is given completed, so a
+    variant still being played would shrink the reference to its few pairs (and the fractions
+    and their intervals with it); it joins once it has caught up.
+
+    Examples
+    --------
+    >>> complete_variants({"oracle": {1: 0.0, 2: 0.0}, "oracle[milp]": {1: 0.0}})
+    ['oracle']
+    >>> complete_variants({"oracle": {1: 0.0}, "oracle[milp]": {1: 0.0, 2: 0.0}})
+    ['oracle[milp]']
+    """
+    if not variants:
+        return []
+    sizes = {k: len(v) for k, v in variants.items()}
+    most = set(variants[max(sizes, key=sizes.__getitem__)])
+    return [k for k, v in variants.items() if most <= set(v)]
 
 
 def reference_scores(variants: Sequence[Mapping[K, float]], sign: float = 1.0) -> dict[K, float]:

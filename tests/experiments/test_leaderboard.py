@@ -185,6 +185,43 @@ def test_the_reference_is_the_best_oracle_variant_on_each_pair():
     assert alone.check.oracle_top is False  # the oracle's mean 15 is below greedy's 20
 
 
+def test_a_variant_still_being_played_is_left_out_of_the_reference():
+    """An oracle variant that has played only some of the pairs does not shrink the reference
+    to those pairs: the reference stays the complete variant's on every pair (the policies'
+    fractions are over all of them, with an interval of width > 0), the partial variant's row
+    is ranked '-' on the page, not 'ref', and it joins the reference once complete."""
+    n = 8
+    rng = np.random.default_rng(1)
+    greedy = 20.0 + rng.normal(0, 5, n)
+    rows = _rows({"greedy": greedy, "oracle": [30.0] * n, "idle": [-70.0] * n})
+    partial = [r for r in _rows({"oracle[milp]": [40.0] * n}) if r["seed"] == 0]
+    t = leaderboard(rows + partial).tiers[0]
+    assert t.reference == ("oracle",)
+    f = t.stats["greedy"]
+    assert f.fraction == pytest.approx((greedy.sum() + 70 * n) / (100 * n))
+    assert f.fraction_ci[0] < f.fraction < f.fraction_ci[1]
+    page = markdown(leaderboard(rows + partial)).splitlines()
+    assert next(x for x in page if "| oracle[milp]" in x).startswith("| - |")
+    assert next(x for x in page if "| oracle (" in x).startswith("| ref |")
+    full = leaderboard(rows + _rows({"oracle[milp]": [40.0] * n})).tiers[0]
+    assert full.reference == ("oracle", "oracle[milp]")
+    assert full.stats["greedy"].fraction == pytest.approx((greedy.sum() + 70 * n) / (110 * n))
+
+
+def test_fraction_interval_pools_scenarios_of_one_pair():
+    """Scenarios with a single pair each would resample to themselves (an interval of zero
+    width); they are resampled together, so the interval has width, and strata of several
+    pairs keep being resampled within themselves."""
+    rng = np.random.default_rng(4)
+    idle = np.zeros(6)
+    oracle = rng.uniform(50, 150, 6)
+    s = oracle * rng.uniform(0.5, 1.0, 6)
+    f, (lo, hi), _ = fraction_of_oracle(s, oracle, idle, strata=["a", "b", "c", "d", "e", "f"])
+    assert lo < f < hi
+    same = fraction_of_oracle(s, oracle, idle, strata=None)
+    assert (lo, hi) == same[1]  # every stratum a singleton: the plain bootstrap
+
+
 def test_tier_check_counts_resolved_pairs_and_cleared_scenarios():
     """Clearly different policies are separated with every pair resolved at Holm p < 0.01 and
     the tier accepted; identical ones are not separated; OFS 100 everywhere is reported."""
