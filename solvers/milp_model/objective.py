@@ -26,7 +26,7 @@ True
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -84,8 +84,7 @@ class FireSnapshot:
     The MILP schedulers keep the snapshots of the last ``recent_fire_s`` seconds (a few dozen in
     an episode that replans several times a second) and every model counts the known cells near
     each block in each of them: a snapshot kept by the scheduler counts them once for the blocks
-    of every model after it (they change only when the graph's blocks do). It unpacks as
-    ``(positions, cells)``.
+    of every model after it (they change only when the graph's blocks do).
 
     Examples
     --------
@@ -102,15 +101,6 @@ class FireSnapshot:
         self._centres: np.ndarray | None = None
         self._reach = np.nan
         self._near = np.zeros(0)
-
-    def __iter__(self) -> Iterator[np.ndarray]:
-        return iter((self.pos, self.cells))
-
-    def __len__(self) -> int:
-        return 2
-
-    def __getitem__(self, i: int) -> np.ndarray:
-        return (self.pos, self.cells)[i]
 
     def counted(self, centres: np.ndarray, reach: float) -> bool:
         """True when :meth:`near` of ``centres`` and ``reach`` is known already."""
