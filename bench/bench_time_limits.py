@@ -60,7 +60,7 @@ import numpy as np
 
 from fcplan import load_scenario, run_episode
 from fcplan.scenario import GeneratorConfig
-from fcplan.scheduling import available_schedulers, make_scheduler, solve
+from fcplan.scheduling import SolveStats, available_schedulers, make_scheduler, solve
 from fcplan.taskgraph import TaskGraph, synthetic_task_graph
 from fcplan.testing import episode_graphs
 
@@ -111,6 +111,16 @@ def pct(a: np.ndarray, q: float) -> float:
     return float(np.percentile(a, q)) if len(a) else float("nan")
 
 
+def record(st: SolveStats, limit: float, cpu: float) -> dict:
+    """One call's record: wall and CPU time, status, whether the clock caused a fallback, the
+    proven gap and whether a MILP finished the plan late."""
+    return dict(
+        wall=st.wall_time_s, cpu=cpu, status=st.status,
+        timed_out=st.timed_out or (st.status == "fallback" and st.solver_s >= limit),
+        gap=st.gap, late=bool(st.size.get("late")),
+    )  # fmt: skip
+
+
 def calls(
     name: str, seqs: list[tuple[str, list[TaskGraph]]], limit: float, by_size: bool
 ) -> Iterator[tuple[str, dict]]:
@@ -121,11 +131,7 @@ def calls(
             c0 = time.process_time()
             plan = solve(scheduler, g, time_limit=limit, rng=np.random.default_rng(0))
             st = plan.stats
-            yield (label if by_size else ""), dict(
-                wall=st.wall_time_s, cpu=time.process_time() - c0, status=st.status,
-                timed_out=st.timed_out or (st.status == "fallback" and st.solver_s >= limit),
-                gap=st.gap, late=bool(st.size.get("late")),
-            )  # fmt: skip
+            yield (label if by_size else ""), record(st, limit, time.process_time() - c0)
 
 
 def episode_calls(name: str, design: str, limit: float) -> Iterator[tuple[str, dict]]:
@@ -134,11 +140,7 @@ def episode_calls(name: str, design: str, limit: float) -> Iterator[tuple[str, d
     for _label, sc in scenarios_of(design):
         res = run_episode(sc, make_scheduler(name), seed=0, time_limit=limit)
         for st in res.solves:
-            yield "", dict(
-                wall=st.wall_time_s, cpu=float("nan"), status=st.status,
-                timed_out=st.timed_out or (st.status == "fallback" and st.solver_s >= limit),
-                gap=st.gap, late=bool(st.size.get("late")),
-            )  # fmt: skip
+            yield "", record(st, limit, float("nan"))
 
 
 def row(design: str, group: str, name: str, limit: float, recs: list[dict], load: str) -> str:

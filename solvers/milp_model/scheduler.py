@@ -77,7 +77,7 @@ from solvers.milp_model.types import IncompletePlanError, MilpModel, MilpParams
 __all__ = ["MilpSchedulerBase"]
 
 
-_LNS = ("exact_routes", "lns_routes", "lns_rounds", "finish_late")
+_LNS = ("exact_routes", "lns_routes", "lns_rounds")
 
 #: The model sizes a wall-clock limit steps down through: each caps the configured settings.
 MODEL_STEPS: tuple[dict[str, int], ...] = (
@@ -176,7 +176,7 @@ class MilpSchedulerBase:
         known = [f.name for f in fields(MilpParams)]
         for key, value in model_settings.items():
             if key not in known:
-                own = ["deterministic", "time_limit", "work_limit", "seed", *_LNS]
+                own = ["deterministic", "time_limit", "work_limit", "seed", *_LNS, "finish_late"]
                 takes = ", ".join([*own, *known])
                 raise SettingError(key, f"unknown setting; {self.name} takes: {takes}", value=value)
         self.params = MilpParams(**model_settings)
@@ -256,7 +256,8 @@ class MilpSchedulerBase:
         )
         # the completion of the solution (solve_model's last step) stops only at the deadline:
         # before it, the completion ran until no route gains, so no agent is idle with work
-        done = deadline is None or time.perf_counter() < deadline
+        # (a plan already finishing late had its warm start completed without a deadline)
+        done = deadline is None or bool(late) or time.perf_counter() < deadline
         idle = np.zeros(0, dtype=np.int64) if done else idle_agents(model, x)
         if idle.size:  # only when the deadline passed before the warm start was complete
             names = ", ".join(graph.agent_ids[a] for a in idle.tolist())

@@ -136,13 +136,12 @@ def solve_pyvrp(
         return _out_of_time(inst, warm)  # (before building the data)
     data = _data(inst, opts.scale)
     phases = TOUR_PHASES if _is_tour(inst) else 1
-    if deadline is None:
-        budget = float(opts.iterations)
-    else:
+    run_s = 0.0  # wall-clock mode: the search's run time
+    if deadline is not None:
         time_left = deadline - time.perf_counter() - opts.reserve_s
         if time_left <= 0:
             return _out_of_time(inst, warm)
-        budget = opts.wall_fraction * time_left
+        run_s = opts.wall_fraction * time_left
     init = None
     if warm is not None and from_warm:
         init = pyvrp.Solution(data, [pyvrp.Route(data, r, v) for v, r in enumerate(warm) if r])
@@ -157,10 +156,11 @@ def solve_pyvrp(
     )
     best, iterations, start = None, 0, init
     for phase in range(phases):
-        if deadline is None:
-            stop: Any = MaxIterations(int(budget) // phases + (phase < int(budget) % phases))
+        if deadline is None:  # the iterations split as evenly as they go
+            n = int(opts.iterations)
+            stop: Any = MaxIterations(n // phases + (phase < n % phases))
         else:
-            stop = MaxRuntime(budget / phases)
+            stop = MaxRuntime(run_s / phases)
         seed = (int(opts.seed) + phase) % 2**32
         res = pyvrp.solve(data, stop, seed=seed, collect_stats=False, params=params,
                           initial_solution=start)  # fmt: skip
