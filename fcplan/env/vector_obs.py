@@ -9,19 +9,18 @@ once, exactly what :class:`fcplan.env.motion_obs.MotionObs` builds for one world
 Coarse maps. Every world keeps the seven observation channels of its coarse cells, padded by
 ``view // 2`` cells as in :class:`fcplan.env.motion_grid.CoarseMaps`, *channel last*:
 :attr:`BatchMotionObs.maps` is ``(B, H, H, 7)`` float32 holding known (scaled, clipped), pruned
-(scaled, clipped), a staleness slot, agents (0/1), and the scenario's static outside, lake and
-facility shares (the same in every world, copied once). ``counts`` ``(B, H, H, 2)`` holds the
-known and pruned cell counts behind the scaled channels. ``seen`` (minus the tick each cell was
-last covered, times the staleness scale; ``+inf`` never) is kept apart, :attr:`BatchMotionObs.seen`
-``(B, H, H)``, so that covering the fields of view each tick writes a compact array. All ``B N``
-crops are one fancy-indexed gather of ``sliding_window_view(maps)``, which yields them directly in
-the ``(7, view, view)`` layout; with the channels last, each window row is one run of ``7 view``
-floats, and the gather runs about twice as fast as from channel-first maps
-(``bench/README.md``). The staleness ``min(1, seen + tick scale)`` is then computed on the
-crops of ``seen`` only (a second, compact gather), as the same float32 operations as the single
-map's, and written into the crops' staleness slot. The true burning layer behind
-:meth:`BatchMotionObs.state` is brought up to date only when read (the fire's changes are queued
-per tick, as the single map queues them).
+(scaled, clipped), ``seen`` (minus the tick each cell was last covered, times the staleness
+scale; ``+inf`` never), agents (0/1), and the scenario's static outside, lake and facility
+shares (the same in every world, copied once). ``counts`` ``(B, H, H, 2)`` holds the known and
+pruned cell counts behind the scaled channels. All ``B N`` crops are one fancy-indexed gather of
+``sliding_window_view(maps)``, which yields them directly in the ``(7, view, view)`` layout;
+with the channels last, each window row is one run of ``7 view`` floats, and the gather runs
+about twice as fast as from channel-first maps (``bench/README.md``). The staleness
+``min(1, seen + tick scale)`` is then computed in place on the crops' ``seen`` slot, as the same
+float32 operations as the single map's (``seen`` once lived in an array of its own and was
+gathered a second time; ``bench/README.md`` has the two timings). The
+true burning layer behind :meth:`BatchMotionObs.state` is brought up to date only when read (the
+fire's changes are queued per tick, as the single map queues them).
 
 Examples
 --------
@@ -103,9 +102,9 @@ class BatchMotionObs:
         v = self.view
         #: (B, H - v + 1, H - v + 1, 7, v, v) windows: a crop is ``windows[b, cx, cy]``
         self.windows = sliding_window_view(self.maps, (v, v), axis=(1, 2))
-        #: (B, H, H) float32: the ``seen`` channel, kept apart (module docstring)
-        self.seen = np.full((self.num, h, h), np.inf, dtype=np.float32)
-        self._seen_windows = sliding_window_view(self.seen, (v, v), axis=(1, 2))
+        #: (B, H, H) float32 view of the ``seen`` channel of :attr:`maps` (module docstring)
+        self.seen = self.maps[..., D_SEEN]
+        self.seen[:] = np.inf
         self._inv_c = 1.0 / self.cell_px
         letters = role_letters(sc)
         self.letters = letters
@@ -135,7 +134,7 @@ class BatchMotionObs:
     def reset_worlds(self, rows: np.ndarray) -> None:
         """Fresh maps for the worlds ``rows``: no fire known, nothing seen, no agent placed."""
         self.maps[rows, :, :, :4] = 0.0
-        self.seen[rows] = np.inf
+        self.maps[rows, :, :, D_SEEN] = np.inf
         self.counts[rows] = 0.0
         self._flush()
         self.burning[rows] = 0.0
@@ -216,7 +215,7 @@ class BatchMotionObs:
         i = i0[rep] + local // nj[rep] + r
         j = j0[rep] + local % nj[rep] + r
         wr = wb[rep]
-        self.seen.reshape(-1)[(wr * h + i) * h + j] = value[wr]
+        self.maps.reshape(-1)[((wr * h + i) * h + j) * N_FOV + D_SEEN] = value[wr]
 
     # ------------------------------------------------------------------ observations
     def agent_arrays(self, batch: BatchWorld) -> tuple[np.ndarray, np.ndarray]:
@@ -283,11 +282,9 @@ class BatchMotionObs:
         v = self.view
         fov = self.windows[self._world_of, cx.reshape(-1), cy.reshape(-1)]  # (one gather)
         stamp = (batch.tick * self.seen_scale).astype(np.float32)
-        seen = self._seen_windows[self._world_of, cx.reshape(-1), cy.reshape(-1)]
-        seen = seen.reshape(self.num, self.n, v * v)
-        seen += stamp[:, None, None]
         stale = fov.reshape(self.num, self.n, N_FOV, v * v)[:, :, D_SEEN]
-        np.minimum(seen, _ONE32, out=stale)
+        stale += stamp[:, None, None]
+        np.minimum(stale, _ONE32, out=stale)
         fov[:, D_AGENTS, self.radius, self.radius] = shared.reshape(-1)
         fov = fov.reshape(self.num, self.n, N_FOV, v, v)
         return {"fov": fov, "agent": vec, "action_mask": masks}
