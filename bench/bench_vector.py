@@ -10,16 +10,20 @@ draw is not timed):
   together: ``n_ticks`` steps, next-step autoreset of all of them at the end included), timing
   ``env.step`` and inside it the batched simulator (``BatchWorld.step``).
 
-It prints world-steps per second (``B`` x steps / time) on the thread's CPU clock and on the wall
-clock with the load average (the machine may be shared: compare the CPU-time ratios), the ratio
-to the single env of the same scenario measured in the same run, the simulator alone (its ratio
+The measurements are interleaved in ``--rounds`` rounds (default 3): each round plays the single
+env and then every ``B``, so that a change of the machine's speed during the run (it is shared:
+the single env's own rate was seen to vary 1.7x between two runs of the same command) reaches
+both sides of a ratio. It prints the median over the rounds of world-steps per second (``B`` x
+steps / time) on the thread's CPU clock and on the wall clock with the load average, the median
+of the rounds' ratios to the single env of the same scenario, with their range, the simulator alone (its ratio
 too), where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
 action decoding, rewards), and the memory per world (``tracemalloc``: the growth from the
 smallest to the largest ``B``, per added world; the tables every world shares are the rest).
 
 Usage::
 
-    python bench/bench_vector.py                       # about 4 minutes on a quiet 2-core machine
+    python bench/bench_vector.py                       # about 25 minutes on a quiet 2-core machine
+    python bench/bench_vector.py --rounds 1            # one round, about 8 minutes
     python bench/bench_vector.py --quick               # 30-s episodes, sizes 1, 16, 256
     python bench/bench_vector.py --plot vector.png     # also plot throughput against B
     python bench/bench_vector.py --duration 60         # 60-s episodes (a loaded machine)
@@ -236,6 +240,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--levels", nargs="+", default=["motion", "task"], choices=["motion", "task"])
     ap.add_argument("--task-max", type=int, default=256, help="largest B at the task level")
     ap.add_argument("--plot", default=None, help="write a plot of throughput against B here")
+    ap.add_argument(
+        "--rounds", type=int, default=3, help="interleaved rounds (the single env, then every B)"
+    )
     args = ap.parse_args(argv)
     sizes = args.sizes or ([1, 16, 256] if args.quick else [1, 16, 64, 256, 1024])
     print(f"# batched motion level, random legal actions; Python {platform.python_version()}, "
@@ -249,20 +256,23 @@ def main(argv: list[str] | None = None) -> int:
             if args.quick or args.duration:
                 sc = sc.replace(duration_s=args.duration or 30)
             sizes_l = [n for n in sizes if level == "motion" or n <= args.task_max]
-            results[f"{level} #{name}"] = _level(level, sc, name, sizes_l, args.episodes)
+            results[f"{level} #{name}"] = _level(
+                level, sc, name, sizes_l, args.episodes, args.rounds
+            )
     sc = load_scenario(args.scenarios[0])
     per, rest = memory_per_world(sc, 16, 64 if args.quick else 256)
     print(
         f"\nmemory, motion level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
         f"{rest / 1e6:.1f} MB shared (terrain jump tables, maps, team constants)"
     )
-    mpe = mpe_rate()
+    mpe_runs = [mpe_rate() for _ in range(args.rounds)]
+    mpe = None if mpe_runs[0] is None else float(np.median(mpe_runs))
     if mpe is None:
         print("MPE simple_spread: skipped (pip install --no-deps mpe2)")
     else:
         print(
             f"MPE simple_spread (PettingZoo, 3 agents, random actions): {mpe:.0f} steps per "
-            f"CPU second (load {os.getloadavg()[0]:.2f})"
+            f"CPU second (median of {args.rounds}; load {os.getloadavg()[0]:.2f})"
         )
         for key, rows in results.items():
             num, rate = rows[-1]
@@ -273,41 +283,59 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int) -> list:
-    """Print one level's table on one scenario; return ``[(0, single rate), (B, rate), ...]``."""
+def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int, rounds: int) -> list:
+    """Print one level's table on one scenario; return ``[(0, single rate), (B, rate), ...]``
+    (medians over ``rounds`` interleaved rounds: the single env, then every ``B``, each round)."""
     single, batched, parts = (
         (single_env, batched_env, _PARTS)
         if level == "motion"
         else (single_task, batched_task, _TASK_PARTS)
     )
-    steps, clock = single(sc, episodes)
-    base, base_sim = steps / clock.cpu["step"], steps / clock.cpu["sim"]
-    print(f"\n## {level} level, #{name}  (load {os.getloadavg()[0]:.2f})")
-    print(f"{'env':14s} {'world-steps/s':>22s} {'ratio':>7s} {'sim world-steps/s':>19s} "
-          f"{'sim ratio':>9s} {'us/world-step':>13s}")  # fmt: skip
-    print(f"{'single':14s} {base:10.0f} ({steps / clock.wall['step']:9.0f}) {1.0:7.2f} "
-          f"{base_sim:19.0f} {1.0:9.2f} {1e6 / base:13.2f}")  # fmt: skip
-    rows = [(0, base)]
-    for num in sizes:
-        ws, clock = batched(sc, num, parts=num == sizes[-1])
-        rate, sim = ws / clock.cpu["step"], ws / clock.cpu["sim"]
-        print(f"{'B=' + str(num):14s} {rate:10.0f} ({ws / clock.wall['step']:9.0f}) "
-              f"{rate / base:7.2f} {sim:19.0f} {sim / base_sim:9.2f} {1e6 / rate:13.2f}")  # fmt: skip
-        rows.append((num, rate))
-    n_steps = ws // sizes[-1]
+    runs: dict[int, list[tuple[float, float, float]]] = collections.defaultdict(list)
+    whole = Clock()  # (the breakdown at the largest B, summed over the rounds)
+    n_steps = 0
+    for _ in range(rounds):
+        steps, clock = single(sc, episodes)
+        runs[0].append(_rates(steps, clock))
+        for num in sizes:
+            ws, clock = batched(sc, num, parts=num == sizes[-1])
+            runs[num].append(_rates(ws, clock))
+        whole.cpu.update(clock.cpu)
+        n_steps += ws // sizes[-1]
+    print(f"\n## {level} level, #{name}  (load {os.getloadavg()[0]:.2f}; median of {rounds} "
+          "interleaved round(s); ratio range over the rounds in brackets)")  # fmt: skip
+    print(f"{'env':8s} {'world-steps/s':>22s} {'ratio':>6s} {'[min, max]':>12s} "
+          f"{'sim world-steps/s':>18s} {'sim ratio':>9s} {'us/world-step':>13s}")  # fmt: skip
+    rows = []
+    base = np.array(runs[0])
+    for num in [0, *sizes]:
+        r = np.array(runs[num])
+        ratio, sim_ratio = r[:, 0] / base[:, 0], r[:, 2] / base[:, 2]
+        cpu, wall, sim = np.median(r, axis=0)
+        label = "single" if num == 0 else f"B={num}"
+        print(f"{label:8s} {cpu:10.0f} ({wall:9.0f}) {np.median(ratio):6.2f} "
+              f"[{ratio.min():4.2f}, {ratio.max():4.2f}] {sim:18.0f} "
+              f"{np.median(sim_ratio):9.2f} {1e6 / cpu:13.2f}")  # fmt: skip
+        rows.append((num, float(cpu)))
     print(f"where a step goes at B={sizes[-1]} (CPU ms per step; % of env.step):")
     for label in [lab for _, _, lab in parts]:
-        ms = clock.cpu[label] / n_steps * 1e3
-        print(f"  {label:40s} {ms:9.3f}  {100 * clock.cpu[label] / clock.cpu['step']:5.1f}%")
+        ms = whole.cpu[label] / n_steps * 1e3
+        print(f"  {label:40s} {ms:9.3f}  {100 * whole.cpu[label] / whole.cpu['step']:5.1f}%")
     if level == "motion":
         env = VectorMotionEnv(sc, 1)
         shape = (sizes[-1], *env.single_observation_space["fov"].shape)
         floor = copy_floor(shape) / sizes[-1]
+        one = rows[0][1]
         print(f"observation floor at B={sizes[-1]}: {4 * np.prod(shape[1:]) / 1e3:.1f} KB of "
               f"crops per world-step; copying them once costs {1e6 * floor:.2f} us per "
-              f"world-step ({1 / floor / base:.1f}x the single env at most, were nothing else "
-              f"done; 20x leaves {1e6 / base / 20:.2f} us)")  # fmt: skip
+              f"world-step ({1 / floor / one:.1f}x the single env at most, were nothing else "
+              f"done; 20x leaves {1e6 / one / 20:.2f} us)")  # fmt: skip
     return rows
+
+
+def _rates(steps: int, clock: Clock) -> tuple[float, float, float]:
+    """(CPU, wall, simulator CPU) world-steps per second of one timed run."""
+    return steps / clock.cpu["step"], steps / clock.wall["step"], steps / clock.cpu["sim"]
 
 
 def _plot(results: dict[str, list[tuple[int, float]]], path: str) -> None:
