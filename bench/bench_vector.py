@@ -265,8 +265,8 @@ def main(argv: list[str] | None = None) -> int:
         f"\nmemory, motion level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
         f"{rest / 1e6:.1f} MB shared (terrain jump tables, maps, team constants)"
     )
-    mpe_runs = [mpe_rate() for _ in range(args.rounds)]
-    mpe = None if mpe_runs[0] is None else float(np.median(mpe_runs))
+    mpe_runs = [r for r in (mpe_rate() for _ in range(args.rounds)) if r is not None]
+    mpe = float(np.median(mpe_runs)) if mpe_runs else None
     if mpe is None:
         print("MPE simple_spread: skipped (pip install --no-deps mpe2)")
     else:
