@@ -22,8 +22,8 @@ smallest to the largest ``B``, per added world; the tables every world shares ar
 
 Usage::
 
-    python bench/bench_vector.py                       # about 25 minutes on a quiet 2-core machine
-    python bench/bench_vector.py --rounds 1            # one round, about 8 minutes
+    python bench/bench_vector.py                       # about 8 minutes on a quiet 2-core machine
+    python bench/bench_vector.py --rounds 1            # one round, about 3 minutes
     python bench/bench_vector.py --quick               # 30-s episodes, sizes 1, 16, 256
     python bench/bench_vector.py --plot vector.png     # also plot throughput against B
     python bench/bench_vector.py --duration 60         # 60-s episodes (a loaded machine)
