@@ -41,7 +41,14 @@ class Trial:
     stray_temporaries: list[str] = field(default_factory=list)
 
 
-def write_config(folder: Path, duration: float = 120.0) -> Path:
+#: long enough episodes that the sweep is still running when the first of its 6 rows is stored:
+#: at 120 s the whole sweep of practice took 0.8 s on a fast 2-core machine (2026-12-02), ended
+#: before a test could see a row and two workers together, and the kill tests failed; at 3,600 s
+#: it took 7.7 s there
+DURATION_S = 3600.0
+
+
+def write_config(folder: Path, duration: float = DURATION_S) -> Path:
     path = folder / "study.toml"
     path.write_text(CONFIG.format(duration=duration), encoding="utf-8")
     return path
