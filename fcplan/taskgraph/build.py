@@ -251,7 +251,9 @@ class TaskGraphBuilder:
         d_fac = _rect_distance(fire_pos, consts.fac_rect)
         close = np.minimum(np.maximum(1.0 - d_fac / radius, 0.0), 1.0)
         speed = max(0.24 * consts.max_fuel * 10.0, 1e-9)  # px/s, first-tick spread at wind 5
-        return close @ consts.fac_pen, np.where(d_fac < radius, d_fac / speed, np.inf)
+        return penalty_weighted(close, consts.fac_pen), np.where(
+            d_fac < radius, d_fac / speed, np.inf
+        )
 
     def _fire_fields(
         self,
@@ -377,6 +379,27 @@ def _columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def _cat_int(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Concatenation as int64 (as ``np.r_[a, b].astype(np.int64)``)."""
     return np.concatenate([a, b]).astype(np.int64, copy=False)
+
+
+def penalty_weighted(close: np.ndarray, pen: np.ndarray) -> np.ndarray:
+    """(P,) threat ``sum_f close[:, f] * pen[f]``, the facilities added in their order with one
+    multiply and one add each.
+
+    Not ``close @ pen``: a matrix product runs the CPU's BLAS kernel, whose order of additions,
+    fused multiply-adds and alignment-dependent paths differ between machines, so the threats'
+    last bits (and the traces' exact digests) differed on an AMD EPYC from the ones recorded on
+    another AVX-512 machine with the same numpy (2026-12-02); elementwise IEEE operations are
+    the same everywhere.
+
+    Examples
+    --------
+    >>> penalty_weighted(np.array([[0.5, 1.0], [0.0, 0.25]]), np.array([2.0, 4.0])).tolist()
+    [5.0, 1.0]
+    """
+    out = np.zeros(close.shape[0])
+    for f, w in enumerate(pen.tolist()):
+        out += close[:, f] * w
+    return out
 
 
 def _rect_distance(points: np.ndarray, rects: np.ndarray) -> np.ndarray:

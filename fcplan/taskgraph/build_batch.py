@@ -33,6 +33,7 @@ from fcplan.taskgraph.build import (
     _neighbours,
     _rect_distance,
     graph_fields,
+    penalty_weighted,
     tile_keys,
     tile_runs,
     unique_ids,
@@ -139,7 +140,7 @@ def _fire_graphs(
         s, e = int(cuts[j]), int(cuts[j + 1])
         fire_ids = unique_ids(ids[s:e])
         cluster = clusters[s:e]
-        threat = close[s:e].copy() @ consts.fac_pen if n_fac else np.zeros(e - s)
+        threat = penalty_weighted(close[s:e], consts.fac_pen) if n_fac else np.zeros(e - s)
         agent_pos = team.pos.copy()
         fields, views = graph_fields(
             b, tc, agent_pos, pos[s:e], counts[s:e], stale[s:e], cluster, threat,

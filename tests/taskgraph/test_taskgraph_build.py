@@ -372,3 +372,30 @@ def test_builder_with_params_equals_build_task_graph():
     builder = TaskGraphBuilder(world.scenario, params)
     assert builder.params is params
     assert_same_graph(builder.build(world.team, belief), graph_of(world, belief, params))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(0, 12),
+    st.integers(0, 6),
+    st.integers(0, 2**32 - 1),
+)
+def test_penalty_weighted_adds_the_facilities_in_order(n, f, seed):
+    """The threat ``penalty_weighted(close, pen)`` is, bit for bit, the plain left-to-right sum
+    ``0 + close[i, 0] pen[0] + close[i, 1] pen[1] + ...`` of Python floats (no BLAS, so the same
+    on every machine), and agrees with the matrix product to rounding."""
+    from fcplan.taskgraph.build import penalty_weighted
+
+    rng = np.random.default_rng(seed)
+    close = rng.random((n, f))
+    pen = rng.choice([0.0, 1.0, 2.5, 10.0], f) * rng.random(f)
+    got = penalty_weighted(close, pen)
+    want = []
+    for row in close.tolist():
+        total = 0.0
+        for c, w in zip(row, pen.tolist(), strict=True):
+            total += c * w
+        want.append(total)
+    assert got.dtype == np.float64 and got.shape == (n,)
+    assert got.tolist() == want
+    np.testing.assert_allclose(got, close @ pen, rtol=1e-12, atol=1e-12)
