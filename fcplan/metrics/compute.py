@@ -138,8 +138,12 @@ def facility_penalty(in_facility: np.ndarray, penalties: np.ndarray) -> float:
     --------
     >>> facility_penalty(np.array([0, 3]), np.array([5.0, 2.0]))
     6.0
+
+    The sum is numpy's over the products, as in the rate of every tick (``_penalty_rate``), not
+    a dot product: BLAS's order of additions and fused multiply-adds follow the CPU, so a
+    fractional penalty's last bits would differ between machines.
     """
-    return float(in_facility @ penalties)
+    return float((in_facility * penalties).sum())
 
 
 def penalty_rate(active: float, facility_term: float, weight: float) -> float:

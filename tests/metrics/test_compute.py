@@ -546,3 +546,17 @@ def test_negative_reward_rate_hand_computed():
     assert rate.sum() / tr.ticks_per_second == pytest.approx(
         compute_metrics(tr).total_negative_reward
     )
+
+
+@pytest.mark.parametrize("n_fac", [0, 1, 3, 7, 8, 13])
+def test_facility_penalty_is_the_rate_s_own_sum(n_fac):
+    """``facility_penalty`` of one tick's counts is, bit for bit, the facility term of that
+    tick's row of the per-tick rate (``_penalty_rate``), for fractional penalties too: one
+    order of additions (numpy's sum, not a BLAS dot whose order follows the CPU)."""
+    from fcplan.metrics.compute import _penalty_rate, facility_penalty
+
+    rng = np.random.default_rng(n_fac)
+    counts = rng.integers(0, 400, size=(50, n_fac))
+    pen = rng.random(n_fac) * 10.0
+    rows = _penalty_rate(np.zeros(50), counts, pen, 0.0)
+    assert [facility_penalty(c, pen) for c in counts] == rows.tolist()
