@@ -15,8 +15,8 @@ env and then every ``B``, so that a change of the machine's speed during the run
 the single env's own rate was seen to vary 1.7x between two runs of the same command) reaches
 both sides of a ratio. It prints the median over the rounds of world-steps per second (``B`` x
 steps / time) on the thread's CPU clock and on the wall clock with the load average, the median
-of the rounds' ratios to the single env of the same scenario, with their range, the simulator alone (its ratio
-too), where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
+of the rounds' ratios to the single env of the same scenario with their range, the simulator
+alone (its ratio too), where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
 action decoding, rewards), and the memory per world (``tracemalloc``: the growth from the
 smallest to the largest ``B``, per added world; the tables every world shares are the rest).
 

@@ -174,7 +174,7 @@ def two_sweeps(folder: Path) -> tuple[Trial, Trial]:
     The first sweep's episodes must outlast the second's start-up (about a second): at 600
     simulated seconds a greedy episode took under a second, so the first could finish its six
     before the second looked at the folder; at 3,600 s the five left take about ten."""
-    config, results = write_config(folder, duration=3600.0), folder / "results"
+    config, results = write_config(folder), folder / "results"
     first = start_sweep(config, results)
     workers = _running(first, results)
     second = start_sweep(config, results, jobs=1)
