@@ -8,15 +8,20 @@ draw is not timed):
 * :class:`fcplan.env.vector_motion.VectorMotionEnv` with ``B`` worlds for every ``B`` of
   ``--sizes`` (default 1, 16, 64, 256, 1024), one whole episode of every world (the worlds start
   together: ``n_ticks`` steps, next-step autoreset of all of them at the end included), timing
-  ``env.step`` and inside it the batched simulator (``BatchWorld.step``).
+  ``env.step`` and inside it the batched simulator (``BatchWorld.step``);
+* for every ``B`` of ``--sync-sizes`` (default 4, 16), what a learner gets without the batched
+  simulator: Gymnasium's ``SyncVectorEnv`` of the single env (``gymnasium.make_vec(...,
+  vectorization_mode="sync")``, the same worlds), one whole episode of every world, timing its
+  ``step``.
 
 The measurements are interleaved in ``--rounds`` rounds (default 3): each round plays the single
-env and then every ``B``, so that a change of the machine's speed during the run (it is shared:
-the single env's own rate was seen to vary 1.7x between two runs of the same command) reaches
-both sides of a ratio. It prints the median over the rounds of world-steps per second (``B`` x
-steps / time) on the thread's CPU clock and on the wall clock with the load average, the median
-of the rounds' ratios to the single env of the same scenario with their range, the simulator
-alone (its ratio too), where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
+env, then every ``B``, then the sync vector envs, so that a change of the machine's speed during
+the run (it is shared: the single env's own rate was seen to vary 1.7x between two runs of the
+same command) reaches both sides of a ratio. It prints the median over the rounds of world-steps
+per second (``B`` x steps / time) on the thread's CPU clock and on the wall clock with the load
+average, the median of the rounds' ratios to the single env of the same scenario with their
+range, the simulator alone (its ratio too), the batched env over the sync one at the same ``B``,
+where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
 action decoding, rewards), and the memory per world (``tracemalloc``: the growth from the
 smallest to the largest ``B``, per added world; the tables every world shares are the rest).
 
@@ -41,10 +46,12 @@ import tracemalloc
 from collections.abc import Callable
 from typing import Any
 
+import gymnasium
 import numpy as np
 
 import fcplan.batch.fire as bfire
 import fcplan.batch.world as bworld
+import fcplan.env  # noqa: F401  (registers the fcplan/ ids for the sync vector envs)
 import fcplan.env.vector_motion as vmotion
 import fcplan.env.vector_obs as vobs
 import fcplan.env.vector_task as vtask
@@ -126,6 +133,15 @@ def batched_env(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int, 
     return _batched(VectorMotionEnv(sc, num), sc.n_ticks + 1, _PARTS if parts else _PARTS[:1], seed)
 
 
+def sync_env(sc: Any, num: int, level: str, seed: int = 0) -> tuple[int, Clock]:
+    """World-steps of one whole episode of ``num`` worlds of Gymnasium's ``SyncVectorEnv`` of the
+    single env (``fcplan/Motion-v0`` or ``fcplan/Task-v0``), timed (``step`` only)."""
+    env_id = "fcplan/Motion-v0" if level == "motion" else "fcplan/Task-v0"
+    env = gymnasium.make_vec(env_id, num, vectorization_mode="sync", scenario=sc)
+    n_steps = sc.n_ticks + 1 if level == "motion" else VectorTaskEnv(sc, 1).one.max_steps + 1
+    return _batched(env, n_steps, [], seed)
+
+
 def _batched(env: Any, n_steps: int, parts: list, seed: int) -> tuple[int, Clock]:
     """``n_steps`` steps of a batched env with random legal actions, ``parts`` timed too."""
     rng = np.random.default_rng(seed)
@@ -137,6 +153,7 @@ def _batched(env: Any, n_steps: int, parts: list, seed: int) -> tuple[int, Clock
         obs, *_ = clock.step(env.step, (rng.random(m.shape) * m).argmax(axis=2))
     for u in undo:
         u()
+    clock.cpu["sim"] = clock.cpu["sim"] or np.nan  # (a sync env's simulator is not timed apart)
     return env.num_envs * n_steps, clock
 
 
@@ -236,6 +253,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--duration", type=float, default=None, help="episode length (s)")
     ap.add_argument("--sizes", type=int, nargs="+", default=None, help="batch sizes B")
     ap.add_argument("--episodes", type=int, default=2, help="single-env episodes")
+    ap.add_argument("--sync-sizes", type=int, nargs="*", default=[4, 16],
+                    help="B of the SyncVectorEnv of the single env measured too")  # fmt: skip
     ap.add_argument("--scenarios", nargs="+", default=["1", "24"])
     ap.add_argument("--levels", nargs="+", default=["motion", "task"], choices=["motion", "task"])
     ap.add_argument("--task-max", type=int, default=256, help="largest B at the task level")
@@ -244,7 +263,7 @@ def main(argv: list[str] | None = None) -> int:
         "--rounds", type=int, default=3, help="interleaved rounds (the single env, then every B)"
     )
     args = ap.parse_args(argv)
-    sizes = args.sizes or ([1, 16, 256] if args.quick else [1, 16, 64, 256, 1024])
+    sizes = args.sizes or ([1, 16, 256] if args.quick else [1, 4, 16, 64, 256, 1024])
     print(f"# batched motion level, random legal actions; Python {platform.python_version()}, "
           f"numpy {np.__version__}; load average at start {os.getloadavg()[0]:.2f}")  # fmt: skip
     print("# world-steps/s on the thread CPU clock (wall clock); ratio = CPU-time world-steps/s "
@@ -257,7 +276,7 @@ def main(argv: list[str] | None = None) -> int:
                 sc = sc.replace(duration_s=args.duration or 30)
             sizes_l = [n for n in sizes if level == "motion" or n <= args.task_max]
             results[f"{level} #{name}"] = _level(
-                level, sc, name, sizes_l, args.episodes, args.rounds
+                level, sc, name, sizes_l, args.episodes, args.rounds, args.sync_sizes
             )
     sc = load_scenario(args.scenarios[0])
     per, rest = memory_per_world(sc, 16, 64 if args.quick else 256)
@@ -283,9 +302,11 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int, rounds: int) -> list:
+def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int, rounds: int,
+           sync_sizes: list[int]) -> list:  # fmt: skip
     """Print one level's table on one scenario; return ``[(0, single rate), (B, rate), ...]``
-    (medians over ``rounds`` interleaved rounds: the single env, then every ``B``, each round)."""
+    (medians over ``rounds`` interleaved rounds: the single env, then every ``B``, then the sync
+    vector env of every ``B`` of ``sync_sizes``, each round)."""
     single, batched, parts = (
         (single_env, batched_env, _PARTS)
         if level == "motion"
@@ -302,21 +323,28 @@ def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int, roun
             runs[num].append(_rates(ws, clock))
         whole.cpu.update(clock.cpu)
         n_steps += ws // sizes[-1]
+        for num in sync_sizes:
+            runs[-num].append(_rates(*sync_env(sc, num, level)))
     print(f"\n## {level} level, #{name}  (load {os.getloadavg()[0]:.2f}; median of {rounds} "
           "interleaved round(s); ratio range over the rounds in brackets)")  # fmt: skip
-    print(f"{'env':8s} {'world-steps/s':>22s} {'ratio':>6s} {'[min, max]':>12s} "
+    print(f"{'env':10s} {'world-steps/s':>22s} {'ratio':>6s} {'[min, max]':>12s} "
           f"{'sim world-steps/s':>18s} {'sim ratio':>9s} {'us/world-step':>13s}")  # fmt: skip
     rows = []
     base = np.array(runs[0])
-    for num in [0, *sizes]:
+    for num in [0, *sizes, *(-n for n in sync_sizes)]:
         r = np.array(runs[num])
         ratio, sim_ratio = r[:, 0] / base[:, 0], r[:, 2] / base[:, 2]
         cpu, wall, sim = np.median(r, axis=0)
-        label = "single" if num == 0 else f"B={num}"
-        print(f"{label:8s} {cpu:10.0f} ({wall:9.0f}) {np.median(ratio):6.2f} "
+        label = "single" if num == 0 else f"B={num}" if num > 0 else f"sync B={-num}"
+        print(f"{label:10s} {cpu:10.0f} ({wall:9.0f}) {np.median(ratio):6.2f} "
               f"[{ratio.min():4.2f}, {ratio.max():4.2f}] {sim:18.0f} "
               f"{np.median(sim_ratio):9.2f} {1e6 / cpu:13.2f}")  # fmt: skip
         rows.append((num, float(cpu)))
+    sync = {-n: c for n, c in rows if n < 0}
+    if sync:
+        print("batched over sync at the same B: " + ", ".join(
+            f"B={n} {c / sync[n]:.2f}x" for n, c in rows if n in sync))  # fmt: skip
+    rows = [(n, c) for n, c in rows if n >= 0]
     print(f"where a step goes at B={sizes[-1]} (CPU ms per step; % of env.step):")
     for label in [lab for _, _, lab in parts]:
         ms = whole.cpu[label] / n_steps * 1e3

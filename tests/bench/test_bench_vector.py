@@ -9,23 +9,28 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 #: a table row: name, CPU rate (wall rate), ratio [min, max], ...
-ROW = re.compile(r"(single|B=\d+)\s+\d+ \(\s*\d+\)\s+([\d.]+) \[([\d.]+), ([\d.]+)\]")
+ROW = re.compile(r"(single|B=\d+|sync B=\d+)\s+\d+ \(\s*\d+\)\s+([\d.]+) \[([\d.]+), ([\d.]+)\]")
 
 
 def test_interleaved_rounds_print_medians_and_ratio_ranges(tmp_path):
     """Two rounds of tiny episodes at both levels: every level's table names its rounds, has a
-    row per ``B`` with a ratio range ``[min, max]`` that holds its median, and the plot is
-    written (the script's own arithmetic on real runs, not the figures, which are timings)."""
+    row per ``B`` and per sync ``B`` (Gymnasium's SyncVectorEnv of the single env) with a ratio
+    range ``[min, max]`` that holds its median, the batched env over the sync one at their common
+    ``B``, and the plot is written (the script's own arithmetic on real runs, not the figures,
+    which are timings)."""
     plot = tmp_path / "vector.png"
     out = subprocess.run(
         [sys.executable, "bench/bench_vector.py", "--sizes", "1", "3", "--duration", "2",
-         "--scenarios", "practice", "--rounds", "2", "--episodes", "1", "--plot", str(plot)],
+         "--scenarios", "practice", "--rounds", "2", "--episodes", "1", "--sync-sizes", "3",
+         "--plot", str(plot)],
         cwd=ROOT, capture_output=True, text=True, check=True, timeout=300,
     ).stdout  # fmt: skip
     assert out.count("median of 2 interleaved round(s)") == 2
-    rows = [ROW.match(line) for line in out.splitlines() if line.startswith(("single ", "B="))]
+    starts = ("single ", "B=", "sync ")
+    rows = [ROW.match(line) for line in out.splitlines() if line.startswith(starts)]
     assert all(rows)
-    assert [m[1] for m in rows if m] == ["single", "B=1", "B=3"] * 2
+    assert [m[1] for m in rows if m] == ["single", "B=1", "B=3", "sync B=3"] * 2
+    assert len(re.findall(r"batched over sync at the same B: B=3 [\d.]+x", out)) == 2
     for m in rows:
         assert m is not None
         median, lo, hi = float(m[2]), float(m[3]), float(m[4])
