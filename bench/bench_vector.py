@@ -294,7 +294,7 @@ def main(argv: list[str] | None = None) -> int:
             f"CPU second (median of {args.rounds}; load {os.getloadavg()[0]:.2f})"
         )
         for key, rows in results.items():
-            num, rate = rows[-1]
+            num, rate = max(rows)
             print(f"  {key}: single env {rows[0][1] / mpe:.2f}x MPE, B={num} {rate / mpe:.1f}x MPE")
     if args.plot:
         _plot(results, args.plot)
@@ -304,7 +304,8 @@ def main(argv: list[str] | None = None) -> int:
 
 def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int, rounds: int,
            sync_sizes: list[int]) -> list:  # fmt: skip
-    """Print one level's table on one scenario; return ``[(0, single rate), (B, rate), ...]``
+    """Print one level's table on one scenario; return ``[(0, single rate), (B, rate), ...,
+    (-B, sync rate), ...]``
     (medians over ``rounds`` interleaved rounds: the single env, then every ``B``, then the sync
     vector env of every ``B`` of ``sync_sizes``, each round)."""
     single, batched, parts = (
@@ -344,7 +345,6 @@ def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int, roun
     if sync:
         print("batched over sync at the same B: " + ", ".join(
             f"B={n} {c / sync[n]:.2f}x" for n, c in rows if n in sync))  # fmt: skip
-    rows = [(n, c) for n, c in rows if n >= 0]
     print(f"where a step goes at B={sizes[-1]} (CPU ms per step; % of env.step):")
     for label in [lab for _, _, lab in parts]:
         ms = whole.cpu[label] / n_steps * 1e3
@@ -374,16 +374,19 @@ def _plot(results: dict[str, list[tuple[int, float]]], path: str) -> None:
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for k, (name, rows) in enumerate(results.items()):
-        xs = [b for b, _ in rows[1:]]
-        ax.plot(xs, [r for _, r in rows[1:]], "o-", color=f"C{k}", label=f"batched, {name}")
+        batched = [(b, r) for b, r in rows if b > 0]
+        sync = sorted((-b, r) for b, r in rows if b < 0)
+        ax.plot(*zip(*batched, strict=True), "o-", color=f"C{k}", label=f"batched, {name}")
+        if sync:
+            ax.plot(*zip(*sync, strict=True), "x:", color=f"C{k}", label=f"sync, {name}")
         ax.axhline(rows[0][1], color=f"C{k}", ls="--", label=f"single env, {name}")
     ax.set_xscale("log", base=2)
     ax.set_yscale("log")
     ax.set_xlabel("worlds per batch B")
     ax.set_ylabel("world-steps per CPU second")
-    ax.set_title("fcplan: batched vs single env (world-steps per CPU second)")
+    ax.set_title("fcplan: batched, sync and single env (world-steps per CPU second)", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, ncol=2)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
 
