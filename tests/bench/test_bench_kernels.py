@@ -11,7 +11,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 #: a table row: rule, numpy ms, numba ms, ratio [min, max], share %, saved %
-ROW = re.compile(r"(crops|scan)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+) \[([\d.]+), ([\d.]+)\]\s+([\d.]+)%")
+ROW = re.compile(
+    r"(crops|scan)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+) \[([\d.]+), ([\d.]+)\]\s+([\d.]+)%"
+)
 
 
 def test_kernels_equal_to_the_rules_and_one_row_per_rule():
