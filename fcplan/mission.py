@@ -229,6 +229,11 @@ class Mission:
         self.period = max(int(round(replan_period * self.scenario.ticks_per_second)), 1)
         self.event_replans = bool(event_replans)
 
+    def set_graph_params(self, params: TaskGraphParams | None) -> None:
+        """Build this episode's task graphs with ``params`` from now on (None: the defaults)."""
+        self.graph_params = params
+        self.graph_builder = TaskGraphBuilder(self.scenario, params)
+
     def track_belief(self) -> Belief:
         """Keep a belief from now on (a fresh one, knowing nothing yet) and return it."""
         self._keep_belief = True

@@ -15,7 +15,10 @@ Two levels of control over the same simulator:
 Batched: :func:`vector_env` (:mod:`fcplan.env.vector`) runs ``B`` worlds per call on
 :class:`fcplan.batch.BatchWorld` as a ``gymnasium.vector.VectorEnv``, world ``i`` bit-identical
 to the single env with seed ``s + i``; ``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B)``
-makes it too.
+makes it too. :class:`BatchPlanFollower` (:mod:`fcplan.env.vector_expert`) is the
+:class:`PlanFollower` of every world of a batched motion env, and
+:meth:`VectorTaskEnv.expert_actions <fcplan.env.vector_task.VectorTaskEnv.expert_actions>` a
+scheduler's actions on every world of the batched task level.
 
 Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with a centralised
 joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any
@@ -68,6 +71,7 @@ __all__ = [
     "Demonstrations",
     "replay_actions",
     "PlanFollower",
+    "BatchPlanFollower",
     "VERSIONED",
     "vector_env",
     "VectorMotionEnv",
@@ -87,6 +91,7 @@ _LAZY = {
     "Demonstrations": "fcplan.env.demonstrations",
     "replay_actions": "fcplan.env.demonstrations",
     "PlanFollower": "fcplan.env.motion_expert",
+    "BatchPlanFollower": "fcplan.env.vector_expert",
     "vector_env": "fcplan.env.vector",
     "VectorMotionEnv": "fcplan.env.vector_motion",
     "VectorTaskEnv": "fcplan.env.vector_task",

@@ -52,7 +52,7 @@ from fcplan.scheduling import Scheduler, make_scheduler
 from fcplan.taskgraph import TaskGraph, TaskGraphParams, TaskKind
 from fcplan.team import Mode
 
-__all__ = ["PlanFollower"]
+__all__ = ["PlanFollower", "TeamRoutes"]
 
 _FIRE = int(TaskKind.FIRE)
 _RETURNING = int(Mode.RETURNING)
@@ -100,15 +100,8 @@ class PlanFollower:
         self.replan_period = float(replan_period)
         self.time_limit = time_limit
         self.graph_params = graph_params
-        sc = env.scenario
         self._ids = list(env.possible_agents)
-        self._row = {a: i for i, a in enumerate(self._ids)}
-        letters = [
-            "H" if (a.role.can_sense and a.role.can_act) else ("P" if a.role.can_sense else "A")
-            for a in sc.agents
-        ]
-        # action index by name, per agent
-        self._act = [{name: k for k, name in enumerate(ACTION_NAMES[r])} for r in letters]
+        self._plans = TeamRoutes(self._ids, env.scenario)
         self.mission: Mission | None = None
         self.belief: Belief | None = None
         self.plan: Plan | None = None
@@ -122,11 +115,8 @@ class PlanFollower:
         self.mission = mission
         self.belief = mission.track_belief()
         mission.set_replan_rule(self.replan_period, event_replans=False)
-        mission.graph_params = self.graph_params
-        n = len(self._ids)
-        self._routes: list[list[tuple[float, float, bool]]] = [[] for _ in range(n)]
-        self._alt: list[float | None] = [None] * n
-        self._patrol = [False] * n
+        mission.set_graph_params(self.graph_params)
+        self._plans = TeamRoutes(self._ids, self.env.scenario)
         self.plan = None
         self.replans = 0
 
@@ -138,16 +128,75 @@ class PlanFollower:
         assert mission is not None
         if mission.replan_due():
             graph, plan = mission.replan(self.scheduler, time_limit=self.time_limit)
-            self._follow(plan, graph)
+            self.plan = plan
+            self.replans += 1
+            self._plans.follow(plan, graph)
         team = mission.world.team
-        pos, z_target = team.pos.tolist(), team.z_target.tolist()
-        mode, speed = team.mode.tolist(), team.speed.tolist()
-        climb = 5.0 * team.tick_scale
+        masks = {a: o["action_mask"] for a, o in observations.items()}
+        return self._plans.choose(
+            masks, team.pos.tolist(), team.z_target.tolist(), team.mode.tolist(),
+            team.speed.tolist(), 5.0 * team.tick_scale,
+        )  # fmt: skip
+
+
+class TeamRoutes:
+    """What a team was told by its last plan, and the move rule (module docstring) that follows
+    it: the one place both :class:`PlanFollower` and the batched follower
+    (:class:`fcplan.env.vector_expert.BatchPlanFollower`, one per world) keep it.
+
+    Parameters
+    ----------
+    ids : list of str
+        The agents, in row order.
+    scenario : Scenario
+        Their scenario (roles: each agent's action names).
+    """
+
+    def __init__(self, ids: list[str], scenario: Any) -> None:
+        self._ids = ids
+        self._row = {a: i for i, a in enumerate(ids)}
+        letters = [
+            "H" if (a.role.can_sense and a.role.can_act) else ("P" if a.role.can_sense else "A")
+            for a in scenario.agents
+        ]
+        #: action index by name, per agent
+        self._act = [{name: k for k, name in enumerate(ACTION_NAMES[r])} for r in letters]
+        self._can_act = [bool(a.role.can_act) for a in scenario.agents]
+        n = len(ids)
+        self._routes: list[list[tuple[float, float, bool]]] = [[] for _ in range(n)]
+        self._alt: list[float | None] = [None] * n
+        self._patrol = [False] * n
+
+    def follow(self, plan: Plan, graph: TaskGraph) -> None:
+        """Take the routes (goal positions, dump on fire tasks) and altitudes of a new plan."""
+        tidx, pos, kind = graph.task_index, graph.task_pos, graph.task_kind
+        can_act = self._can_act
+        for agent, z in plan.altitudes.items():
+            self._alt[self._row[agent]] = float(z)
+        for agent in plan.home:
+            self._routes[self._row[agent]] = []
+        for agent, route in plan.routes.items():
+            i = self._row[agent]
+            self._patrol[i] = agent in plan.patrol
+            self._routes[i] = [
+                (
+                    float(pos[tidx[t], 0]),
+                    float(pos[tidx[t], 1]),
+                    can_act[i] and int(kind[tidx[t]]) == _FIRE,
+                )
+                for t in route
+            ]
+
+    def choose(self, masks: dict[str, Any], pos: list, z_target: list, mode: list, speed: list,
+               climb: float) -> dict[str, int]:  # fmt: skip
+        """One legal action for each agent of ``masks`` (agent id -> its action mask), from the
+        team's positions, commanded altitudes, modes and speeds (lists in row order) and the
+        altitude step of a climb."""
         out = {}
         for i, a in enumerate(self._ids):
-            if a not in observations:
+            if a not in masks:
                 continue
-            mask = observations[a]["action_mask"].tolist()
+            mask = masks[a].tolist()
             act = self._act[i]
 
             def legal(name: str, act: dict[str, int] = act, mask: list[int] = mask) -> bool:
@@ -186,26 +235,3 @@ class PlanFollower:
                             break
             out[a] = act[choice]
         return out
-
-    def _follow(self, plan: Plan, graph: TaskGraph) -> None:
-        """Take the routes (goal positions, dump on fire tasks) and altitudes of a new plan."""
-        self.plan = plan
-        self.replans += 1
-        tidx, pos, kind = graph.task_index, graph.task_pos, graph.task_kind
-        assert self.mission is not None
-        can_act = self.mission.world.team.can_act.tolist()
-        for agent, z in plan.altitudes.items():
-            self._alt[self._row[agent]] = float(z)
-        for agent in plan.home:
-            self._routes[self._row[agent]] = []
-        for agent, route in plan.routes.items():
-            i = self._row[agent]
-            self._patrol[i] = agent in plan.patrol
-            self._routes[i] = [
-                (
-                    float(pos[tidx[t], 0]),
-                    float(pos[tidx[t], 1]),
-                    can_act[i] and int(kind[tidx[t]]) == _FIRE,
-                )
-                for t in route
-            ]

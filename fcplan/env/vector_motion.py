@@ -122,6 +122,9 @@ class VectorMotionEnv(BatchedEnv):
         self._weight = sc.scoring.propagation_weight
         self._fb_last = np.full((b, self.batch.n_facilities), -1, dtype=np.int64)
         self._fb_pen = np.zeros(b)
+        #: the batched simulator's report of the last step (None before the first): what a
+        #: batched expert folds into its beliefs (:mod:`fcplan.env.vector_expert`)
+        self.last_info: BatchStepInfo | None = None
 
     def _actions_table(self) -> None:
         """Per agent and action: kind, goal offset (dx, dy) and altitude change."""
@@ -175,6 +178,7 @@ class VectorMotionEnv(BatchedEnv):
         next_step = self.autoreset_mode is AutoresetMode.NEXT_STEP
         self._decode(act, run)
         info = batch.step(autoreset=next_step)
+        self.last_info = info
         batch.team.armed.fill(False)
         if np.count_nonzero(info.reset):
             self._reset_views(np.flatnonzero(info.reset))

@@ -82,11 +82,11 @@ from fcplan.metrics import facility_penalty, penalty_rate
 from fcplan.mission import ScenarioLike
 from fcplan.plan import validate_plan
 from fcplan.scheduling import Scheduler, solve
-from fcplan.taskgraph import TaskGraphBuilder, TaskGraphParams
+from fcplan.taskgraph import TaskGraph, TaskGraphBuilder, TaskGraphParams
 from fcplan.taskgraph.build_batch import build_graphs
 from fcplan.team import Team
 
-__all__ = ["VectorTaskEnv", "TeamView"]
+__all__ = ["VectorTaskEnv", "TeamView", "world_graphs"]
 
 
 class TeamView:
@@ -130,6 +130,24 @@ class TeamView:
     @property
     def mode(self) -> np.ndarray:
         return self._team.mode[self._b]
+
+
+def world_graphs(rows: np.ndarray, builders: Sequence[TaskGraphBuilder], teams: Sequence[TeamView],
+                 batch: BatchWorld, belief: BatchBelief, block_px: int) -> list[TaskGraph]:  # fmt: skip
+    """The task graphs of the worlds ``rows`` of ``batch``, built together from their beliefs
+    (:func:`fcplan.taskgraph.build_batch.build_graphs`; ``builders[b]`` and ``teams[b]`` are
+    world ``b``'s; the agents' ranges computed once for all worlds)."""
+    views = belief.views(rows, block_px)
+    rows_l = rows.tolist()
+    chosen = [teams[b] for b in rows_l]
+    ranges = batch.team.range_px()
+    for b, team in zip(rows_l, chosen, strict=True):
+        team._range = ranges[b]
+    try:
+        return build_graphs([builders[b] for b in rows_l], chosen, views)
+    finally:
+        for team in chosen:
+            team._range = None
 
 
 class VectorTaskEnv(BatchedEnv):
@@ -238,15 +256,10 @@ class VectorTaskEnv(BatchedEnv):
         :func:`fcplan.env.task_batch.batch_observe`)."""
         if not rows.size:
             return
-        views = self.belief.views(rows, self._block_px)
         rows_l = rows.tolist()
-        teams = [self.teams[b] for b in rows_l]
-        ranges = self.batch.team.range_px()
-        for b, team in zip(rows_l, teams, strict=True):
-            team._range = ranges[b]
-        graphs = build_graphs([self.builders[b] for b in rows_l], teams, views)
-        for team in teams:
-            team._range = None
+        graphs = world_graphs(
+            rows, self.builders, self.teams, self.batch, self.belief, self._block_px
+        )
         frac = self.batch.tick[rows] / max(self.scenario.n_ticks, 1)
         seen = batch_observe(graphs, self.one.k, self._goal[rows], frac)
         for b, graph, cand in zip(rows_l, graphs, seen.candidates, strict=True):

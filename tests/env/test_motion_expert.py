@@ -92,3 +92,26 @@ def test_bad_arguments_are_refused():
         PlanFollower(MotionEnv("practice"), "greedy", replan_period=0.0)
     with pytest.raises(EnvError, match="reset the env first"):
         PlanFollower(MotionEnv("practice"), "greedy").reset()
+
+
+def test_graph_params_shape_the_graphs_it_plans_on():
+    """``graph_params`` reaches the mission's graph builder: 200-px search blocks give the
+    practice map 36 search tasks (the default 100-px blocks 144), from the first replan of an
+    episode and again after the next reset (it once set the parameters after the builder was
+    made, so they were ignored)."""
+    from fcplan.taskgraph import TaskGraphParams
+
+    env = MotionEnv("practice")
+    expert = PlanFollower(env, "greedy", graph_params=TaskGraphParams(search_block_px=200))
+    for seed in (0, 1):
+        obs, _ = env.reset(seed=seed)
+        expert.reset()
+        env.step(expert.actions(obs))
+        assert expert.mission is not None and expert.mission.graph is not None
+        assert expert.mission.graph.search_tasks.size == 36
+    plain = PlanFollower(env, "greedy")
+    obs, _ = env.reset(seed=0)
+    plain.reset()
+    env.step(plain.actions(obs))
+    assert plain.mission is not None and plain.mission.graph is not None
+    assert plain.mission.graph.search_tasks.size == 144
