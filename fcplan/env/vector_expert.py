@@ -4,7 +4,7 @@
 :class:`fcplan.env.vector_motion.VectorMotionEnv`: world ``b``'s actions are, tick for tick,
 those the single follower chooses on the single env of world ``b``'s seed (the same beliefs,
 replans, plans and moves: ``tests/env/test_vector_expert.py``), so that a learned motion policy
-is compared with, or imitates, a scheduling baseline at the batched env's speed.
+is compared with, or imitates, a scheduling baseline on the batched env.
 
 What is batched and what is not. The team's belief of every world is one
 :class:`fcplan.belief_batch.BatchBelief`, folded in from the batched simulator's report of each
@@ -15,7 +15,10 @@ instance per world, through :func:`fcplan.scheduling.solve` with the world's con
 generator, so a failing solver falls back to greedy) and the move rule
 (:class:`fcplan.env.motion_expert.TeamRoutes`, the single follower's own), a few Python
 operations per agent. Worlds that finish are skipped (their actions are 0: the env ignores
-them) and start afresh when the env resets them.
+them) and start afresh when the env resets them. The per-world schedulers are most of the cost:
+with greedy on #1, rollouts of 256 worlds run about 2x the single env with
+:class:`~fcplan.env.motion_expert.PlanFollower`, the expert taking three quarters of the time,
+most of it in the greedy solves (``bench/bench_vector_expert.py``, ``bench/README.md``).
 
 Examples
 --------
