@@ -135,6 +135,8 @@ class BatchPlanFollower:
     def actions(self, observations: dict[str, np.ndarray]) -> np.ndarray:
         """(B, N) int64 actions of every world for the current tick (0 in finished worlds)."""
         env, batch = self.env, self.env.batch
+        if not env._started:
+            raise EnvError("BatchPlanFollower.actions: reset the env first")
         tick = batch.tick
         fresh = np.flatnonzero(tick < self._last_tick)  # (worlds the env has reset)
         info = env.last_info

@@ -90,8 +90,10 @@ def test_graph_params_reach_the_graphs_of_both_followers():
 
 def test_bad_arguments_are_named():
     """A wrong env, a shared instance, a wrong count of schedulers or a bad period is an
-    EnvError naming the argument."""
+    EnvError naming the argument; so is asking for actions before the env's first reset."""
     venv = VectorMotionEnv("practice", 2)
+    with pytest.raises(EnvError, match="reset the env first"):
+        BatchPlanFollower(venv, "greedy").actions({})
     from fcplan.scheduling import make_scheduler
 
     for kwargs, word in [
