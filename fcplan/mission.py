@@ -136,6 +136,18 @@ def as_scenario(scenario: ScenarioLike) -> Scenario:
     return scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
 
 
+def period_ticks(seconds: float, ticks_per_second: int) -> int:
+    """Ticks between periodic replans every ``seconds`` simulated seconds (at least one): the
+    one rounding rule of the mission, the task env and the batched expert.
+
+    Examples
+    --------
+    >>> period_ticks(1.0, 10), period_ticks(0.04, 10), period_ticks(2.26, 10)
+    (10, 1, 23)
+    """
+    return max(int(round(seconds * ticks_per_second)), 1)
+
+
 class Mission:
     """One episode: world, belief and the replan rule (module docstring: the loop and the rule).
 
@@ -226,7 +238,7 @@ class Mission:
             raise ValueError(f"replan_period must be > 0 simulated seconds, got {replan_period!r}")
         self.replan_period = float(replan_period)
         #: ticks between periodic replans
-        self.period = max(int(round(replan_period * self.scenario.ticks_per_second)), 1)
+        self.period = period_ticks(replan_period, self.scenario.ticks_per_second)
         self.event_replans = bool(event_replans)
 
     def set_graph_params(self, params: TaskGraphParams | None) -> None:

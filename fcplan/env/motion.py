@@ -116,10 +116,11 @@ from fcplan.env.presets import make_preset
 from fcplan.env.reward import PenaltyReward, RewardFn
 from fcplan.errors import EnvError
 from fcplan.mission import Mission, ScenarioLike, as_scenario
+from fcplan.scenario import Scenario
 from fcplan.team import CLIMB_PER_TICK
 from fcplan.world import StepInfo, World
 
-__all__ = ["MotionEnv", "parallel_env", "PRESETS", "ACTION_NAMES"]
+__all__ = ["MotionEnv", "parallel_env", "PRESETS", "ACTION_NAMES", "role_letters"]
 
 #: Preset names accepted by :func:`parallel_env`.
 #: names of the reference presets (:data:`fcplan.env.presets.PRESETS`)
@@ -188,6 +189,15 @@ def parallel_env(
     return MotionEnv(scenario, **kwargs)
 
 
+def role_letters(scenario: Scenario) -> list[str]:
+    """Role letter of each agent (``"P"`` perception, ``"A"`` action, ``"H"`` hybrid), the key
+    of :data:`ACTION_NAMES`."""
+    return [
+        "H" if (a.role.can_sense and a.role.can_act) else ("P" if a.role.can_sense else "A")
+        for a in scenario.agents
+    ]
+
+
 class MotionEnv(ParallelEnv):
     """Motion-level environment on a fcplan scenario (module docstring: spaces, reward, rules)."""
 
@@ -234,10 +244,7 @@ class MotionEnv(ParallelEnv):
         self.agents: list[str] = []
         n = len(self.possible_agents)
         self._n = n
-        letters = [
-            "H" if (a.role.can_sense and a.role.can_act) else ("P" if a.role.can_sense else "A")
-            for a in sc.agents
-        ]
+        letters = role_letters(sc)
         self._letters = letters
         self._n_actions = np.array([len(ACTION_NAMES[r]) for r in letters], dtype=np.int64)
         # per agent and action: dx, dy (unit), dz sign, dump, is a move; and the column of the

@@ -44,7 +44,7 @@ from __future__ import annotations
 from typing import Any
 
 from fcplan.belief import Belief
-from fcplan.env.motion import ACTION_NAMES, MotionEnv
+from fcplan.env.motion import ACTION_NAMES, MotionEnv, role_letters
 from fcplan.errors import EnvError
 from fcplan.mission import Mission
 from fcplan.plan import Plan
@@ -155,12 +155,10 @@ class TeamRoutes:
     def __init__(self, ids: list[str], scenario: Any) -> None:
         self._ids = ids
         self._row = {a: i for i, a in enumerate(ids)}
-        letters = [
-            "H" if (a.role.can_sense and a.role.can_act) else ("P" if a.role.can_sense else "A")
-            for a in scenario.agents
-        ]
         #: action index by name, per agent
-        self._act = [{name: k for k, name in enumerate(ACTION_NAMES[r])} for r in letters]
+        self._act = [
+            {name: k for k, name in enumerate(ACTION_NAMES[r])} for r in role_letters(scenario)
+        ]
         self._can_act = [bool(a.role.can_act) for a in scenario.agents]
         n = len(ids)
         self._routes: list[list[tuple[float, float, bool]]] = [[] for _ in range(n)]

@@ -126,7 +126,7 @@ from fcplan.env.task_candidates import (
 )
 from fcplan.errors import EnvError
 from fcplan.metrics import compute_all
-from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario
+from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario, period_ticks
 from fcplan.plan import validate_plan
 from fcplan.taskgraph import TaskGraph, TaskGraphParams
 from fcplan.world import World
@@ -177,7 +177,7 @@ class TaskEnv(ParallelEnv):
             raise EnvError(f"render_mode: must be None or 'rgb_array' (got {render_mode!r})")
         self.k = int(k)
         self.tps = self.scenario.ticks_per_second
-        self.period = max(int(round(replan_period * self.tps)), 1)
+        self.period = period_ticks(replan_period, self.tps)
         n_steps = -(-self.scenario.n_ticks // self.period)
         self.max_steps = n_steps if max_steps is None else min(int(max_steps), n_steps)
         self.watch_altitude = float(watch_altitude)

@@ -44,6 +44,7 @@ from fcplan.env.motion_expert import TeamRoutes
 from fcplan.env.vector_motion import VectorMotionEnv
 from fcplan.env.vector_task import TeamView, world_graphs
 from fcplan.errors import EnvError
+from fcplan.mission import period_ticks
 from fcplan.plan import Plan
 from fcplan.scheduling import Scheduler, make_scheduler, solve
 from fcplan.taskgraph import TaskGraphBuilder, TaskGraphParams
@@ -104,7 +105,7 @@ class BatchPlanFollower:
             raise EnvError("scheduler: clairvoyant schedulers (oracle) are not batched")
         sc = env.scenario
         self.time_limit, self.graph_params = time_limit, graph_params
-        self.period = max(int(round(float(replan_period) * sc.ticks_per_second)), 1)
+        self.period = period_ticks(float(replan_period), sc.ticks_per_second)
         self._block_px = int((graph_params or TaskGraphParams()).search_block_px)
         self._ids = list(env.agent_ids)
         self._teams = [TeamView(env.batch.team, b) for b in range(num)]

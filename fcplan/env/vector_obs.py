@@ -44,26 +44,19 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from fcplan.batch import BatchStepInfo, BatchWorld
 from fcplan.batch.cells import SENSED
+from fcplan.env.motion import role_letters
 from fcplan.env.motion_grid import FACILITY, LAKE, OUTSIDE, CoarseMaps
 from fcplan.env.motion_obs import N_AGENT_FEATURES, N_FOV
 from fcplan.scenario import Scenario
 from fcplan.team import DRAIN_PER_PX
 
-__all__ = ["BatchMotionObs", "role_letters"]
+__all__ = ["BatchMotionObs"]
 
 #: the channels of :attr:`BatchMotionObs.maps` that differ between worlds
 D_KNOWN, D_PRUNED, D_SEEN, D_AGENTS = range(4)
 _ONE32 = np.float32(1.0)
 _PENDING_MAX = 1 << 16  # (queued fire cells of the burning layer before it is updated)
 _ACTIVE = 1
-
-
-def role_letters(scenario: Scenario) -> list[str]:
-    """Role letter of each agent (``"P"``, ``"A"``, ``"H"``), as the motion env names them."""
-    return [
-        "H" if (a.role.can_sense and a.role.can_act) else ("P" if a.role.can_sense else "A")
-        for a in scenario.agents
-    ]
 
 
 class BatchMotionObs:
