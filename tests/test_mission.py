@@ -211,3 +211,16 @@ def test_latency_changes_the_outcome_and_wall_latency_runs():
     assert run_episode("practice", "greedy", seed=0, latency="wall").ticks == 1800
     with pytest.raises(FcplanError, match=r"latency: must be None, 'wall' or 'ticks:N'"):
         run_episode("practice", "greedy", seed=0, latency="ticks:-1")
+
+
+def test_set_graph_params_builds_the_graphs_with_them_from_then_on():
+    """``Mission.set_graph_params`` reaches the graphs built after it, and survives a reset:
+    200-px search blocks give the practice map 36 search tasks instead of 144."""
+    from fcplan.taskgraph import TaskGraphParams
+
+    mission = Mission("practice", 0)
+    assert mission.task_graph().search_tasks.size == 144
+    mission.set_graph_params(TaskGraphParams(search_block_px=200))
+    assert mission.task_graph().search_tasks.size == 36
+    mission.reset(1)
+    assert mission.task_graph().search_tasks.size == 36
