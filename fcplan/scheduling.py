@@ -80,24 +80,11 @@ from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
 
 __all__ = [
-    "Scheduler",
-    "SolveStats",
-    "STATUSES",
-    "SettingError",
-    "make_scheduler",
-    "scheduler_factory",
-    "supports_deterministic",
-    "int_setting",
-    "float_setting",
-    "bool_setting",
-    "choice_setting",
-    "parse_scheduler_spec",
-    "register_scheduler",
-    "available_schedulers",
-    "solve",
-    "effective_time_limit",
-    "idle_team",
-]
+    "Scheduler", "SolveStats", "STATUSES", "SettingError", "make_scheduler", "scheduler_factory",
+    "supports_deterministic", "int_setting", "float_setting", "bool_setting", "choice_setting",
+    "parse_scheduler_spec", "register_scheduler", "available_schedulers", "solve", "settle",
+    "effective_time_limit", "idle_team",
+]  # fmt: skip
 
 #: Possible :attr:`SolveStats.status` values.
 STATUSES = ("optimal", "feasible", "time_limit", "fallback", "heuristic")
@@ -557,11 +544,7 @@ def _timeout_fallback(
 
 
 def solve(
-    scheduler: Scheduler,
-    graph: TaskGraph,
-    *,
-    time_limit: float | None,
-    rng: np.random.Generator,
+    scheduler: Scheduler, graph: TaskGraph, *, time_limit: float | None, rng: np.random.Generator
 ) -> Plan:
     """Run ``scheduler`` on ``graph``; always return a valid plan carrying :class:`SolveStats`.
 
@@ -570,31 +553,48 @@ def solve(
     for this replan (``status="fallback"``, the reason in ``message``). The stats record the
     wall time of the whole call, the limit it was held to and any overrun.
     """
-    limit = effective_time_limit(scheduler, time_limit)
     t0 = time.perf_counter()
-    message, timed_out = "", False
-    plan: Plan | None
     try:
-        plan = scheduler.plan(graph, time_limit=time_limit, rng=rng)
-        solver_s = time.perf_counter() - t0
+        plan: Plan | Exception = scheduler.plan(graph, time_limit=time_limit, rng=rng)
+    except Exception as exc:  # noqa: BLE001 - an episode must survive any solver failure
+        plan = exc
+    solver_s = time.perf_counter() - t0
+    return settle(scheduler, graph, plan, t0, solver_s, time_limit=time_limit, rng=rng)
+
+
+def settle(
+    scheduler: Scheduler,
+    graph: TaskGraph,
+    plan: Plan | Exception,
+    t0: float,
+    solver_s: float,
+    *,
+    time_limit: float | None,
+    rng: np.random.Generator,
+) -> Plan:
+    """:func:`solve` after the scheduler's call (``plan`` or what it raised; ``solver_s`` s of a
+    call begun at ``perf_counter()`` ``t0``): validation, time-outs, the fallback, the stats."""
+    limit = effective_time_limit(scheduler, time_limit)
+    message, timed_out = "", False
+    try:
+        if isinstance(plan, Exception):
+            raise plan
         validate_plan(plan, graph)
         timed_out, message = _timeout_fallback(scheduler, plan, graph, solver_s, limit)
-        if message:
-            plan = None
+        ok: Plan | None = None if message else plan
     except Exception as exc:  # noqa: BLE001 - an episode must survive any solver failure
-        solver_s = time.perf_counter() - t0
         message = f"{type(exc).__name__}: {exc}"
         timed_out = isinstance(exc, TimeoutError)  # the scheduler says the clock stopped it
-        plan = None
-    if plan is None:
-        plan = _fallback_scheduler().plan(graph, time_limit=None, rng=rng)
-        validate_plan(plan, graph)
+        ok = None
+    if ok is None:
+        ok = _fallback_scheduler().plan(graph, time_limit=None, rng=rng)
+        validate_plan(ok, graph)
         stats = SolveStats(status="fallback", message=message)
     else:
-        stats = plan.stats if isinstance(plan.stats, SolveStats) else SolveStats()
+        stats = ok.stats if isinstance(ok.stats, SolveStats) else SolveStats()
     wall = time.perf_counter() - t0
     overrun = max(wall - limit, 0.0) if limit is not None else 0.0
     # every replan records the graph's size (the scheduler's own size keys win)
     size = {"agents": graph.n_agents, "tasks": graph.n_tasks, **stats.size}
-    return plan.with_stats(replace(stats, wall_time_s=wall, time_limit_s=limit, overrun_s=overrun,
-                                   solver_s=solver_s, timed_out=timed_out, size=size))  # fmt: skip
+    return ok.with_stats(replace(stats, wall_time_s=wall, time_limit_s=limit, overrun_s=overrun,
+                                 solver_s=solver_s, timed_out=timed_out, size=size))  # fmt: skip

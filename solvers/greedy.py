@@ -51,6 +51,7 @@ True
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -61,6 +62,12 @@ from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
 
 __all__ = ["GreedyScheduler"]
+
+#: One assignment problem: agent rows, task rows, task values, per-agent route limits.
+_Job = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: Its answer: task rows per agent row, in pick order, and the value gained.
+_Picks = tuple[dict[int, list[int]], float]
+_Assigner = Callable[[list[TaskGraph], list[_Job | None], bool], list[_Picks | None]]
 
 
 class GreedyScheduler:
@@ -116,13 +123,89 @@ class GreedyScheduler:
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
         """Build the greedy plan for ``graph``."""
-        routes: dict[str, tuple[str, ...]] = {}
-        alts: dict[str, float] = {}
+        return self._plans([graph], self._assign_each)[0]
+
+    def plan_batch(
+        self,
+        graphs: Sequence[TaskGraph],
+        *,
+        time_limit: float | None = None,
+        rngs: Sequence[Any] | None = None,
+    ) -> list[Plan]:
+        """The greedy plans of several independent graphs (one per world of a batched env), the
+        assignments of all graphs computed together (:mod:`solvers.greedy_batch`): equal, plan
+        for plan, to ``[self.plan(g) for g in graphs]`` (``tests/solvers/test_greedy_batch.py``).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fcplan.taskgraph import synthetic_task_graph
+        >>> gs = [synthetic_task_graph(4, 9, np.random.default_rng(s)) for s in range(3)]
+        >>> g = GreedyScheduler()
+        >>> [p.routes for p in g.plan_batch(gs)] == [g.plan(x).routes for x in gs]
+        True
+        """
+        from solvers.greedy_batch import assign_batch
+
+        return self._plans(list(graphs), lambda gs, jobs, spread: assign_batch(
+            gs, jobs, spread_px=self.spread_px if spread else None))  # fmt: skip
+
+    def _plans(self, graphs: list[TaskGraph], assign: _Assigner) -> list[Plan]:
+        """The three steps of the module docstring for every graph, the two assignment steps
+        done by ``assign`` (one graph at a time, or all together)."""
+        fire_jobs = [self._fire_job(g) for g in graphs]
+        fire_picks = assign(graphs, fire_jobs, False)
+        out: list[Plan] = []
+        search_jobs: list[_Job | None] = []
+        states = []
+        for g, picks in zip(graphs, fire_picks, strict=True):
+            routes: dict[str, tuple[str, ...]] = {}
+            alts: dict[str, float] = {}
+            first_fire: dict[int, int] = {}
+            objective = 0.0
+            if picks is not None:
+                objective += picks[1]
+                for row, tasks in picks[0].items():
+                    if tasks:
+                        routes[g.agent_ids[row]] = tuple(g.task_ids[k] for k in tasks)
+                        first_fire[row] = tasks[0]
+            # 2. perception agents watch the fires being fought
+            free = g.agent_mode != Mode.HOMING
+            sensors = np.flatnonzero(free & g.agent_can_sense & ~g.agent_can_act)
+            busy = self._watch(g, sensors, first_fire, routes, alts)
+            # 3. the others search
+            hybrids = np.flatnonzero(
+                free & g.agent_can_act & g.agent_can_sense & (g.agent_tank > 0)
+            )
+            searchers = np.array(
+                [i for i in np.r_[sensors, hybrids] if i not in busy and g.agent_ids[i] not in routes],
+                dtype=np.int64,
+            )  # fmt: skip
+            blocks = g.search_tasks
+            job = None
+            if searchers.size and blocks.size:
+                job = (searchers, blocks, g.task_value[blocks].astype(np.float64),
+                       np.full(searchers.size, self.search_route_length))  # fmt: skip
+            search_jobs.append(job)
+            states.append((routes, alts, objective))
+        search_picks = assign(graphs, search_jobs, True)
+        for g, (routes, alts, objective), picks in zip(graphs, states, search_picks, strict=True):
+            if picks is not None:
+                objective += picks[1]
+                for row, tasks in picks[0].items():
+                    if tasks:
+                        routes[g.agent_ids[row]] = tuple(g.task_ids[k] for k in tasks)
+                        alts[g.agent_ids[row]] = g.clip_altitude(row, self.search_altitude)
+            size = {"agents": g.n_agents, "tasks": g.n_tasks, "fires": int(g.fire_tasks.size)}
+            stats = SolveStats(status="heuristic", objective=float(objective), size=size)
+            out.append(Plan(routes=routes, altitudes=alts, stats=stats))
+        return out
+
+    def _fire_job(self, graph: TaskGraph) -> _Job | None:
+        """Step 1's assignment problem: the action agents (and hybrids) with water, the fire
+        tasks, their fresh values and the route limits; None when either side is empty."""
         free = graph.agent_mode != Mode.HOMING
         fires = graph.fire_tasks
-        objective = 0.0
-
-        # 1. action agents -> fires
         actors = np.flatnonzero(
             free & graph.agent_can_act & (graph.agent_tank > 0) & ~graph.agent_can_sense
         )
@@ -130,64 +213,27 @@ class GreedyScheduler:
             free & graph.agent_can_act & graph.agent_can_sense & (graph.agent_tank > 0)
         )
         actors = np.r_[actors, hybrids].astype(np.int64)
-        first_fire: dict[int, int] = {}
-        if actors.size and fires.size:
-            fresh = np.where(
-                graph.task_staleness[fires] <= self.fresh_s,
-                1.0,
-                np.exp(-(graph.task_staleness[fires] - self.fresh_s) / max(self.fresh_s, 1e-9)),
-            )
-            value = graph.task_value[fires] * fresh
-            picks, gained = self._assign(
-                graph,
-                actors,
-                fires,
-                value,
-                limit=np.minimum(graph.agent_tank[actors], self.route_length),
-            )
-            objective += gained
-            for row, tasks in picks.items():
-                if tasks:
-                    routes[graph.agent_ids[row]] = tuple(graph.task_ids[k] for k in tasks)
-                    first_fire[row] = tasks[0]
-
-        # 2. perception agents watch the fires being fought
-        sensors = np.flatnonzero(free & graph.agent_can_sense & ~graph.agent_can_act)
-        busy = self._watch(graph, sensors, first_fire, routes, alts)
-
-        # 3. the others search
-        searchers = np.array(
-            [
-                i
-                for i in np.r_[sensors, hybrids]
-                if i not in busy and graph.agent_ids[i] not in routes
-            ],
-            dtype=np.int64,
+        if not (actors.size and fires.size):
+            return None
+        stale = graph.task_staleness[fires]
+        fresh = np.where(
+            stale <= self.fresh_s,
+            1.0,
+            np.exp(-(stale - self.fresh_s) / max(self.fresh_s, 1e-9)),
         )
-        blocks = graph.search_tasks
-        if searchers.size and blocks.size:
-            picks, gained = self._assign(
-                graph,
-                searchers,
-                blocks,
-                graph.task_value[blocks].astype(np.float64),
-                limit=np.full(searchers.size, self.search_route_length),
-                spread=True,
-            )
-            objective += gained
-            for row, tasks in picks.items():
-                if tasks:
-                    routes[graph.agent_ids[row]] = tuple(graph.task_ids[k] for k in tasks)
-                    alts[graph.agent_ids[row]] = graph.clip_altitude(row, self.search_altitude)
-        return Plan(
-            routes=routes,
-            altitudes=alts,
-            stats=SolveStats(
-                status="heuristic",
-                objective=float(objective),
-                size={"agents": graph.n_agents, "tasks": graph.n_tasks, "fires": int(fires.size)},
-            ),
-        )
+        value = graph.task_value[fires] * fresh
+        return actors, fires, value, np.minimum(graph.agent_tank[actors], self.route_length)
+
+    def _assign_each(
+        self, graphs: list[TaskGraph], jobs: list[_Job | None], spread: bool
+    ) -> list[_Picks | None]:
+        """:meth:`_assign` on each graph's job in turn (the readable rule)."""
+        return [
+            None
+            if job is None
+            else self._assign(g, job[0], job[1], job[2], limit=job[3], spread=spread)
+            for g, job in zip(graphs, jobs, strict=True)
+        ]
 
     # ------------------------------------------------------------------ helpers
     def _watch(

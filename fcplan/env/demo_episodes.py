@@ -142,7 +142,7 @@ def rollout_episode(
 
 def batched_rollouts(
     env: Any,
-    schedulers: Sequence[Scheduler],
+    schedulers: Scheduler | Sequence[Scheduler],
     scenario_key: str,
     seeds: Sequence[int],
     *,
@@ -152,9 +152,12 @@ def batched_rollouts(
     """:func:`rollout_episode` of ``len(seeds)`` seeds at once in a
     :class:`fcplan.env.vector_task.VectorTaskEnv` of as many worlds (``autoreset_mode=
     "disabled"``): world ``b`` plays seed ``seeds[b]`` with ``schedulers[b]``
-    (:meth:`~fcplan.env.vector_task.VectorTaskEnv.expert_actions`). Each record equals the
-    sequential rollout of its seed (with a scheduler that keeps no state between episodes)."""
+    (:meth:`~fcplan.env.vector_task.VectorTaskEnv.expert_actions`; one instance for every world
+    is planned batched when it can be). Each record equals the sequential rollout of its seed
+    (with a scheduler that keeps no state between episodes)."""
     n = len(seeds)
+    names = [_name(schedulers if not isinstance(schedulers, Sequence) else schedulers[b])
+             for b in range(n)]  # fmt: skip
     obs, _ = env.reset(seed=[int(s) for s in seeds])
     keep: list[dict[str, np.ndarray]] = [obs]
     acts, rews, ticks, ill, con = [], [], [env.batch.tick.copy()], [], []
@@ -181,7 +184,7 @@ def batched_rollouts(
         rec = _record([{k: o[k][b] for k in OBS_KEYS} for o in keep[: e + 1]],
                       [x[b] for x in acts[:e]], [x[b] for x in rews[:e]],
                       [x[b] for x in ticks[: e + 1]], [x[b] for x in ill[:e]],
-                      [x[b] for x in con[:e]], scenario_key, seed, _name(schedulers[b]))  # fmt: skip
+                      [x[b] for x in con[:e]], scenario_key, seed, names[b])  # fmt: skip
         rec.metrics, rec.fallbacks = finals[b], int(falls[b])
         out.append(rec)
     return out

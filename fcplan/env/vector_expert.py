@@ -10,15 +10,16 @@ What is batched and what is not. The team's belief of every world is one
 :class:`fcplan.belief_batch.BatchBelief`, folded in from the batched simulator's report of each
 step (:attr:`VectorMotionEnv.last_info <fcplan.env.vector_motion.VectorMotionEnv.last_info>`);
 the task graphs of the worlds that replan at a tick are built together
-(:func:`fcplan.taskgraph.build_batch.build_graphs`). Per world, in a loop: the scheduler (one
-instance per world, through :func:`fcplan.scheduling.solve` with the world's controller
-generator, so a failing solver falls back to greedy) and the move rule
-(:class:`fcplan.env.motion_expert.TeamRoutes`, the single follower's own), a few Python
-operations per agent. Worlds that finish are skipped (their actions are 0: the env ignores
-them) and start afresh when the env resets them. The per-world schedulers are most of the cost:
-with greedy on #1, rollouts of 256 worlds run about 2x the single env with
-:class:`~fcplan.env.motion_expert.PlanFollower`, the expert taking three quarters of the time,
-most of it in the greedy solves (``bench/bench_vector_expert.py``, ``bench/README.md``).
+(:func:`fcplan.taskgraph.build_batch.build_graphs`) and planned together
+(:func:`fcplan.scheduling_batch.solve_batch`): a scheduler named by a spec that offers
+``plan_batch`` (greedy) is one instance planning every replanning world in one call, any other
+one instance per world called in turn, each plan settled as :func:`fcplan.scheduling.solve`
+settles it (with the world's controller generator; a failing solver falls back to greedy for
+its world). Per world, in a loop: the move rule (:class:`fcplan.env.motion_expert.TeamRoutes`,
+the single follower's own), a few Python operations per agent. Worlds that finish are skipped
+(their actions are 0: the env ignores them) and start afresh when the env resets them. What
+this costs against the single env with :class:`~fcplan.env.motion_expert.PlanFollower` is
+measured by ``bench/bench_vector_expert.py`` (figures in ``bench/README.md``).
 
 Examples
 --------
@@ -46,7 +47,8 @@ from fcplan.env.vector_task import TeamView, world_graphs
 from fcplan.errors import EnvError
 from fcplan.mission import period_ticks
 from fcplan.plan import Plan
-from fcplan.scheduling import Scheduler, make_scheduler, solve
+from fcplan.scheduling import Scheduler, make_scheduler
+from fcplan.scheduling_batch import batch_capable, solve_batch
 from fcplan.taskgraph import TaskGraphBuilder, TaskGraphParams
 
 __all__ = ["BatchPlanFollower"]
@@ -86,8 +88,15 @@ class BatchPlanFollower:
         if not replan_period > 0:
             raise EnvError(f"replan_period: must be > 0 simulated seconds (got {replan_period!r})")
         self.env, num = env, env.num_envs
+        #: The one instance planning every world together (a name of a scheduler with
+        #: ``plan_batch``: :mod:`fcplan.scheduling_batch`), else None.
+        self.shared: Scheduler | None = None
         if isinstance(scheduler, str):
-            self.schedulers: list[Scheduler] = [make_scheduler(scheduler) for _ in range(num)]
+            first = make_scheduler(scheduler)
+            if batch_capable(first):
+                self.shared = first
+            more = [first if self.shared else make_scheduler(scheduler) for _ in range(num - 1)]
+            self.schedulers: list[Scheduler] = [first, *more]
         elif isinstance(scheduler, (list, tuple)):
             self.schedulers = list(scheduler)
             if len(self.schedulers) != num:
@@ -169,10 +178,13 @@ class BatchPlanFollower:
         (:meth:`fcplan.mission.Mission.replan`'s steps, per world)."""
         batch = self.env.batch
         graphs = world_graphs(rows, self._builders, self._teams, batch, self.belief, self._block_px)
-        for b, graph in zip(rows.tolist(), graphs, strict=True):
-            rng = batch.controller_rngs[b]
-            assert rng is not None  # (set by every reset)
-            plan = solve(self.schedulers[b], graph, time_limit=self.time_limit, rng=rng)
+        rngs = [batch.controller_rngs[b] for b in rows.tolist()]
+        assert all(r is not None for r in rngs)  # (set by every reset)
+        who = (
+            self.shared if self.shared is not None else [self.schedulers[b] for b in rows.tolist()]
+        )
+        plans = solve_batch(who, graphs, time_limit=self.time_limit, rngs=rngs)
+        for b, graph, plan in zip(rows.tolist(), graphs, plans, strict=True):
             self.plans[b] = plan
             self.replans[b] += 1
             self._routes[b].follow(plan, graph)

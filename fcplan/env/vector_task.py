@@ -81,7 +81,8 @@ from fcplan.errors import EnvError
 from fcplan.metrics import facility_penalty, penalty_rate
 from fcplan.mission import ScenarioLike
 from fcplan.plan import validate_plan
-from fcplan.scheduling import Scheduler, solve
+from fcplan.scheduling import Scheduler
+from fcplan.scheduling_batch import solve_batch
 from fcplan.taskgraph import TaskGraph, TaskGraphBuilder, TaskGraphParams
 from fcplan.taskgraph.build_batch import build_graphs
 from fcplan.team import Team
@@ -411,7 +412,7 @@ class VectorTaskEnv(BatchedEnv):
 
     def expert_actions(
         self,
-        schedulers: Sequence[Scheduler],
+        schedulers: Scheduler | Sequence[Scheduler],
         *,
         time_limit: float | None = None,
         counts: MappingCounts | None = None,
@@ -419,23 +420,21 @@ class VectorTaskEnv(BatchedEnv):
         """(B, A) actions of a scheduler's plans on every world's current graph, and (B,) bool:
         the plan came from the greedy fallback.
 
-        ``schedulers[b]`` plans world ``b`` (one instance per world: a scheduler that keeps state
-        between calls sees only its own world), through :func:`fcplan.scheduling.solve` with
-        the world's controller generator, as :func:`fcplan.env.demonstrations.demonstrations`
-        does on one env; the plan becomes actions by
-        :func:`fcplan.env.task_actions.plan_to_actions`. A loop over the worlds: the schedulers
-        work on one graph each.
+        ``schedulers`` is one instance per world (a scheduler that keeps state between calls
+        sees only its own world), or one instance for every world: the worlds' graphs are then
+        planned in one call when it has ``plan_batch`` (greedy does), else in turn
+        (:func:`fcplan.scheduling_batch.solve_batch`, with each world's controller generator,
+        as :func:`fcplan.env.demonstrations.demonstrations` does on one env). Each plan becomes
+        actions by :func:`fcplan.env.task_actions.plan_to_actions`.
         """
         a, k = self.one.n_agents, self.one.k
         out = np.full((self.num_envs, a), k, dtype=np.int64)
-        fallback = np.zeros(self.num_envs, dtype=bool)
-        for b in range(self.num_envs):
-            graph, cand = self.graphs[b], self.candidates[b]
-            rng = self.batch.controller_rngs[b]
-            assert rng is not None  # (set by every reset)
-            plan = solve(schedulers[b], graph, time_limit=time_limit, rng=rng)
-            fallback[b] = getattr(plan.stats, "status", None) == "fallback"
-            out[b] = plan_to_actions(plan, graph, cand, counts)
+        rngs = list(self.batch.controller_rngs)
+        assert all(r is not None for r in rngs)  # (set by every reset)
+        plans = solve_batch(schedulers, self.graphs, time_limit=time_limit, rngs=rngs)  # type: ignore[arg-type]
+        fallback = np.array([getattr(p.stats, "status", None) == "fallback" for p in plans])
+        for b, plan in enumerate(plans):
+            out[b] = plan_to_actions(plan, self.graphs[b], self.candidates[b], counts)
         return out, fallback
 
     def _finals(self, done: np.ndarray, infos: dict[str, Any]) -> None:
