@@ -14,10 +14,18 @@ and prints the median over the rounds of world-steps per CPU second (expert and 
 the median ratio to the single rollout with its range over the rounds, and the expert's share of
 the time (belief updates, replans with the scheduler, the move rule).
 
+``--level task`` measures instead the task level's recorded rollouts, what
+``demonstrations(..., num_envs=B)`` runs: :func:`fcplan.env.demo_episodes.rollout_episode` on
+the single :class:`fcplan.env.task.TaskEnv` (a plan every step) against
+:func:`fcplan.env.demo_episodes.batched_rollouts` on a
+:class:`fcplan.env.vector_task.VectorTaskEnv` of ``B`` worlds (one episode each), whole calls
+timed (no expert share).
+
 Usage::
 
     python bench/bench_vector_expert.py                   # about 2 minutes
     python bench/bench_vector_expert.py --scheduler greedy --sizes 16 256 --rounds 5
+    python bench/bench_vector_expert.py --level task --duration 30 --sizes 16 64
 """
 
 from __future__ import annotations
@@ -30,11 +38,16 @@ from typing import Any
 
 import numpy as np
 
+from fcplan.env.demo_episodes import batched_rollouts, rollout_episode
 from fcplan.env.motion import MotionEnv
 from fcplan.env.motion_expert import PlanFollower
 from fcplan.env.vector_expert import BatchPlanFollower
+from fcplan.env.task import TaskEnv
 from fcplan.env.vector_motion import VectorMotionEnv
+from fcplan.env.vector_task import VectorTaskEnv
 from fcplan.scenario import load_scenario
+from fcplan.scheduling import make_scheduler
+from fcplan.scheduling_batch import batch_capable
 
 _CPU = time.thread_time
 
@@ -78,6 +91,27 @@ def batched(sc: object, scheduler: str, num: int) -> tuple[float, float]:
     return num * n_ticks / clock[0], clock[1] / clock[0]
 
 
+def single_task(sc: object, scheduler: str, episodes: int) -> tuple[float, float]:
+    """(world-steps per CPU second, NaN) of ``episodes`` recorded task-level rollouts."""
+    env = TaskEnv(sc)  # type: ignore[arg-type]
+    sched = make_scheduler(scheduler)
+    c, steps = _CPU(), 0
+    for ep in range(episodes):
+        steps += rollout_episode(env, sched, "bench", ep).steps
+    return steps / (_CPU() - c), float("nan")
+
+
+def batched_task(sc: object, scheduler: str, num: int) -> tuple[float, float]:
+    """(world-steps per CPU second, NaN) of one recorded episode of ``num`` worlds (one
+    scheduler instance for all when it plans batched, else one per world)."""
+    env = VectorTaskEnv(sc, num, autoreset_mode="disabled")  # type: ignore[arg-type]
+    first = make_scheduler(scheduler)
+    scheds: Any = first if batch_capable(first) else [make_scheduler(scheduler) for _ in range(num)]
+    c = _CPU()
+    steps = sum(r.steps for r in batched_rollouts(env, scheds, "bench", list(range(num))))
+    return steps / (_CPU() - c), float("nan")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default="1")
@@ -86,14 +120,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", type=int, nargs="+", default=[16, 64, 256])
     ap.add_argument("--episodes", type=int, default=2, help="single-env episodes per round")
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--level", choices=["motion", "task"], default="motion")
     args = ap.parse_args(argv)
+    one, many = (single, batched) if args.level == "motion" else (single_task, batched_task)
     sc = load_scenario(args.scenario).replace(duration_s=args.duration)
     runs: dict[int, list[tuple[float, float]]] = {0: [], **{n: [] for n in args.sizes}}
     for _ in range(args.rounds):
-        runs[0].append(single(sc, args.scheduler, args.episodes))
+        runs[0].append(one(sc, args.scheduler, args.episodes))
         for num in args.sizes:
-            runs[num].append(batched(sc, args.scheduler, num))
-    print(f"# scheduling expert ({args.scheduler}) on the motion level, scenario "
+            runs[num].append(many(sc, args.scheduler, num))
+    print(f"# scheduling expert ({args.scheduler}) on the {args.level} level, scenario "
           f"#{args.scenario}, {args.duration:g}-s episodes; Python {platform.python_version()}, "
           f"numpy {np.__version__}; load {os.getloadavg()[0]:.2f}; median of {args.rounds} "
           "interleaved round(s)")  # fmt: skip
@@ -105,8 +141,12 @@ def main(argv: list[str] | None = None) -> int:
         ratio = r[:, 0] / base
         label = "single" if num == 0 else f"B={num}"
         print(f"{label:10s} {np.median(r[:, 0]):14.0f} {np.median(ratio):6.2f} "
-              f"[{ratio.min():4.2f}, {ratio.max():4.2f}] {100 * np.median(r[:, 1]):12.0f}%")  # fmt: skip
+              f"[{ratio.min():4.2f}, {ratio.max():4.2f}] {_share(r[:, 1]):>13s}")  # fmt: skip
     return 0
+
+
+def _share(shares: np.ndarray) -> str:
+    return "-" if np.isnan(shares).any() else f"{100 * np.median(shares):.0f}%"
 
 
 if __name__ == "__main__":
