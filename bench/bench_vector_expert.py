@@ -21,6 +21,10 @@ the single :class:`fcplan.env.task.TaskEnv` (a plan every step) against
 :class:`fcplan.env.vector_task.VectorTaskEnv` of ``B`` worlds (one episode each), whole calls
 timed (no expert share).
 
+``--apart`` adds, for every ``B``, a row with one scheduler instance per world, each world's
+graph planned by its own call, as before greedy planned the worlds together
+(:func:`fcplan.scheduling_batch.solve_batch`): what the batched call gains, in the same run.
+
 Usage::
 
     python bench/bench_vector_expert.py                   # about 2 minutes
@@ -41,8 +45,8 @@ import numpy as np
 from fcplan.env.demo_episodes import batched_rollouts, rollout_episode
 from fcplan.env.motion import MotionEnv
 from fcplan.env.motion_expert import PlanFollower
-from fcplan.env.vector_expert import BatchPlanFollower
 from fcplan.env.task import TaskEnv
+from fcplan.env.vector_expert import BatchPlanFollower
 from fcplan.env.vector_motion import VectorMotionEnv
 from fcplan.env.vector_task import VectorTaskEnv
 from fcplan.scenario import load_scenario
@@ -79,10 +83,20 @@ def _step(expert: Any, env: Any, obs: Any, clock: list[float]) -> Any:
     return obs
 
 
-def batched(sc: object, scheduler: str, num: int) -> tuple[float, float]:
+def _schedulers(scheduler: str, num: int, apart: bool) -> Any:
+    """One instance for all ``num`` worlds when it plans batched (and not ``apart``), else one
+    per world (each world's graph planned by its own call)."""
+    first = make_scheduler(scheduler)
+    if batch_capable(first) and not apart:
+        return first
+    return [first] + [make_scheduler(scheduler) for _ in range(num - 1)]
+
+
+def batched(sc: object, scheduler: str, num: int, apart: bool = False) -> tuple[float, float]:
     """(world-steps per CPU second, expert's share) of one episode of ``num`` worlds."""
     env = VectorMotionEnv(sc, num)  # type: ignore[arg-type]
-    expert = BatchPlanFollower(env, scheduler)
+    per_world = [make_scheduler(scheduler) for _ in range(num)]
+    expert = BatchPlanFollower(env, per_world if apart else scheduler)
     obs, _ = env.reset(seed=0)
     clock = [0.0, 0.0]
     n_ticks = env.scenario.n_ticks
@@ -101,12 +115,10 @@ def single_task(sc: object, scheduler: str, episodes: int) -> tuple[float, float
     return steps / (_CPU() - c), float("nan")
 
 
-def batched_task(sc: object, scheduler: str, num: int) -> tuple[float, float]:
-    """(world-steps per CPU second, NaN) of one recorded episode of ``num`` worlds (one
-    scheduler instance for all when it plans batched, else one per world)."""
+def batched_task(sc: object, scheduler: str, num: int, apart: bool = False) -> tuple[float, float]:
+    """(world-steps per CPU second, NaN) of one recorded episode of ``num`` worlds."""
     env = VectorTaskEnv(sc, num, autoreset_mode="disabled")  # type: ignore[arg-type]
-    first = make_scheduler(scheduler)
-    scheds: Any = first if batch_capable(first) else [make_scheduler(scheduler) for _ in range(num)]
+    scheds = _schedulers(scheduler, num, apart)
     c = _CPU()
     steps = sum(r.steps for r in batched_rollouts(env, scheds, "bench", list(range(num))))
     return steps / (_CPU() - c), float("nan")
@@ -121,26 +133,32 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--episodes", type=int, default=2, help="single-env episodes per round")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--level", choices=["motion", "task"], default="motion")
+    ap.add_argument("--apart", action="store_true",
+                    help="also each B with one scheduler instance per world, called in turn")  # fmt: skip
     args = ap.parse_args(argv)
     one, many = (single, batched) if args.level == "motion" else (single_task, batched_task)
     sc = load_scenario(args.scenario).replace(duration_s=args.duration)
-    runs: dict[int, list[tuple[float, float]]] = {0: [], **{n: [] for n in args.sizes}}
+    rows_of = ["single"] + [f"B={n}" for n in args.sizes]
+    if args.apart:
+        rows_of += [f"B={n} apart" for n in args.sizes]
+    runs: dict[str, list[tuple[float, float]]] = {k: [] for k in rows_of}
     for _ in range(args.rounds):
-        runs[0].append(one(sc, args.scheduler, args.episodes))
+        runs["single"].append(one(sc, args.scheduler, args.episodes))
         for num in args.sizes:
-            runs[num].append(many(sc, args.scheduler, num))
+            runs[f"B={num}"].append(many(sc, args.scheduler, num))
+            if args.apart:
+                runs[f"B={num} apart"].append(many(sc, args.scheduler, num, True))
     print(f"# scheduling expert ({args.scheduler}) on the {args.level} level, scenario "
           f"#{args.scenario}, {args.duration:g}-s episodes; Python {platform.python_version()}, "
           f"numpy {np.__version__}; load {os.getloadavg()[0]:.2f}; median of {args.rounds} "
           "interleaved round(s)")  # fmt: skip
-    print(f"{'rollout':10s} {'world-steps/s':>14s} {'ratio':>6s} {'[min, max]':>12s} "
+    print(f"{'rollout':12s} {'world-steps/s':>14s} {'ratio':>6s} {'[min, max]':>12s} "
           f"{'expert share':>13s}")  # fmt: skip
-    base = np.array([r for r, _ in runs[0]])
-    for num, rows in runs.items():
+    base = np.array([r for r, _ in runs["single"]])
+    for label, rows in runs.items():
         r = np.array(rows)
         ratio = r[:, 0] / base
-        label = "single" if num == 0 else f"B={num}"
-        print(f"{label:10s} {np.median(r[:, 0]):14.0f} {np.median(ratio):6.2f} "
+        print(f"{label:12s} {np.median(r[:, 0]):14.0f} {np.median(ratio):6.2f} "
               f"[{ratio.min():4.2f}, {ratio.max():4.2f}] {_share(r[:, 1]):>13s}")  # fmt: skip
     return 0
 

@@ -80,10 +80,11 @@ def test_an_invalid_plan_falls_back_for_its_world_only():
 def test_one_instance_per_world_and_instances_without_plan_batch():
     """A sequence is one scheduler per world; a single instance without ``plan_batch`` is called
     on each graph in turn; both equal ``solve``."""
-    graphs, rngs = graphs_and_rngs(3)
+    graphs, _ = graphs_and_rngs(3)
     per_world = [make_scheduler("random") for _ in graphs]
     one = make_scheduler("random")
     assert not batch_capable(one)
+
     def rngs():
         return [np.random.default_rng(s) for s in range(3)]
 
