@@ -160,6 +160,12 @@ def main(argv: list[str] | None = None) -> int:
         ratio = r[:, 0] / base
         print(f"{label:12s} {np.median(r[:, 0]):14.0f} {np.median(ratio):6.2f} "
               f"[{ratio.min():4.2f}, {ratio.max():4.2f}] {_share(r[:, 1]):>13s}")  # fmt: skip
+    if args.apart:  # paired per round: the batched call against per-world calls
+        pairs = []
+        for n in args.sizes:
+            q = np.array(runs[f"B={n}"])[:, 0] / np.array(runs[f"B={n} apart"])[:, 0]
+            pairs.append(f"B={n} {np.median(q):.2f}x [{q.min():.2f}, {q.max():.2f}]")
+        print("one batched call over one call per world, same round: " + ", ".join(pairs))
     return 0
 
 

@@ -32,3 +32,4 @@ def test_rows_per_size_with_ratio_ranges(level):
         assert lo <= median <= hi
         assert m[1] != "single" or median == lo == hi == 1.0
         assert (m[5] == "-") == (level == "task")
+    assert re.search(r"same round: B=1 [\d.]+x \[[\d.]+, [\d.]+\], B=3 [\d.]+x", out)
