@@ -24,6 +24,9 @@ time-out            a call at a limit nobody can meet (``timeout_limit``, 1 us) 
                     ``deterministic = True`` (then an idle team is its decision):
                     :func:`fcplan.scheduling.solve` would replace such a plan by greedy's
 no mutation         every numpy array of the graph holds the same bytes after the call
+batched plans       a scheduler with ``plan_batch`` (:mod:`fcplan.scheduling_batch`): one
+                    call on all the sampled graphs returns, graph for graph, the plans
+                    ``plan`` returns on each (fresh schedulers, generators seeded alike)
 ==================  ======================================================================
 
 The graphs come from episodes played by ``greedy`` (so the states are realistic and the same for
@@ -51,6 +54,7 @@ import numpy as np
 
 from fcplan.plan import Plan, validate_plan
 from fcplan.scheduling import Scheduler, idle_team, make_scheduler
+from fcplan.scheduling_batch import batch_capable
 from fcplan.taskgraph import TaskGraph
 
 __all__ = ["ConformanceReport", "check_scheduler", "episode_graphs", "shipped_scenarios"]
@@ -162,6 +166,28 @@ def _timeout_failure(scheduler: Scheduler, graph: TaskGraph, limit: float, seed:
     return f"at time_limit={limit:g} the plan left the team idle: {idle}" if idle else ""
 
 
+def _batch_failures(
+    factory: Callable[[], Scheduler],
+    sampled: list[tuple[str, TaskGraph]],
+    time_limit: float | None,
+    seed: int,
+) -> list[str]:
+    """The batched-plans check (module docstring): what differs, per graph."""
+    graphs = [g for _, g in sampled]
+    rngs = [np.random.default_rng(seed) for _ in graphs]
+    try:
+        plans = factory().plan_batch(graphs, time_limit=time_limit, rngs=rngs)  # type: ignore[attr-defined]
+        if len(plans) != len(graphs):
+            return [f"plan_batch returned {len(plans)} plans for {len(graphs)} graphs"]
+    except Exception as exc:  # noqa: BLE001 - every failure is reported, not raised
+        return [f"plan_batch: {type(exc).__name__}: {exc}"]
+    return [
+        f"{where}: plan_batch's plan differs from plan's"
+        for (where, g), p in zip(sampled, plans, strict=True)
+        if not _same_plan(p, _call(factory(), g, time_limit, seed)[0])
+    ]
+
+
 def check_scheduler(
     factory: Callable[[], Scheduler],
     *,
@@ -205,9 +231,11 @@ def check_scheduler(
     scheduler = factory()
     report = ConformanceReport(name=str(getattr(scheduler, "name", type(scheduler).__name__)))
     budget = None if time_limit is None else time_limit * (1 + time_tolerance) + time_slack_s
+    sampled: list[tuple[str, TaskGraph]] = []
     for sc in shipped_scenarios() if scenarios is None else scenarios:
         for graph in episode_graphs(sc, ticks, seed):
             where = f"scenario {getattr(sc, 'name', sc)} tick {graph.tick}"
+            sampled.append((where, graph))
             before = _arrays(graph)
             try:
                 plan, wall = _call(scheduler, graph, time_limit, seed)
@@ -238,6 +266,8 @@ def check_scheduler(
                     report.failures.append(f"{where}: not deterministic under a fixed seed")
     if report.graphs == 0:
         report.failures.append("no task graph was sampled (no scenario, or no tick in range)")
+    elif batch_capable(scheduler):
+        report.failures += _batch_failures(factory, sampled, time_limit, seed)
     if raise_on_failure and report.failures:
         raise AssertionError(
             f"scheduler {report.name!r} failed {len(report.failures)} conformance check(s):\n  "

@@ -169,3 +169,36 @@ def test_episode_graphs_are_taken_at_replan_ticks():
     episode's end drops the rest."""
     graphs = episode_graphs("practice", (0, 5, 10, 10**6))
     assert [g.tick for g in graphs] == [0, 10]
+
+
+class _BatchDiffers:
+    """Greedy whose ``plan_batch`` drops the last graph's routes (or raises)."""
+
+    name = "batch-differs"
+
+    def __init__(self, how: str) -> None:
+        from solvers.greedy import GreedyScheduler
+
+        self._g, self.how = GreedyScheduler(), how
+
+    def plan(self, graph, *, time_limit=None, rng=None):
+        return self._g.plan(graph, time_limit=time_limit, rng=rng)
+
+    def plan_batch(self, graphs, *, time_limit=None, rngs=None):
+        if self.how == "raises":
+            raise RuntimeError("no batch today")
+        plans = self._g.plan_batch(graphs)
+        plans[-1] = Plan()
+        return plans
+
+
+@pytest.mark.parametrize(("how", "message"), [("differs", "differs from plan's"),
+                                              ("raises", "plan_batch: RuntimeError")])  # fmt: skip
+def test_kit_checks_plan_batch_against_plan(how, message):
+    """A scheduler with ``plan_batch`` must return plan's plans graph for graph: one that differs
+    on a graph (named by scenario and tick) or raises fails the kit; greedy's passes."""
+    kw = {"scenarios": ["1"], "ticks": (0, 300), "time_limit": None, "raise_on_failure": False}
+    report = check_scheduler(lambda: _BatchDiffers(how), **kw)
+    assert len(report.failures) == 1 and message in report.failures[0], report.failures
+    assert how == "raises" or "scenario 1 tick 300" in report.failures[0]
+    assert check_scheduler(lambda: make_scheduler("greedy"), **kw).failures == []
