@@ -104,10 +104,12 @@ def test_lengths_must_match():
 
 
 def test_the_batched_expert_shares_one_greedy_and_not_one_routing():
-    """BatchPlanFollower plans every world with one greedy instance (batched), but makes one
-    routing instance per world (no ``plan_batch``)."""
+    """BatchPlanFollower plans every world with one greedy instance (batched), named or given,
+    but makes one routing instance per world (no ``plan_batch``)."""
     env = VectorMotionEnv("practice", 3)
     shared = BatchPlanFollower(env, "greedy")
     assert shared.shared is not None and all(s is shared.shared for s in shared.schedulers)
     apart = BatchPlanFollower(env, "routing")
     assert apart.shared is None and len({id(s) for s in apart.schedulers}) == 3
+    given = make_scheduler("greedy")
+    assert BatchPlanFollower(env, given).shared is given

@@ -236,8 +236,8 @@ def demonstrations(
         The Minari dataset id (``format="minari"``; default ``"fcplan/task/<scheduler>-v0"``).
     num_envs : int
         Roll up to this many seeds of a scenario out at once in a batched task env
-        (:func:`fcplan.env.demo_episodes.batched_rollouts`, one scheduler instance per world);
-        the dataset is the one ``num_envs=1`` gives, for schedulers that keep no state between
+        (:func:`fcplan.env.demo_episodes.batched_rollouts`; one greedy instance plans every
+        world in one call, ``plan_batch``; other schedulers one instance per world); the dataset is the one ``num_envs=1`` gives, for schedulers that keep no state between
         episodes.
     progress : bool or callable
         ``True`` (default): a progress bar on stderr counted in episodes, the one of ``compare``

@@ -61,13 +61,18 @@ class BatchPlanFollower:
     ----------
     env : VectorMotionEnv
     scheduler : str, Scheduler or sequence of Scheduler
-        A registered scheduler name or spec (one instance is made per world), or one instance
-        per world (a scheduler that keeps state between calls sees only its own world).
+        A registered scheduler name or spec (one instance planning every world together when it
+        has ``plan_batch``, as greedy, else one instance per world); one instance with
+        ``plan_batch`` (shared by the worlds); or one instance per world (a scheduler that keeps
+        state between calls sees only its own world).
     replan_period, time_limit, graph_params
         As :class:`fcplan.env.motion_expert.PlanFollower`.
 
     Attributes
     ----------
+    shared : Scheduler or None
+        The one instance planning every world in one call (:mod:`fcplan.scheduling_batch`),
+        else None (one call per world).
     replans : ndarray, (B,) int64
         Plans made in each world since its episode started.
     plans : list of Plan or None
@@ -88,8 +93,6 @@ class BatchPlanFollower:
         if not replan_period > 0:
             raise EnvError(f"replan_period: must be > 0 simulated seconds (got {replan_period!r})")
         self.env, num = env, env.num_envs
-        #: The one instance planning every world together (a name of a scheduler with
-        #: ``plan_batch``: :mod:`fcplan.scheduling_batch`), else None.
         self.shared: Scheduler | None = None
         if isinstance(scheduler, str):
             first = make_scheduler(scheduler)
@@ -103,12 +106,13 @@ class BatchPlanFollower:
                 raise EnvError(
                     f"scheduler: need {num} schedulers, one per world (got {len(self.schedulers)})"
                 )
-        elif num == 1:
-            self.schedulers = [cast(Scheduler, scheduler)]
+        elif num == 1 or batch_capable(scheduler):
+            self.schedulers = [cast(Scheduler, scheduler)] * num
+            self.shared = self.schedulers[0] if num > 1 else None
         else:
             raise EnvError(
-                "scheduler: give a name or one instance per world (an instance would be shared "
-                "by the worlds)"
+                "scheduler: give a name, an instance with plan_batch, or one instance per world "
+                "(an instance without plan_batch would be shared by the worlds)"
             )
         if any(getattr(s, "clairvoyant", False) for s in self.schedulers):
             raise EnvError("scheduler: clairvoyant schedulers (oracle) are not batched")

@@ -89,15 +89,16 @@ def test_graph_params_reach_the_graphs_of_both_followers():
 
 
 def test_bad_arguments_are_named():
-    """A wrong env, a shared instance, a wrong count of schedulers or a bad period is an
-    EnvError naming the argument; so is asking for actions before the env's first reset."""
+    """A wrong env, a shared instance without plan_batch, a wrong count of schedulers or a bad
+    period is an EnvError naming the argument; so is asking for actions before the env's first
+    reset."""
     venv = VectorMotionEnv("practice", 2)
     with pytest.raises(EnvError, match="reset the env first"):
         BatchPlanFollower(venv, "greedy").actions({})
     from fcplan.scheduling import make_scheduler
 
     for kwargs, word in [
-        ({"scheduler": make_scheduler("greedy")}, "one instance per world"),
+        ({"scheduler": make_scheduler("routing")}, "one instance per world"),
         ({"scheduler": [make_scheduler("greedy")]}, "need 2 schedulers"),
         ({"scheduler": "greedy", "replan_period": 0}, "replan_period"),
     ]:
