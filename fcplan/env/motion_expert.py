@@ -141,8 +141,9 @@ class PlanFollower:
 
 class TeamRoutes:
     """What a team was told by its last plan, and the move rule (module docstring) that follows
-    it: the one place both :class:`PlanFollower` and the batched follower
-    (:class:`fcplan.env.vector_expert.BatchPlanFollower`, one per world) keep it.
+    it: the readable rule, :class:`PlanFollower`'s; the batched follower
+    (:class:`fcplan.env.vector_expert.BatchPlanFollower`) runs its fast kernel
+    :class:`fcplan.env.vector_moves.BatchRoutes`, tested equal to it.
 
     Parameters
     ----------

@@ -15,8 +15,9 @@ the task graphs of the worlds that replan at a tick are built together
 ``plan_batch`` (greedy) is one instance planning every replanning world in one call, any other
 one instance per world called in turn, each plan settled as :func:`fcplan.scheduling.solve`
 settles it (with the world's controller generator; a failing solver falls back to greedy for
-its world). Per world, in a loop: the move rule (:class:`fcplan.env.motion_expert.TeamRoutes`,
-the single follower's own), a few Python operations per agent. Worlds that finish are skipped
+its world). The move rule is the single follower's (:class:`fcplan.env.motion_expert.TeamRoutes`)
+run for every world and agent at once by its fast kernel
+(:class:`fcplan.env.vector_moves.BatchRoutes`, tested equal to it). Worlds that finish are skipped
 (their actions are 0: the env ignores them) and start afresh when the env resets them. What
 this costs against the single env with :class:`~fcplan.env.motion_expert.PlanFollower` is
 measured by ``bench/bench_vector_expert.py`` (figures in ``bench/README.md``).
@@ -24,6 +25,7 @@ measured by ``bench/bench_vector_expert.py`` (figures in ``bench/README.md``).
 Examples
 --------
 >>> from fcplan.env.vector_motion import VectorMotionEnv
+from fcplan.env.vector_moves import BatchRoutes
 >>> env = VectorMotionEnv("practice", 3)
 >>> expert = BatchPlanFollower(env, "greedy")
 >>> obs, infos = env.reset(seed=0)
@@ -41,8 +43,8 @@ from typing import Any, cast
 import numpy as np
 
 from fcplan.belief_batch import BatchBelief
-from fcplan.env.motion_expert import TeamRoutes
 from fcplan.env.vector_motion import VectorMotionEnv
+from fcplan.env.vector_moves import BatchRoutes
 from fcplan.env.vector_task import TeamView, world_graphs
 from fcplan.errors import EnvError
 from fcplan.mission import period_ticks
@@ -123,7 +125,7 @@ class BatchPlanFollower:
         self._ids = list(env.agent_ids)
         self._teams = [TeamView(env.batch.team, b) for b in range(num)]
         self.belief = BatchBelief(sc, num)
-        self._routes = [TeamRoutes(self._ids, sc) for _ in range(num)]
+        self._routes = BatchRoutes(self._ids, sc, num)
         self._builders = [TaskGraphBuilder(sc, graph_params) for _ in range(num)]
         self._next = np.zeros(num, dtype=np.int64)  # the tick of each world's next replan
         self._last_tick = np.zeros(num, dtype=np.int64)
@@ -137,8 +139,8 @@ class BatchPlanFollower:
         rows = np.arange(self.env.num_envs) if rows is None else np.asarray(rows, dtype=np.int64)
         sc = self.env.scenario
         self.belief.reset(rows)
+        self._routes.reset(rows)
         for b in rows.tolist():
-            self._routes[b] = TeamRoutes(self._ids, sc)
             self._builders[b] = TaskGraphBuilder(sc, self.graph_params)
             self.plans[b] = None
         tick = self.env.batch.tick[rows]
@@ -166,15 +168,12 @@ class BatchPlanFollower:
             self._replan(due)
         team = batch.team
         out = np.zeros((env.num_envs, len(self._ids)), dtype=np.int64)
-        masks = observations["action_mask"]
-        climb = 5.0 * team.one.tick_scale
-        speed = team.speed.tolist()
-        for b in np.flatnonzero(live).tolist():
-            chosen = self._routes[b].choose(
-                dict(zip(self._ids, masks[b], strict=True)), team.pos[b].tolist(),
-                team.z_target[b].tolist(), team.mode[b].tolist(), speed, climb,
+        rows = np.flatnonzero(live)
+        if rows.size:
+            out[rows] = self._routes.choose(
+                rows, observations["action_mask"], team.pos, team.z_target, team.mode,
+                np.asarray(team.speed, dtype=np.float64), 5.0 * team.one.tick_scale,
             )  # fmt: skip
-            out[b] = [chosen[a] for a in self._ids]
         return out
 
     def _replan(self, rows: np.ndarray) -> None:
@@ -191,5 +190,5 @@ class BatchPlanFollower:
         for b, graph, plan in zip(rows.tolist(), graphs, plans, strict=True):
             self.plans[b] = plan
             self.replans[b] += 1
-            self._routes[b].follow(plan, graph)
+            self._routes.follow(b, plan, graph)
             self._next[b] = int(batch.tick[b]) + self.period
