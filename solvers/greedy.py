@@ -41,6 +41,11 @@ limit (``bench/bench_time_limits.py``: about a millisecond of CPU per replan on 
 suite, 10-27 ms at 50-100 agents x 200-2,000 tasks). It is also what
 :func:`fcplan.scheduling.solve` falls back to, so a fallback costs that on top of the failed call.
 
+Many worlds at once. :meth:`GreedyScheduler.plan_batch` plans several independent graphs in one
+call, the plans equal to :meth:`~GreedyScheduler.plan`'s graph for graph; the pick loop of all
+the graphs runs together (:mod:`solvers.greedy_batch`), the rest of the steps per graph. The
+batched envs' experts use it (:mod:`fcplan.scheduling_batch`).
+
 Examples
 --------
 >>> from fcplan import run_episode
