@@ -25,7 +25,6 @@ measured by ``bench/bench_vector_expert.py`` (figures in ``bench/README.md``).
 Examples
 --------
 >>> from fcplan.env.vector_motion import VectorMotionEnv
-from fcplan.env.vector_moves import BatchRoutes
 >>> env = VectorMotionEnv("practice", 3)
 >>> expert = BatchPlanFollower(env, "greedy")
 >>> obs, infos = env.reset(seed=0)
