@@ -51,7 +51,7 @@ from fcplan.env.vector_motion import VectorMotionEnv
 from fcplan.env.vector_task import VectorTaskEnv
 from fcplan.scenario import load_scenario
 from fcplan.scheduling import make_scheduler
-from fcplan.scheduling_batch import batch_capable
+from fcplan.scheduling_batch import instances
 
 _CPU = time.thread_time
 
@@ -83,15 +83,6 @@ def _step(expert: Any, env: Any, obs: Any, clock: list[float]) -> Any:
     return obs
 
 
-def _schedulers(scheduler: str, num: int, apart: bool) -> Any:
-    """One instance for all ``num`` worlds when it plans batched (and not ``apart``), else one
-    per world (each world's graph planned by its own call)."""
-    first = make_scheduler(scheduler)
-    if batch_capable(first) and not apart:
-        return first
-    return [first] + [make_scheduler(scheduler) for _ in range(num - 1)]
-
-
 def batched(sc: object, scheduler: str, num: int, apart: bool = False) -> tuple[float, float]:
     """(world-steps per CPU second, expert's share) of one episode of ``num`` worlds."""
     env = VectorMotionEnv(sc, num)  # type: ignore[arg-type]
@@ -118,7 +109,11 @@ def single_task(sc: object, scheduler: str, episodes: int) -> tuple[float, float
 def batched_task(sc: object, scheduler: str, num: int, apart: bool = False) -> tuple[float, float]:
     """(world-steps per CPU second, NaN) of one recorded episode of ``num`` worlds."""
     env = VectorTaskEnv(sc, num, autoreset_mode="disabled")  # type: ignore[arg-type]
-    scheds = _schedulers(scheduler, num, apart)
+    scheds = (
+        [make_scheduler(scheduler) for _ in range(num)]
+        if apart
+        else instances(lambda: make_scheduler(scheduler), num)
+    )
     c = _CPU()
     steps = sum(r.steps for r in batched_rollouts(env, scheds, "bench", list(range(num))))
     return steps / (_CPU() - c), float("nan")

@@ -31,7 +31,7 @@ Examples
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -40,7 +40,7 @@ from fcplan.plan import Plan
 from fcplan.scheduling import Scheduler, settle, solve
 from fcplan.taskgraph import TaskGraph
 
-__all__ = ["BatchScheduler", "batch_capable", "solve_batch"]
+__all__ = ["BatchScheduler", "batch_capable", "instances", "solve_batch"]
 
 
 @runtime_checkable
@@ -68,6 +68,22 @@ def batch_capable(scheduler: object) -> bool:
     (True, False)
     """
     return callable(getattr(scheduler, "plan_batch", None))
+
+
+def instances(make: Callable[[], Scheduler], num: int) -> Scheduler | list[Scheduler]:
+    """What plans ``num`` worlds: one instance from ``make()`` when it is :func:`batch_capable`
+    (every world in one call), else ``num`` instances, one per world.
+
+    Examples
+    --------
+    >>> from fcplan.scheduling import make_scheduler
+    >>> instances(lambda: make_scheduler("greedy"), 3).name
+    'greedy'
+    >>> len(instances(lambda: make_scheduler("routing"), 3))
+    3
+    """
+    first = make()
+    return first if batch_capable(first) else [first] + [make() for _ in range(num - 1)]
 
 
 def solve_batch(

@@ -158,12 +158,13 @@ class GreedyScheduler:
     def _plans(self, graphs: list[TaskGraph], assign: _Assigner) -> list[Plan]:
         """The three steps of the module docstring for every graph, the two assignment steps
         done by ``assign`` (one graph at a time, or all together)."""
-        fire_jobs = [self._fire_job(g) for g in graphs]
+        roles = [_free_and_hybrids(g) for g in graphs]
+        fire_jobs = [self._fire_job(g, *r) for g, r in zip(graphs, roles, strict=True)]
         fire_picks = assign(graphs, fire_jobs, False)
         out: list[Plan] = []
         search_jobs: list[_Job | None] = []
         states = []
-        for g, picks in zip(graphs, fire_picks, strict=True):
+        for g, (free, hybrids), picks in zip(graphs, roles, fire_picks, strict=True):
             routes: dict[str, tuple[str, ...]] = {}
             alts: dict[str, float] = {}
             first_fire: dict[int, int] = {}
@@ -175,13 +176,9 @@ class GreedyScheduler:
                         routes[g.agent_ids[row]] = tuple(g.task_ids[k] for k in tasks)
                         first_fire[row] = tasks[0]
             # 2. perception agents watch the fires being fought
-            free = g.agent_mode != Mode.HOMING
             sensors = np.flatnonzero(free & g.agent_can_sense & ~g.agent_can_act)
             busy = self._watch(g, sensors, first_fire, routes, alts)
             # 3. the others search
-            hybrids = np.flatnonzero(
-                free & g.agent_can_act & g.agent_can_sense & (g.agent_tank > 0)
-            )
             searchers = np.array(
                 [i for i in np.r_[sensors, hybrids] if i not in busy and g.agent_ids[i] not in routes],
                 dtype=np.int64,
@@ -206,16 +203,13 @@ class GreedyScheduler:
             out.append(Plan(routes=routes, altitudes=alts, stats=stats))
         return out
 
-    def _fire_job(self, graph: TaskGraph) -> _Job | None:
-        """Step 1's assignment problem: the action agents (and hybrids) with water, the fire
-        tasks, their fresh values and the route limits; None when either side is empty."""
-        free = graph.agent_mode != Mode.HOMING
+    def _fire_job(self, graph: TaskGraph, free: np.ndarray, hybrids: np.ndarray) -> _Job | None:
+        """Step 1's assignment problem: the action agents (and ``hybrids``) with water among the
+        ``free`` ones, the fire tasks, their fresh values and the route limits; None when either
+        side is empty."""
         fires = graph.fire_tasks
         actors = np.flatnonzero(
             free & graph.agent_can_act & (graph.agent_tank > 0) & ~graph.agent_can_sense
-        )
-        hybrids = np.flatnonzero(
-            free & graph.agent_can_act & graph.agent_can_sense & (graph.agent_tank > 0)
         )
         actors = np.r_[actors, hybrids].astype(np.int64)
         if not (actors.size and fires.size):
@@ -353,3 +347,12 @@ class GreedyScheduler:
             best[idx] = np.argmax(score[idx], axis=1)
             best_s[idx] = score[idx, best[idx]]
         return routes, gained
+
+
+def _free_and_hybrids(graph: TaskGraph) -> tuple[np.ndarray, np.ndarray]:
+    """(A,) bool: the agents not homing; and the rows of the free hybrids with water."""
+    free = graph.agent_mode != Mode.HOMING
+    hybrids = np.flatnonzero(
+        free & graph.agent_can_act & graph.agent_can_sense & (graph.agent_tank > 0)
+    )
+    return free, hybrids

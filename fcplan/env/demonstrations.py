@@ -77,7 +77,7 @@ from fcplan.errors import FcplanError
 from fcplan.mission import ScenarioLike, as_scenario
 from fcplan.provenance import library_versions
 from fcplan.scheduling import Scheduler, make_scheduler, parse_scheduler_spec
-from fcplan.scheduling_batch import batch_capable
+from fcplan.scheduling_batch import instances
 
 __all__ = [
     "Demonstrations",
@@ -387,11 +387,8 @@ class _Rollouts:
         for i in range(0, len(seeds), num):
             chunk = seeds[i : i + num]
             env = VectorTaskEnv(scenario, len(chunk), autoreset_mode="disabled", **env_kwargs)
-            first = _scheduler(spec)[0] if isinstance(spec, str) else copy.deepcopy(spec)
-            # one instance plans every world together when it can (greedy), else one per world
-            scheds: Scheduler | list[Scheduler] = first if batch_capable(first) else [first] + [
-                _scheduler(spec)[0] if isinstance(spec, str) else copy.deepcopy(spec)
-                for _ in chunk[1:]]  # fmt: skip
+            scheds = instances(lambda: _scheduler(spec)[0] if isinstance(spec, str)
+                               else copy.deepcopy(spec), len(chunk))  # fmt: skip
             for rec in batched_rollouts(env, scheds, key, chunk, time_limit=self.time_limit,
                                         counts=self.counts):  # fmt: skip
                 self.add(rec)

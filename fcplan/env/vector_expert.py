@@ -49,7 +49,7 @@ from fcplan.errors import EnvError
 from fcplan.mission import period_ticks
 from fcplan.plan import Plan
 from fcplan.scheduling import Scheduler, make_scheduler
-from fcplan.scheduling_batch import batch_capable, solve_batch
+from fcplan.scheduling_batch import batch_capable, instances, solve_batch
 from fcplan.taskgraph import TaskGraphBuilder, TaskGraphParams
 
 __all__ = ["BatchPlanFollower"]
@@ -96,11 +96,9 @@ class BatchPlanFollower:
         self.env, num = env, env.num_envs
         self.shared: Scheduler | None = None
         if isinstance(scheduler, str):
-            first = make_scheduler(scheduler)
-            if batch_capable(first):
-                self.shared = first
-            more = [first if self.shared else make_scheduler(scheduler) for _ in range(num - 1)]
-            self.schedulers: list[Scheduler] = [first, *more]
+            made = instances(lambda: make_scheduler(scheduler), num)
+            self.shared = None if isinstance(made, list) else made
+            self.schedulers: list[Scheduler] = made if isinstance(made, list) else [made] * num
         elif isinstance(scheduler, (list, tuple)):
             self.schedulers = list(scheduler)
             if len(self.schedulers) != num:
