@@ -169,7 +169,9 @@ class BatchWorld:
         ----------
         seeds : sequence, int or None
             One seed per world (ints, SeedSequences or None; with ``mask``, one per masked
-            world, or one per world), or an int ``s`` for ``s, s + 1, ...``. A None seed takes
+            world, or one per world), or an int ``s`` for ``s, s + 1, ...`` (with ``mask``: for the
+            masked worlds in order; the vector envs seed world ``b`` with ``s + b``,
+            :func:`fcplan.env.vector_base.reset_seeds`). A None seed takes
             the world's next seed from its reseed generator (module docstring), or fresh
             entropy before its first seeded episode.
         """

@@ -19,6 +19,12 @@ makes it too. :class:`BatchPlanFollower` (:mod:`fcplan.env.vector_expert`) is th
 :class:`PlanFollower` of every world of a batched motion env, and
 :meth:`VectorTaskEnv.expert_actions <fcplan.env.vector_task.VectorTaskEnv.expert_actions>` a
 scheduler's actions on every world of the batched task level.
+Their ``reset(seed=s)`` seeds world ``b`` with ``s + b``, also when ``options["reset_mask"]``
+picks the worlds, as Gymnasium's vector envs do (:func:`fcplan.env.vector_base.reset_seeds`).
+
+Actions are integers; floats of whole values are taken as those integers, and a fractional or
+non-finite one raises :class:`~fcplan.errors.EnvError` before anything steps
+(:mod:`fcplan.env.action_input`).
 
 Also here: :func:`gym_env` (a Gymnasium single-agent view of the task level with a centralised
 joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert datasets from any

@@ -40,6 +40,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from fcplan.env.action_input import integer_actions
 from fcplan.env.human import HumanWindow, WindowedRender
 from fcplan.env.task import TaskEnv
 from fcplan.env.wrappers import split_options
@@ -102,8 +103,8 @@ class TaskGymEnv(WindowedRender, gymnasium.Env):
         """Apply the joint action; return ``(obs, reward, terminated, truncated, info)``."""
         e = self.env
         ids = e.possible_agents
-        act = np.asarray(action, dtype=np.int64).reshape(len(ids))
-        _, rew, _, trunc, infos = e.step({a: int(x) for a, x in zip(ids, act, strict=True)})
+        act = integer_actions(action, (len(ids),), "action").tolist()
+        _, rew, _, trunc, infos = e.step(dict(zip(ids, act, strict=True)))
         first = infos[ids[0]]
         info = {
             "tick": first["tick"],

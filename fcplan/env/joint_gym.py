@@ -41,6 +41,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from fcplan.env.action_input import integer_actions
 from fcplan.env.human import HumanWindow, WindowedRender
 from fcplan.env.wrappers import split_options
 from fcplan.errors import EnvError
@@ -143,7 +144,7 @@ class JointGymEnv(WindowedRender, gymnasium.Env):
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         """Apply the joint action; return ``(obs, reward, terminated, truncated, info)``."""
         ids = self.env.possible_agents
-        act = np.asarray(action, dtype=np.int64).reshape(len(ids)).tolist()
+        act = integer_actions(action, (len(ids),), "action").tolist()
         obs, rew, term, trunc, infos = self.env.step(dict(zip(ids, act, strict=True)))
         if self.team_reward == "first":
             reward = float(rew[ids[0]])

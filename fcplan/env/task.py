@@ -113,6 +113,7 @@ import numpy as np
 from pettingzoo import ParallelEnv
 
 from fcplan.belief import Belief
+from fcplan.env.action_input import integer_action
 from fcplan.env.reward import PenaltyReward, RewardFn
 from fcplan.env.task_actions import actions_plan, decode_actions, rows_commands
 from fcplan.env.task_candidates import (
@@ -278,7 +279,10 @@ class TaskEnv(ParallelEnv):
         assert graph is not None and cand is not None  # (built by reset)
         noop = self.k
         # (a list of Python ints: decode_actions' fast path, though its annotation says ndarray)
-        act: Any = [noop if (x := actions.get(a)) is None else int(x) for a in self.possible_agents]
+        act: Any = [
+            noop if (x := actions.get(a)) is None else integer_action(x, f"action of {a}")
+            for a in self.possible_agents
+        ]
         rows, illegal, conflict = decode_actions(graph, cand, act, illegal=self.illegal_action)
         # a handful of agents: plain Python lists from here
         rows_l = rows.tolist()

@@ -15,6 +15,8 @@ Examples
 'SameStep'
 >>> reset_rows(4, None, {"reset_mask": [True, False, False, True]}).tolist()
 [0, 3]
+>>> reset_seeds(4, np.array([0, 3]), 10)
+[10, 13]
 """
 
 from __future__ import annotations
@@ -27,7 +29,14 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 
 from fcplan.errors import EnvError
 
-__all__ = ["AUTORESET_MODES", "BatchedEnv", "autoreset_from", "reset_rows", "per_world_info"]
+__all__ = [
+    "AUTORESET_MODES",
+    "BatchedEnv",
+    "autoreset_from",
+    "reset_rows",
+    "reset_seeds",
+    "per_world_info",
+]
 
 #: accepted ``autoreset_mode`` values (or Gymnasium's :class:`~gymnasium.vector.AutoresetMode`)
 AUTORESET_MODES = ("next_step", "same_step", "disabled")
@@ -55,6 +64,34 @@ def reset_rows(num: int, seed: Any, options: dict[str, Any] | None) -> np.ndarra
         return np.flatnonzero(np.asarray(mask, dtype=bool).reshape(num))
     except ValueError:
         raise EnvError(f"options['reset_mask']: must be {num} booleans") from None
+
+
+def reset_seeds(num: int, rows: np.ndarray, seed: Any) -> list[Any]:
+    """The seed of each world of ``rows`` that ``reset(seed=seed)`` resets, by Gymnasium's rule
+    (``gymnasium.vector.SyncVectorEnv.reset``): None, None for each (the world continues its
+    own seed sequence); an int ``s``, ``s + b`` for world ``b`` whichever worlds are reset; a
+    list of ``num`` seeds, world ``b``'s is ``seed[b]``. A list of one seed per world reset (in
+    the order of ``rows``) is accepted too.
+
+    Raises
+    ------
+    EnvError
+        For a list of another length.
+    """
+    rows_l = np.asarray(rows, dtype=np.int64).tolist()
+    if seed is None:
+        return [None] * len(rows_l)
+    if isinstance(seed, (int, np.integer)):
+        return [int(seed) + b for b in rows_l]
+    given = list(seed)
+    if len(given) == num:
+        return [given[b] for b in rows_l]
+    if len(given) == len(rows_l):
+        return given
+    raise EnvError(
+        f"seed: need {num} seeds, one per world (or {len(rows_l)}, one per world reset), "
+        f"got {len(given)}"
+    )
 
 
 def per_world_info(mask: np.ndarray, value: Callable[[int], Any]) -> tuple[np.ndarray, np.ndarray]:

@@ -53,9 +53,10 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from fcplan.batch import BatchStepInfo, BatchWorld
+from fcplan.env.action_input import integer_actions
 from fcplan.env.motion import MotionEnv
 from fcplan.env.motion_obs import N_AGENT_FEATURES, N_FOV
-from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows
+from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows, reset_seeds
 from fcplan.env.vector_obs import BatchMotionObs
 from fcplan.errors import EnvError
 from fcplan.metrics import facility_penalty
@@ -150,14 +151,14 @@ class VectorMotionEnv(BatchedEnv):
     def reset(
         self, *, seed: int | list | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-        """Start episodes: every world (``seed``: an int ``s`` for ``s, s + 1, ...``, a list of
-        seeds, or None to continue each world's seeds), or only ``options["reset_mask"]``."""
+        """Start episodes: every world, or only ``options["reset_mask"]``'s; ``seed`` as
+        Gymnasium's vector envs take it (an int ``s``: ``s + b`` for world ``b``; a list: one
+        seed per world; None: each world continues its seeds), or one seed per world reset
+        (:func:`fcplan.env.vector_base.reset_seeds`)."""
         rows = reset_rows(self.num_envs, seed, options)
         mask = np.zeros(self.num_envs, dtype=bool)
         mask[rows] = True
-        if seed is not None and not isinstance(seed, (int, np.integer)):
-            seed = list(seed)
-        self.batch.reset(seeds=seed, mask=mask)
+        self.batch.reset(seeds=reset_seeds(self.num_envs, rows, seed), mask=mask)
         self._reset_views(rows)
         self._started = True
         return self.views.observe(self.batch), {}
@@ -197,12 +198,7 @@ class VectorMotionEnv(BatchedEnv):
 
     def _check(self, actions: Any) -> np.ndarray:
         """(B, N) int64 actions, checked against each agent's action count."""
-        try:
-            act = np.asarray(actions, dtype=np.int64).reshape(self.num_envs, len(self.agent_ids))
-        except (TypeError, ValueError):
-            raise EnvError(
-                f"actions: must be integers of shape ({self.num_envs}, {len(self.agent_ids)})"
-            ) from None
+        act = integer_actions(actions, (self.num_envs, len(self.agent_ids)))
         bad = (act < 0) | (act >= self.views.n_actions)
         if np.count_nonzero(bad):
             b, j = (int(k[0]) for k in np.nonzero(bad))

@@ -67,6 +67,7 @@ from gymnasium.vector.utils import batch_space
 
 from fcplan.batch import BatchStepInfo, BatchWorld
 from fcplan.belief_batch import BatchBelief
+from fcplan.env.action_input import integer_actions
 from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import (
     MappingCounts,
@@ -76,7 +77,7 @@ from fcplan.env.task_actions import (
     rows_commands,
 )
 from fcplan.env.task_batch import batch_observe
-from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows
+from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows, reset_seeds
 from fcplan.errors import EnvError
 from fcplan.metrics import facility_penalty, penalty_rate
 from fcplan.mission import ScenarioLike
@@ -211,20 +212,12 @@ class VectorTaskEnv(BatchedEnv):
     def reset(
         self, *, seed: int | list | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-        """Start episodes in every world (``seed``: ``s`` for ``s, s + 1, ...``, a list, or None
-        to continue each world's seed sequence), or in ``options["reset_mask"]``'s worlds."""
+        """Start episodes in every world, or in ``options["reset_mask"]``'s; ``seed`` as
+        Gymnasium's vector envs take it (an int ``s``: ``s + b`` for world ``b``; a list: one
+        seed per world; None: each world continues its seed sequence), or one seed per world
+        reset (:func:`fcplan.env.vector_base.reset_seeds`)."""
         rows = reset_rows(self.num_envs, seed, options)
-        if isinstance(seed, (int, np.integer)):
-            given: list[Any] = [int(seed) + int(i) for i in rows]
-        elif seed is None:
-            given = [None] * rows.size
-        else:
-            given = list(seed)
-            if len(given) != rows.size:
-                raise EnvError(
-                    f"seed: need {rows.size} seeds, one per world reset (got {len(given)})"
-                )
-        self._reset_worlds(rows, given)
+        self._reset_worlds(rows, reset_seeds(self.num_envs, rows, seed))
         self._started = True
         return self._observation(), {"tick": self.batch.tick.copy()}
 
@@ -286,10 +279,7 @@ class VectorTaskEnv(BatchedEnv):
         batch = self.batch
         run = self._stepping(batch.done | (self.steps >= self.one.max_steps))
         a = self.one.n_agents
-        try:
-            act = np.asarray(actions, dtype=np.int64).reshape(self.num_envs, a)
-        except (TypeError, ValueError):
-            raise EnvError(f"actions: must be integers of shape ({self.num_envs}, {a})") from None
+        act = integer_actions(actions, (self.num_envs, a))
         resets = ~run if self.autoreset_mode is AutoresetMode.NEXT_STEP else np.zeros_like(run)
         if np.count_nonzero(resets):
             self._reset_worlds(np.flatnonzero(resets), [None] * int(resets.sum()))
