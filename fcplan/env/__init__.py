@@ -19,7 +19,8 @@ makes it too. :class:`BatchPlanFollower` (:mod:`fcplan.env.vector_expert`) is th
 :class:`PlanFollower` of every world of a batched motion env, and
 :meth:`VectorTaskEnv.expert_actions <fcplan.env.vector_task.VectorTaskEnv.expert_actions>` a
 scheduler's actions on every world of the batched task level.
-Their ``reset(seed=s)`` seeds world ``b`` with ``s + b``, also when ``options["reset_mask"]``
+``vector_env(..., processes=P)`` splits the worlds over ``P`` processes stepped at once
+(:mod:`fcplan.env.vector_shards`). Their ``reset(seed=s)`` seeds world ``b`` with ``s + b``, also when ``options["reset_mask"]``
 picks the worlds, as Gymnasium's vector envs do (:func:`fcplan.env.vector_base.reset_seeds`).
 
 Actions are integers; floats of whole values are taken as those integers, and a fractional or
@@ -82,6 +83,7 @@ __all__ = [
     "vector_env",
     "VectorMotionEnv",
     "VectorTaskEnv",
+    "ShardedVectorEnv",
 ]
 
 #: Environment levels accepted by :func:`parallel_env`.
@@ -101,6 +103,7 @@ _LAZY = {
     "vector_env": "fcplan.env.vector",
     "VectorMotionEnv": "fcplan.env.vector_motion",
     "VectorTaskEnv": "fcplan.env.vector_task",
+    "ShardedVectorEnv": "fcplan.env.vector_shards",
 }
 
 

@@ -15,6 +15,10 @@ over worlds on the per-tick path):
     ticks are batched; the belief, task graph, candidates and features stay per world (that
     module says why and ``bench/README.md`` measures it).
 
+``processes=K`` splits the worlds into ``K`` shards stepped at once, one here and ``K - 1`` in
+worker processes (:class:`fcplan.env.vector_shards.ShardedVectorEnv`: the same worlds and
+steps, on ``K`` cores).
+
 ``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` (and ``"fcplan/Task-v0"``)
 return the same classes (the ids' ``vector_entry_point``); ``vectorization_mode="sync"`` still
 gives Gymnasium's ``SyncVectorEnv`` of single envs, which the batched ones match step for step.
@@ -35,15 +39,20 @@ from __future__ import annotations
 
 from typing import Any
 
+from fcplan.env.vector_make import VECTOR_MODES, batched_env
 from fcplan.errors import EnvError
 
 __all__ = ["vector_env", "VECTOR_MODES"]
 
-#: levels :func:`vector_env` batches
-VECTOR_MODES = ("motion", "task")
 
-
-def vector_env(scenario: Any, mode: str = "motion", num_envs: int = 1, **kwargs: Any) -> Any:
+def vector_env(
+    scenario: Any,
+    mode: str = "motion",
+    num_envs: int = 1,
+    *,
+    processes: int | None = None,
+    **kwargs: Any,
+) -> Any:
     """Make a batched ``gymnasium.vector.VectorEnv`` of ``num_envs`` worlds of ``scenario``.
 
     Parameters
@@ -54,6 +63,10 @@ def vector_env(scenario: Any, mode: str = "motion", num_envs: int = 1, **kwargs:
         The level (module docstring).
     num_envs : int
         Worlds ``B``.
+    processes : int, optional
+        Step the worlds in this many processes at once, this one included
+        (:class:`~fcplan.env.vector_shards.ShardedVectorEnv`, which also takes ``context`` and
+        ``copy``); default: all in this process, in one batched env.
     **kwargs
         The level's options (``autoreset_mode``; ``cell_px``, ``view``, ... at the motion level;
         ``k``, ``replan_period``, ... at the task level).
@@ -63,12 +76,10 @@ def vector_env(scenario: Any, mode: str = "motion", num_envs: int = 1, **kwargs:
     EnvError
         For an unknown ``mode`` or a bad option.
     """
-    if mode == "motion":
-        from fcplan.env.vector_motion import VectorMotionEnv
+    if mode not in VECTOR_MODES:
+        raise EnvError(f"mode: must be one of {', '.join(VECTOR_MODES)} (got {mode!r})")
+    if processes is not None:
+        from fcplan.env.vector_shards import ShardedVectorEnv
 
-        return VectorMotionEnv(scenario, num_envs, **kwargs)
-    if mode == "task":
-        from fcplan.env.vector_task import VectorTaskEnv
-
-        return VectorTaskEnv(scenario, num_envs, **kwargs)
-    raise EnvError(f"mode: must be one of {', '.join(VECTOR_MODES)} (got {mode!r})")
+        return ShardedVectorEnv(scenario, mode, num_envs, processes=processes, **kwargs)
+    return batched_env(scenario, mode, num_envs, **kwargs)

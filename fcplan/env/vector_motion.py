@@ -175,7 +175,7 @@ class VectorMotionEnv(BatchedEnv):
         """Advance every world one tick with ``actions`` ((B, N) ints); see the module docstring."""
         batch = self.batch
         run = self._stepping(batch.done)
-        act = self._check(actions)
+        act = self.check_actions(actions)
         next_step = self.autoreset_mode is AutoresetMode.NEXT_STEP
         self._decode(act, run)
         info = batch.step(autoreset=next_step)
@@ -196,9 +196,11 @@ class VectorMotionEnv(BatchedEnv):
         terms = np.zeros(self.num_envs, dtype=bool)
         return obs, rewards, terms, truncs, infos
 
-    def _check(self, actions: Any) -> np.ndarray:
-        """(B, N) int64 actions, checked against each agent's action count."""
-        act = integer_actions(actions, (self.num_envs, len(self.agent_ids)))
+    def check_actions(self, actions: Any, num: int | None = None) -> np.ndarray:
+        """``(num, N)`` int64 actions (``num`` default ``B``), checked against each agent's
+        action count (:class:`~fcplan.errors.EnvError` naming the first bad one)."""
+        b = self.num_envs if num is None else int(num)
+        act = integer_actions(actions, (b, len(self.agent_ids)))
         bad = (act < 0) | (act >= self.views.n_actions)
         if np.count_nonzero(bad):
             b, j = (int(k[0]) for k in np.nonzero(bad))

@@ -279,7 +279,7 @@ class VectorTaskEnv(BatchedEnv):
         batch = self.batch
         run = self._stepping(batch.done | (self.steps >= self.one.max_steps))
         a = self.one.n_agents
-        act = integer_actions(actions, (self.num_envs, a))
+        act = self.check_actions(actions)
         resets = ~run if self.autoreset_mode is AutoresetMode.NEXT_STEP else np.zeros_like(run)
         if np.count_nonzero(resets):
             self._reset_worlds(np.flatnonzero(resets), [None] * int(resets.sum()))
@@ -311,6 +311,12 @@ class VectorTaskEnv(BatchedEnv):
             obs = self._observation()
         self._ended(done)
         return obs, rewards, np.zeros(self.num_envs, dtype=bool), done, infos
+
+    def check_actions(self, actions: Any, num: int | None = None) -> np.ndarray:
+        """``(num, A)`` int64 actions (``num`` default ``B``; any integer: a slot out of range
+        acts as the no-op and is reported ``illegal``)."""
+        b = self.num_envs if num is None else int(num)
+        return integer_actions(actions, (b, self.one.n_agents))
 
     def _commands(
         self, worlds: np.ndarray, act: np.ndarray, illegal: np.ndarray, conflict: np.ndarray

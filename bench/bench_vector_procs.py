@@ -1,0 +1,136 @@
+"""Benchmark the batched env on several cores: ``B`` worlds in one process against the same
+``B`` worlds over ``P`` processes, wall clock, in the same rounds.
+
+For every ``P`` of ``--procs`` (default 1, 2) it measures, with random legal actions (drawn
+from the masks between steps):
+
+* ``independent``: ``P`` processes started together, each with a batched env
+  (:class:`fcplan.env.vector_motion.VectorMotionEnv`, or ``VectorTaskEnv`` with ``--level
+  task``) of ``B / P`` worlds, exchanging nothing: the bound of any process-parallel design,
+  which pays for moving actions and observations on top. ``P`` = 1 is the one-process batched
+  env, the baseline of every ratio;
+* ``sharded``: :class:`fcplan.env.vector_shards.ShardedVectorEnv` of the ``B`` worlds over
+  ``P`` processes (this one and ``P - 1`` workers), with ``copy=True`` (its default) and
+  ``copy=False`` (the observations left in the shared arrays).
+
+Each is reset, then stepped ``--steps`` times; the rate is ``B x steps`` over the wall-clock
+time from the first process's first step to the last one's last. ``--rounds`` interleaved
+rounds (default 3); the table gives the median rate and the median ratio to the baseline of
+the same round with its range.
+
+Usage::
+
+    python bench/bench_vector_procs.py                          # about 2 minutes
+    python bench/bench_vector_procs.py --procs 1 2 4 --worlds 256 --steps 600
+    python bench/bench_vector_procs.py --level task --worlds 256 --steps 20
+"""
+
+from __future__ import annotations
+
+import argparse
+import multiprocessing as mp
+import os
+import platform
+import time
+from typing import Any
+
+import numpy as np
+
+
+def _shard(level: str, scenario: str, num: int, steps: int, seed: int, barrier: Any,
+           out: Any) -> None:  # fmt: skip
+    """One process: make and reset its env, wait for the others, step; report when its steps
+    started and ended (``time.perf_counter``: the system's monotonic clock, one for all
+    processes)."""
+    from fcplan.env import vector_env
+
+    env = vector_env(scenario, mode=level, num_envs=num)
+    obs, _ = env.reset(seed=seed)
+    rng = np.random.default_rng(seed)
+    barrier.wait()
+    start = time.perf_counter()
+    for _ in range(steps):
+        m = obs["action_mask"]
+        act = (rng.random(m.shape) * m).argmax(axis=2)
+        obs, *_ = env.step(act)
+    out.put((start, time.perf_counter()))
+
+
+def run(level: str, scenario: str, worlds: int, procs: int, steps: int) -> float:
+    """Aggregate world-steps per wall-clock second of ``worlds`` worlds over ``procs`` processes
+    (``worlds`` split as evenly as ``numpy.array_split`` splits)."""
+    ctx = mp.get_context("spawn")  # (fresh interpreters: nothing inherited from this one)
+    sizes = [len(p) for p in np.array_split(np.arange(worlds), procs)]
+    barrier, out = ctx.Barrier(procs + 1), ctx.Queue()
+    seeds = np.cumsum([0, *sizes[:-1]])
+    ps = [
+        ctx.Process(target=_shard, args=(level, scenario, n, steps, int(s), barrier, out))
+        for n, s in zip(sizes, seeds, strict=True)
+    ]
+    for p in ps:
+        p.start()
+    barrier.wait()
+    spans = [out.get() for _ in ps]
+    start, end = min(s for s, _ in spans), max(e for _, e in spans)
+    for p in ps:
+        p.join()
+    return worlds * steps / (end - start)
+
+
+def sharded(level: str, scenario: str, worlds: int, procs: int, steps: int, copy: bool) -> float:
+    """World-steps per wall-clock second of a :class:`ShardedVectorEnv` of ``worlds`` worlds
+    over ``procs`` processes."""
+    from fcplan.env import vector_env
+
+    env = vector_env(scenario, mode=level, num_envs=worlds, processes=procs, copy=copy,
+                     context="spawn")  # fmt: skip
+    try:
+        obs, _ = env.reset(seed=0)
+        rng = np.random.default_rng(0)
+        start = time.perf_counter()
+        for _ in range(steps):
+            m = obs["action_mask"]
+            obs, *_ = env.step((rng.random(m.shape) * m).argmax(axis=2))
+        return worlds * steps / (time.perf_counter() - start)
+    finally:
+        env.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--level", choices=("motion", "task"), default="motion")
+    ap.add_argument("--scenario", default="1")
+    ap.add_argument("--worlds", type=int, default=256, help="worlds B in all")
+    ap.add_argument("--procs", type=int, nargs="+", default=[1, 2], help="process counts P")
+    ap.add_argument("--steps", type=int, default=None, help="steps (default: 300 at the "
+                    "motion level, 20 at the task level)")  # fmt: skip
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args(argv)
+    steps = args.steps or (300 if args.level == "motion" else 20)
+    procs = sorted({1, *args.procs})
+    print(f"# {args.level} level, scenario #{args.scenario}, B={args.worlds} worlds in all, "
+          f"{steps} steps; Python {platform.python_version()}, {os.cpu_count()} CPUs, "
+          f"load {os.getloadavg()[0]:.2f}; median of {args.rounds} interleaved round(s)")  # fmt: skip
+    rows = [("independent", p) for p in procs]
+    rows += [(kind, p) for p in procs if p > 1 for kind in ("sharded", "sharded copy=False")]
+    rates: dict[tuple[str, int], list[float]] = {r: [] for r in rows}
+    for _ in range(args.rounds):
+        for kind, p in rows:
+            if kind == "independent":
+                rate = run(args.level, args.scenario, args.worlds, p, steps)
+            else:
+                copy = kind == "sharded"
+                rate = sharded(args.level, args.scenario, args.worlds, p, steps, copy)
+            rates[kind, p].append(rate)
+    base = np.array(rates["independent", 1])
+    print(f"{'env':<20} {'processes':>9} {'world-steps/s':>14} {'ratio':>6}  [min, max]  (wall)")
+    for kind, p in rows:
+        r = np.array(rates[kind, p]) / base
+        label = "one process" if p == 1 else kind
+        print(f"{label:<20} {p:>9} {np.median(rates[kind, p]):>14.0f} {np.median(r):>6.2f}  "
+              f"[{r.min():.2f}, {r.max():.2f}]")  # fmt: skip
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
