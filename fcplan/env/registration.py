@@ -13,9 +13,11 @@ id                         environment                                     defau
 =========================  ==============================================  =====================
 
 ``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` makes the batched env of
-:data:`VECTOR_ENTRY_POINTS` (:class:`fcplan.env.vector_motion.VectorMotionEnv`: ``B`` worlds in
-one call, each bit-identical to the single env with seed ``s + i``); ``vectorization_mode="sync"``
-gives Gymnasium's ``SyncVectorEnv`` of single envs instead.
+:data:`VECTOR_ENTRY_POINTS` (:func:`fcplan.env.vector_env`: a
+:class:`fcplan.env.vector_motion.VectorMotionEnv` of ``B`` worlds in one call, each
+bit-identical to the single env with seed ``s + i``; with ``processes=P``, a
+:class:`fcplan.env.vector_shards.ShardedVectorEnv`); ``vectorization_mode="sync"`` gives
+Gymnasium's ``SyncVectorEnv`` of single envs instead.
 
 Any keyword of the environment goes through ``gymnasium.make``: ``gymnasium.make("fcplan/Task-v0",
 scenario=24, k=8)``, ``gymnasium.make("fcplan/MotionBase-v0", reward="rf1")``. Every id accepts
@@ -58,8 +60,8 @@ ENV_IDS: dict[str, tuple[str, dict[str, Any]]] = {
 
 #: Gymnasium id -> the batched env ``gymnasium.make_vec`` makes (:mod:`fcplan.env.vector`).
 VECTOR_ENTRY_POINTS: dict[str, str] = {
-    "fcplan/Motion-v0": "fcplan.env.vector_motion:VectorMotionEnv",
-    "fcplan/Task-v0": "fcplan.env.vector_task:VectorTaskEnv",
+    "fcplan/Motion-v0": "fcplan.env.vector:motion_vector_env",
+    "fcplan/Task-v0": "fcplan.env.vector:task_vector_env",
 }
 
 

@@ -20,8 +20,9 @@ worker processes (:class:`fcplan.env.vector_shards.ShardedVectorEnv`: the same w
 steps, on ``K`` cores).
 
 ``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` (and ``"fcplan/Task-v0"``)
-return the same classes (the ids' ``vector_entry_point``); ``vectorization_mode="sync"`` still
-gives Gymnasium's ``SyncVectorEnv`` of single envs, which the batched ones match step for step.
+return the same envs (the ids' ``vector_entry_point``, :func:`motion_vector_env` and
+:func:`task_vector_env`; ``processes=P`` too); ``vectorization_mode="sync"`` still gives
+Gymnasium's ``SyncVectorEnv`` of single envs, which the batched ones match step for step.
 
 Examples
 --------
@@ -42,7 +43,7 @@ from typing import Any
 from fcplan.env.vector_make import VECTOR_MODES, batched_env
 from fcplan.errors import EnvError
 
-__all__ = ["vector_env", "VECTOR_MODES"]
+__all__ = ["vector_env", "motion_vector_env", "task_vector_env", "VECTOR_MODES"]
 
 
 def vector_env(
@@ -83,3 +84,15 @@ def vector_env(
 
         return ShardedVectorEnv(scenario, mode, num_envs, processes=processes, **kwargs)
     return batched_env(scenario, mode, num_envs, **kwargs)
+
+
+def motion_vector_env(scenario: Any = "practice", num_envs: int = 1, **kwargs: Any) -> Any:
+    """``vector_env(scenario, "motion", num_envs, **kwargs)``: what ``gymnasium.make_vec(
+    "fcplan/Motion-v0", num_envs)`` makes."""
+    return vector_env(scenario, "motion", num_envs, **kwargs)
+
+
+def task_vector_env(scenario: Any = "practice", num_envs: int = 1, **kwargs: Any) -> Any:
+    """``vector_env(scenario, "task", num_envs, **kwargs)``: what ``gymnasium.make_vec(
+    "fcplan/Task-v0", num_envs)`` makes."""
+    return vector_env(scenario, "task", num_envs, **kwargs)

@@ -170,3 +170,23 @@ def test_merge_infos_fills_missing_keys():
     assert m["metrics"].tolist() == [None, {"a": 1}, None]
     assert m["_metrics"].tolist() == [False, True, False]
     assert m["note"].tolist() == [None, None, "x"]
+
+
+def test_make_vec_takes_processes():
+    """``gymnasium.make_vec(..., processes=P)`` makes the sharded env, equal step for step to
+    ``make_vec`` without it (the batched env)."""
+    import gymnasium
+
+    import fcplan.env  # noqa: F401  (registers the ids)
+
+    sc = load_scenario("practice").replace(duration_s=2)
+    env = gymnasium.make_vec("fcplan/Task-v0", num_envs=3, scenario=sc, processes=2)
+    ref = gymnasium.make_vec("fcplan/Task-v0", num_envs=3, scenario=sc)
+    try:
+        assert isinstance(env, ShardedVectorEnv) and not isinstance(ref, ShardedVectorEnv)
+        assert _same(env.reset(seed=2), ref.reset(seed=2))
+        act = np.full((3, 4), 8)
+        for _ in range(3):
+            assert _same(env.step(act), ref.step(act))
+    finally:
+        env.close()
