@@ -36,23 +36,27 @@ from typing import Any
 
 import numpy as np
 
+from fcplan.env import vector_env
+from fcplan.env.vector_shards import shard_bounds
+
+
+def _play(env: Any, obs: Any, steps: int, rng: np.random.Generator) -> None:
+    """``steps`` steps of random legal actions (drawn from the masks)."""
+    for _ in range(steps):
+        m = obs["action_mask"]
+        obs, *_ = env.step((rng.random(m.shape) * m).argmax(axis=2))
+
 
 def _shard(level: str, scenario: str, num: int, steps: int, seed: int, barrier: Any,
            out: Any) -> None:  # fmt: skip
     """One process: make and reset its env, wait for the others, step; report when its steps
     started and ended (``time.perf_counter``: the system's monotonic clock, one for all
     processes)."""
-    from fcplan.env import vector_env
-
     env = vector_env(scenario, mode=level, num_envs=num)
     obs, _ = env.reset(seed=seed)
-    rng = np.random.default_rng(seed)
     barrier.wait()
     start = time.perf_counter()
-    for _ in range(steps):
-        m = obs["action_mask"]
-        act = (rng.random(m.shape) * m).argmax(axis=2)
-        obs, *_ = env.step(act)
+    _play(env, obs, steps, np.random.default_rng(seed))
     out.put((start, time.perf_counter()))
 
 
@@ -60,12 +64,10 @@ def run(level: str, scenario: str, worlds: int, procs: int, steps: int) -> float
     """Aggregate world-steps per wall-clock second of ``worlds`` worlds over ``procs`` processes
     (``worlds`` split as evenly as ``numpy.array_split`` splits)."""
     ctx = mp.get_context("spawn")  # (fresh interpreters: nothing inherited from this one)
-    sizes = [len(p) for p in np.array_split(np.arange(worlds), procs)]
     barrier, out = ctx.Barrier(procs + 1), ctx.Queue()
-    seeds = np.cumsum([0, *sizes[:-1]])
     ps = [
-        ctx.Process(target=_shard, args=(level, scenario, n, steps, int(s), barrier, out))
-        for n, s in zip(sizes, seeds, strict=True)
+        ctx.Process(target=_shard, args=(level, scenario, hi - lo, steps, lo, barrier, out))
+        for lo, hi in shard_bounds(worlds, procs)
     ]
     for p in ps:
         p.start()
@@ -80,17 +82,12 @@ def run(level: str, scenario: str, worlds: int, procs: int, steps: int) -> float
 def sharded(level: str, scenario: str, worlds: int, procs: int, steps: int, copy: bool) -> float:
     """World-steps per wall-clock second of a :class:`ShardedVectorEnv` of ``worlds`` worlds
     over ``procs`` processes."""
-    from fcplan.env import vector_env
-
     env = vector_env(scenario, mode=level, num_envs=worlds, processes=procs, copy=copy,
                      context="spawn")  # fmt: skip
     try:
         obs, _ = env.reset(seed=0)
-        rng = np.random.default_rng(0)
         start = time.perf_counter()
-        for _ in range(steps):
-            m = obs["action_mask"]
-            obs, *_ = env.step((rng.random(m.shape) * m).argmax(axis=2))
+        _play(env, obs, steps, np.random.default_rng(0))
         return worlds * steps / (time.perf_counter() - start)
     finally:
         env.close()

@@ -41,7 +41,6 @@ from __future__ import annotations
 from typing import Any
 
 from fcplan.env.vector_make import VECTOR_MODES, batched_env
-from fcplan.errors import EnvError
 
 __all__ = ["vector_env", "motion_vector_env", "task_vector_env", "VECTOR_MODES"]
 
@@ -77,8 +76,6 @@ def vector_env(
     EnvError
         For an unknown ``mode`` or a bad option.
     """
-    if mode not in VECTOR_MODES:
-        raise EnvError(f"mode: must be one of {', '.join(VECTOR_MODES)} (got {mode!r})")
     if processes is not None:
         from fcplan.env.vector_shards import ShardedVectorEnv
 

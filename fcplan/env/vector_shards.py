@@ -62,16 +62,21 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from fcplan.env.vector_base import autoreset_from, reset_rows, reset_seeds
-from fcplan.env.vector_make import VECTOR_MODES, batched_env
+from fcplan.env.vector_base import reset_rows, reset_seeds
+from fcplan.env.vector_make import batched_env
 from fcplan.errors import EnvError
 
-__all__ = ["ShardedVectorEnv", "merge_infos"]
+__all__ = ["ShardedVectorEnv", "merge_infos", "shard_bounds"]
 
 
-def _shard_bounds(num: int, workers: int) -> list[tuple[int, int]]:
-    """``(lo, hi)`` of each shard: ``num`` worlds split as evenly as ``array_split`` splits."""
-    cuts = np.cumsum([0] + [len(p) for p in np.array_split(np.arange(num), workers)])
+def shard_bounds(num: int, parts: int) -> list[tuple[int, int]]:
+    """``(lo, hi)`` of each of ``parts`` shards of ``num`` worlds, split as evenly as
+    :func:`numpy.array_split` splits.
+
+    >>> shard_bounds(7, 3)
+    [(0, 3), (3, 5), (5, 7)]
+    """
+    cuts = np.cumsum([0] + [len(p) for p in np.array_split(np.arange(num), parts)])
     return [(int(a), int(b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
 
 
@@ -98,16 +103,11 @@ def _views(buffers: dict[str, Any], num: int) -> dict[str, np.ndarray]:
 def _serve(env: Any, out: dict[str, np.ndarray], command: str, arg: Any) -> Any:
     """Run one request on a shard's batched env (here or in a worker); the observations go
     into ``out``, the shard's rows of the shared arrays."""
-    if command == "reset":
-        obs, info = env.reset(**arg)
+    if command in ("reset", "step"):
+        obs, *rest = env.reset(**arg) if command == "reset" else env.step(arg)
         for k, v in out.items():
             v[...] = obs[k]
-        return info
-    if command == "step":
-        obs, *rest = env.step(arg)
-        for k, v in out.items():
-            v[...] = obs[k]
-        return rest
+        return rest[0] if command == "reset" else rest
     if command == "call":
         name, args, kw = arg
         value = getattr(env, name)
@@ -226,15 +226,11 @@ class ShardedVectorEnv(VectorEnv):
         self.num_envs, processes = int(num_envs), int(processes)
         if self.num_envs < 1:
             raise EnvError(f"num_envs: must be >= 1 (got {num_envs})")
-        if mode not in VECTOR_MODES:
-            raise EnvError(f"mode: must be one of {', '.join(VECTOR_MODES)} (got {mode!r})")
         if not 1 <= processes <= self.num_envs:
             raise EnvError(f"processes: must be in 1..num_envs={self.num_envs} (got {processes})")
         self.mode, self.copy = mode, bool(copy)
-        self.autoreset_mode = autoreset_from(kwargs.get("autoreset_mode", "next_step"))
-        self.metadata = {**self.metadata, "autoreset_mode": self.autoreset_mode}
         #: ``(lo, hi)``: the worlds of each shard (the first stepped in this process)
-        self.shards = _shard_bounds(self.num_envs, processes)
+        self.shards = shard_bounds(self.num_envs, processes)
         self._sizes = [hi - lo for lo, hi in self.shards]
         self._broken: str | None = None
         self._fresh: dict[str, np.ndarray] | None = None
@@ -252,9 +248,12 @@ class ShardedVectorEnv(VectorEnv):
     def _start(self, ctx: Any, scenario: Any, mode: str, kwargs: dict[str, Any]) -> None:
         """Make the first shard's env here (its spaces; a bad option fails here, before any
         process starts), the shared arrays, then the workers."""
-        lo, hi = self.shards[0]
-        #: the batched env of the first shard, stepped in this process
-        self.local = batched_env(scenario, mode, hi - lo, **kwargs)
+        first = self.shards[0]
+        #: the batched env of the first shard, stepped in this process (a bad ``mode`` or
+        #: option fails here: :func:`fcplan.env.vector_make.batched_env`)
+        self.local = batched_env(scenario, mode, first[1] - first[0], **kwargs)
+        self.autoreset_mode = self.local.autoreset_mode
+        self.metadata = {**self.metadata, "autoreset_mode": self.autoreset_mode}
         self.single_observation_space: spaces.Dict = self.local.single_observation_space
         self.single_action_space = self.local.single_action_space
         buffers = _buffers(self.single_observation_space, self.num_envs, ctx)
@@ -275,8 +274,7 @@ class ShardedVectorEnv(VectorEnv):
             if not ok:
                 raise EnvError(f"shard {j}: {value}")
         self._obs = _views(buffers, self.num_envs)
-        lo, hi = self.shards[0]
-        self._local_out = {k: v[lo:hi] for k, v in self._obs.items()}
+        self._local_out = {k: v[first[0] : first[1]] for k, v in self._obs.items()}
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
 

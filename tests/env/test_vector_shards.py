@@ -89,7 +89,8 @@ def test_masked_resets_and_held_worlds():
 def test_bad_input_fails_before_any_shard_steps():
     """A bad action (out of an agent's range, fractional, wrong shape) raises EnvError and no
     world has stepped: the next step is the one-process env's first; bad options, process
-    counts and the task level's state() are errors before or without any step."""
+    counts, an unknown level and the task level's state() are errors before or without any
+    step."""
     sc = load_scenario("practice").replace(duration_s=2)
     ref = vector_env(sc, mode="motion", num_envs=4)
     env = vector_env(sc, mode="motion", num_envs=4, processes=2)
@@ -111,6 +112,9 @@ def test_bad_input_fails_before_any_shard_steps():
         vector_env(sc, mode="motion", num_envs=2, processes=3)
     with pytest.raises(EnvError, match="view"):
         vector_env(sc, mode="motion", num_envs=2, processes=2, view=4)
+    for procs in (None, 2):
+        with pytest.raises(EnvError, match="mode: must be one of motion, task .got 'grid'"):
+            vector_env(sc, mode="grid", num_envs=2, processes=procs)
     task = vector_env(sc, mode="task", num_envs=2, processes=1)
     with pytest.raises(EnvError, match="only the motion level"):
         task.state()
