@@ -52,8 +52,7 @@ def integer_actions(actions: Any, shape: tuple[int, ...], name: str = "actions")
         return raw.astype(np.int64, copy=False)
     if kind != "f":
         raise EnvError(f"{name}: must be integers of shape {shape} (got {raw.dtype} values)")
-    bad = ~np.isfinite(raw)
-    bad[~bad] = raw[~bad] != np.trunc(raw[~bad])
+    bad = ~np.isfinite(raw) | (raw != np.trunc(raw))
     if np.count_nonzero(bad):
         at = tuple(int(k[0]) for k in np.nonzero(bad))
         where = ", ".join(map(str, at))
