@@ -45,7 +45,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["spawn_streams", "UniformBlocks", "TerrainJump", "PCG64_MULTIPLIER"]
+__all__ = ["spawn_streams", "UniformBlocks", "TerrainJump", "PCG64_MULTIPLIER", "world_seeds"]
 
 #: PCG64's 128-bit LCG multiplier (numpy's ``PCG_DEFAULT_MULTIPLIER_128``).
 PCG64_MULTIPLIER = 0x2360ED051FC65DA44385DF649FCCF645
@@ -258,14 +258,36 @@ class TerrainJump:
         return (u32 >> _S8).astype(np.float64) * _INV24
 
 
-def seed_list(seeds: Sequence | int | None, num: int) -> list:
-    """Seeds for ``num`` worlds: a sequence of ``num`` seeds as given, an int ``s`` as
-    ``s, s + 1, ...`` (Gymnasium's vector convention), or None (fresh entropy each)."""
+def world_seeds(num: int, rows: Sequence[int] | np.ndarray, seeds: Sequence | int | None) -> list:
+    """The seed of each world of ``rows`` (of ``num``) that a reset with ``seeds`` starts, by
+    Gymnasium's rule (``gymnasium.vector.SyncVectorEnv.reset``): None, None for each (the world
+    continues its own seed sequence); an int ``s``, ``s + b`` for world ``b`` whichever worlds
+    are reset; a sequence of ``num`` seeds, world ``b``'s is ``seeds[b]``. A sequence of one seed
+    per world reset (in the order of ``rows``) is accepted too. The one rule of the batched
+    simulator (:meth:`fcplan.batch.BatchWorld.reset`) and the vector envs
+    (:func:`fcplan.env.vector_base.reset_seeds`).
+
+    Raises
+    ------
+    ValueError
+        For a sequence of another length.
+
+    Examples
+    --------
+    >>> world_seeds(4, [0, 3], 10)
+    [10, 13]
+    >>> world_seeds(4, [1, 2], [7, 8])
+    [7, 8]
+    """
+    rows_l = np.asarray(rows, dtype=np.int64).tolist()
     if seeds is None:
-        return [None] * num
+        return [None] * len(rows_l)
     if isinstance(seeds, (int, np.integer)):
-        return [int(seeds) + i for i in range(num)]
-    out = list(seeds)
-    if len(out) != num:
-        raise ValueError(f"seeds: need {num} seeds, one per world (got {len(out)})")
-    return out
+        return [int(seeds) + b for b in rows_l]
+    given = list(seeds)
+    if len(given) == num:
+        return [given[b] for b in rows_l]
+    if len(given) == len(rows_l):
+        return given
+    also = f" (or {len(rows_l)}, one per world reset)" if len(rows_l) != num else ""
+    raise ValueError(f"seed: need {num} seeds, one per world{also}, got {len(given)}")

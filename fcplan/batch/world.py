@@ -46,7 +46,7 @@ import numpy as np
 from fcplan._fast.fire import unique
 from fcplan.batch.cells import SENSED, STATE_BITS, CellGrid, runs, scan_boxes
 from fcplan.batch.fire import BatchFire
-from fcplan.batch.streams import UniformBlocks, seed_list, spawn_streams
+from fcplan.batch.streams import UniformBlocks, spawn_streams, world_seeds
 from fcplan.batch.team import BatchTeam
 from fcplan.fire import BURNING
 from fcplan.scenario import Scenario
@@ -168,18 +168,14 @@ class BatchWorld:
         Parameters
         ----------
         seeds : sequence, int or None
-            One seed per world (ints, SeedSequences or None; with ``mask``, one per masked
-            world, or one per world), or an int ``s`` for ``s, s + 1, ...`` (with ``mask``: for the
-            masked worlds in order; the vector envs seed world ``b`` with ``s + b``,
-            :func:`fcplan.env.vector_base.reset_seeds`). A None seed takes
-            the world's next seed from its reseed generator (module docstring), or fresh
-            entropy before its first seeded episode.
+            Seeds by :func:`fcplan.batch.streams.world_seeds` (Gymnasium's rule): one per world,
+            or with ``mask`` one per masked world; an int ``s`` gives world ``b`` the seed
+            ``s + b``, whichever worlds are reset. A None seed takes the world's next seed from
+            its reseed generator (module docstring), or fresh entropy before its first seeded
+            episode.
         """
         rows = np.arange(self.num) if mask is None else np.flatnonzero(mask)
-        given = seed_list(seeds, self.num if mask is None else rows.size)
-        if mask is not None and isinstance(seeds, Sequence) and len(given) == self.num != rows.size:
-            given = [given[i] for i in rows.tolist()]
-        for b, seed in zip(rows.tolist(), given, strict=True):
+        for b, seed in zip(rows.tolist(), world_seeds(self.num, rows, seeds), strict=True):
             self._reset_world(b, seed)
         self.team.reset_worlds(rows)
 

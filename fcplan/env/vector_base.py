@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 
+from fcplan.batch.streams import world_seeds
 from fcplan.errors import EnvError
 
 __all__ = [
@@ -67,31 +68,19 @@ def reset_rows(num: int, seed: Any, options: dict[str, Any] | None) -> np.ndarra
 
 
 def reset_seeds(num: int, rows: np.ndarray, seed: Any) -> list[Any]:
-    """The seed of each world of ``rows`` that ``reset(seed=seed)`` resets, by Gymnasium's rule
-    (``gymnasium.vector.SyncVectorEnv.reset``): None, None for each (the world continues its
-    own seed sequence); an int ``s``, ``s + b`` for world ``b`` whichever worlds are reset; a
-    list of ``num`` seeds, world ``b``'s is ``seed[b]``. A list of one seed per world reset (in
-    the order of ``rows``) is accepted too.
+    """The seed of each world of ``rows`` that ``reset(seed=seed)`` resets: Gymnasium's rule,
+    :func:`fcplan.batch.streams.world_seeds` (an int ``s`` gives world ``b`` the seed ``s + b``
+    whichever worlds are reset; a list holds one seed per world, or one per world reset).
 
     Raises
     ------
     EnvError
         For a list of another length.
     """
-    rows_l = np.asarray(rows, dtype=np.int64).tolist()
-    if seed is None:
-        return [None] * len(rows_l)
-    if isinstance(seed, (int, np.integer)):
-        return [int(seed) + b for b in rows_l]
-    given = list(seed)
-    if len(given) == num:
-        return [given[b] for b in rows_l]
-    if len(given) == len(rows_l):
-        return given
-    raise EnvError(
-        f"seed: need {num} seeds, one per world (or {len(rows_l)}, one per world reset), "
-        f"got {len(given)}"
-    )
+    try:
+        return world_seeds(num, rows, seed)
+    except ValueError as exc:
+        raise EnvError(str(exc)) from None
 
 
 def per_world_info(mask: np.ndarray, value: Callable[[int], Any]) -> tuple[np.ndarray, np.ndarray]:

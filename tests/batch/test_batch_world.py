@@ -104,6 +104,24 @@ def test_held_and_autoreset_worlds():
     assert batch.seeds == nxt
 
 
+def test_masked_reset_seeds_follow_gymnasium():
+    """``reset(seeds=s, mask=m)`` seeds world ``b`` with ``s + b`` whichever worlds are reset
+    (as the vector envs and ``SyncVectorEnv`` do); a list may hold one seed per world or one
+    per reset world; the other worlds keep their episodes."""
+    sc = load_scenario("practice").replace(duration_s=2)
+    batch = BatchWorld(sc, 4)
+    batch.reset(seeds=[0, 1, 2, 3])
+    batch.step()
+    mask = np.array([False, True, False, True])
+    batch.reset(seeds=10, mask=mask)
+    assert batch.seeds == [0, 11, 2, 13]
+    assert batch.tick.tolist() == [1, 0, 1, 0]
+    batch.reset(seeds=[20, 21, 22, 23], mask=mask)
+    assert batch.seeds == [0, 21, 2, 23]
+    batch.reset(seeds=[31, 33], mask=mask)
+    assert batch.seeds == [0, 31, 2, 33]
+
+
 def test_bad_input():
     """A batch needs at least one world and PCG64-seeded streams; it must be reset first."""
     sc = load_scenario("practice")

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fcplan.batch.streams import TerrainJump, UniformBlocks, seed_list, spawn_streams
+from fcplan.batch.streams import TerrainJump, UniformBlocks, spawn_streams, world_seeds
 from fcplan.fire import Fire
 from fcplan.scenario import load_scenario
 from tests._fast.bits import bits
@@ -82,12 +82,16 @@ def test_uniform_blocks_equal_successive_draws(counts):
 
 
 def test_seeds():
-    """An int seeds worlds ``s, s + 1, ...``; a list gives one per world; streams need ints or
+    """Gymnasium's seed rule: an int ``s`` gives world ``b`` the seed ``s + b`` whichever worlds
+    are reset; a list holds one seed per world or one per world reset; streams need ints or
     SeedSequences."""
-    assert seed_list(5, 3) == [5, 6, 7]
-    assert seed_list(None, 2) == [None, None]
-    with pytest.raises(ValueError, match="3 seeds"):
-        seed_list([1, 2], 3)
+    assert world_seeds(3, [0, 1, 2], 5) == [5, 6, 7]
+    assert world_seeds(4, [1, 3], 5) == [6, 8]
+    assert world_seeds(2, [0, 1], None) == [None, None]
+    assert world_seeds(3, [0, 2], [7, 8, 9]) == [7, 9]
+    assert world_seeds(3, [0, 2], [7, 9]) == [7, 9]
+    with pytest.raises(ValueError, match="need 3 seeds"):
+        world_seeds(3, [0, 1, 2], [1, 2])
     with pytest.raises(ValueError, match="seed"):
         spawn_streams(np.random.default_rng(0))
     a = spawn_streams(3)
