@@ -64,12 +64,11 @@ import numpy as np
 
 from fcplan.env.demo_episodes import (
     EpisodeRecord,
-    batched_rollouts,
     env_kwargs_from_metadata,
     recording_episode,
-    rollout_episode,
     scenario_from_metadata,
 )
+from fcplan.env.demo_units import UnitResult, demo_units, play_unit, play_units
 from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import MappingCounts
 from fcplan.env.task_candidates import AGENT_FEATURES, TASK_FEATURES
@@ -77,7 +76,6 @@ from fcplan.errors import FcplanError
 from fcplan.mission import ScenarioLike, as_scenario
 from fcplan.provenance import library_versions
 from fcplan.scheduling import Scheduler, make_scheduler, parse_scheduler_spec
-from fcplan.scheduling_batch import instances
 
 __all__ = [
     "Demonstrations",
@@ -209,6 +207,7 @@ def demonstrations(
     format: str = "npz",
     dataset_id: str | None = None,
     num_envs: int = 1,
+    jobs: int = 1,
     progress: Any = True,
 ) -> Any:
     """Roll ``scheduler`` out through the task-level env on every (scenario, seed).
@@ -239,6 +238,12 @@ def demonstrations(
         (:func:`fcplan.env.demo_episodes.batched_rollouts`; one greedy instance plans every
         world in one call, ``plan_batch``; other schedulers one instance per world); the dataset is the one ``num_envs=1`` gives, for schedulers that keep no state between
         episodes.
+    jobs : int or None
+        Worker processes (None: one per CPU). With more than one, the episodes are split into
+        units (one seed each, or batched envs of at most ``ceil(seeds / jobs)`` worlds), played
+        on a local process pool, the pool of ``compare`` and ``sweep``
+        (:mod:`fcplan.env.demo_units`); the dataset is the one ``jobs=1`` gives, for schedulers
+        that keep no state between episodes. A scheduler object is sent to each unit pickled.
     progress : bool or callable
         ``True`` (default): a progress bar on stderr counted in episodes, the one of ``compare``
         and ``sweep`` (:mod:`fcplan.experiments.progress`; in place in Jupyter); ``False``:
@@ -252,6 +257,7 @@ def demonstrations(
         raise DemonstrationError(f"format: must be 'npz' or 'minari' (got {format!r})")
     from fcplan.experiments.progress import episode_progress
 
+    jobs = _check_counts(num_envs, jobs)
     sched, name, settings = _scheduler(scheduler)
     env_kwargs = dict(env_kwargs or {})
     env_kwargs.pop("render_mode", None)
@@ -261,7 +267,7 @@ def demonstrations(
     rollouts = _Rollouts(sched, time_limit, bar, len(scenarios) * len(seeds) + len(recordings))
     try:
         scen_docs = _roll_out(rollouts, sched, scheduler, scenarios, seeds, recordings, env_kwargs,
-                              time_limit, num_envs)  # fmt: skip
+                              time_limit, num_envs, jobs)  # fmt: skip
     finally:
         getattr(bar, "close", lambda: None)()
     meta = {
@@ -291,6 +297,16 @@ def demonstrations(
     return demo
 
 
+def _check_counts(num_envs: Any, jobs: Any) -> int:
+    """``jobs`` as an int (None: one per CPU), after checking both counts (one-line errors)."""
+    from fcplan.experiments.workers import check_jobs
+
+    jobs = check_jobs(jobs)
+    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+        raise DemonstrationError(f"num_envs: must be an integer >= 1 (got {num_envs!r:.40})")
+    return jobs
+
+
 def _roll_out(
     rollouts: _Rollouts,
     sched: Scheduler,
@@ -301,20 +317,33 @@ def _roll_out(
     env_kwargs: dict[str, Any],
     time_limit: float | None,
     num_envs: int,
+    jobs: int,
 ) -> dict[str, dict[str, Any]]:
-    """Add every (scenario, seed) episode and every recording to ``rollouts``; the scenario
-    documents by dataset key."""
+    """Add every (scenario, seed) episode (:mod:`fcplan.env.demo_units`) and every recording to
+    ``rollouts``; the scenario documents by dataset key."""
     scen_docs: dict[str, dict[str, Any]] = {}
+    keyed = []
     for sc in scenarios:
         scenario = as_scenario(sc)
-        key = _scenario_key(scen_docs, scenario)
-        if num_envs > 1:
-            rollouts.add_batched(scenario, spec, key, seeds, int(num_envs), env_kwargs)
-            continue
-        env = TaskEnv(scenario, **env_kwargs)
-        for seed in seeds:
-            rollouts.add(rollout_episode(env, sched, key, seed, time_limit=time_limit,
-                                         counts=rollouts.counts))  # fmt: skip
+        keyed.append((scenario, _scenario_key(scen_docs, scenario)))
+    units = demo_units(keyed, seeds, sched, spec, env_kwargs=env_kwargs, time_limit=time_limit,
+                       num_envs=int(num_envs), jobs=jobs)  # fmt: skip
+    if jobs == 1:  # (each unit's episodes go in as it finishes, in order)
+        for unit in units:
+            rollouts.add_unit(play_unit(unit))
+    else:
+        finished = [0]
+
+        def tick(unit: Any, result: Any) -> None:
+            finished[0] += len(result.records)
+            if rollouts.progress is not None:
+                rollouts.progress(finished[0], rollouts.total, {})
+
+        results = play_units(units, jobs, on_unit=tick)
+        progress, rollouts.progress = rollouts.progress, None
+        for result in results:
+            rollouts.add_unit(result)
+        rollouts.progress = progress
     for rec in recordings:
         scenario = rec.scenario
         key = _scenario_key(scen_docs, scenario)
@@ -377,21 +406,12 @@ class _Rollouts:
         if self.progress is not None:
             self.progress(len(self.episodes), self.total, {})
 
-    def add_batched(self, scenario: Any, spec: Any, key: str, seeds: list[int], num: int,
-                    env_kwargs: dict[str, Any]) -> None:  # fmt: skip
-        """The episodes of ``seeds`` on ``scenario``, ``num`` at a time in a batched env."""
-        import copy
-
-        from fcplan.env.vector_task import VectorTaskEnv
-
-        for i in range(0, len(seeds), num):
-            chunk = seeds[i : i + num]
-            env = VectorTaskEnv(scenario, len(chunk), autoreset_mode="disabled", **env_kwargs)
-            scheds = instances(lambda: _scheduler(spec)[0] if isinstance(spec, str)
-                               else copy.deepcopy(spec), len(chunk))  # fmt: skip
-            for rec in batched_rollouts(env, scheds, key, chunk, time_limit=self.time_limit,
-                                        counts=self.counts):  # fmt: skip
-                self.add(rec)
+    def add_unit(self, result: UnitResult) -> None:
+        """Append a played unit's episodes in order and add its mapping counts."""
+        for name, n in result.counts.items():
+            self.counts[name] += n
+        for rec in result.records:
+            self.add(rec)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The dataset's arrays (module docstring), rows of every episode in order."""
