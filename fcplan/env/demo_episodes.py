@@ -73,6 +73,9 @@ class EpisodeRecord:
         Final metrics (``{"manual": {...}, "reference2020": {...}}``).
     fallbacks : int
         Steps whose plan came from the greedy fallback (scheduler rollouts).
+    counts : dict
+        How the episode's plans mapped onto actions (:class:`fcplan.env.task_actions.MappingCounts`;
+        scheduler rollouts; empty for a recorded game).
     """
 
     observations: dict[str, np.ndarray]
@@ -86,6 +89,7 @@ class EpisodeRecord:
     source: str
     metrics: dict[str, Any] = field(default_factory=dict)
     fallbacks: int = 0
+    counts: dict[str, int] = field(default_factory=dict)
 
     @property
     def steps(self) -> int:
@@ -114,8 +118,10 @@ def rollout_episode(
     time_limit: float | None = None,
     counts: MappingCounts | None = None,
 ) -> EpisodeRecord:
-    """One episode of ``env`` with ``seed``, ``scheduler`` choosing the actions every step."""
+    """One episode of ``env`` with ``seed``, ``scheduler`` choosing the actions every step (its
+    mapping counts in the record's ``counts``, and added to ``counts`` when given)."""
     ids = env.possible_agents
+    own = MappingCounts()
     env.reset(seed=seed)
     rng = env.world.controller_rng
     obs, acts, rews, ticks, ill, con = [_joint_obs(env)], [], [], [0], [], []
@@ -126,7 +132,7 @@ def rollout_episode(
         assert graph is not None and cand is not None  # (built by reset and step)
         plan = solve(scheduler, graph, time_limit=time_limit, rng=rng)
         fallbacks += getattr(plan.stats, "status", None) == "fallback"
-        act = plan_to_actions(plan, graph, cand, counts)
+        act = plan_to_actions(plan, graph, cand, own)
         _, rew, _, _, infos = env.step(dict(zip(ids, act.tolist(), strict=True)))
         acts.append(act)
         rews.append(rew[ids[0]])
@@ -137,7 +143,16 @@ def rollout_episode(
     rec = _record(obs, acts, rews, ticks, ill, con, scenario_key, seed, _name(scheduler))
     rec.metrics = infos[ids[0]]["metrics"]
     rec.fallbacks = fallbacks
+    rec.counts = _count(own, counts)
     return rec
+
+
+def _count(own: MappingCounts, total: MappingCounts | None) -> dict[str, int]:
+    """An episode's mapping counts as a plain dict, added to ``total`` when given."""
+    if total is not None:
+        for name, n in own.items():
+            total[name] += n
+    return dict(own)
 
 
 def batched_rollouts(
@@ -154,8 +169,9 @@ def batched_rollouts(
     "disabled"``): world ``b`` plays seed ``seeds[b]`` with ``schedulers[b]``
     (:meth:`~fcplan.env.vector_task.VectorTaskEnv.expert_actions`; one instance for every world
     is planned batched when it can be). Each record equals the sequential rollout of its seed
-    (with a scheduler that keeps no state between episodes)."""
+    (with a scheduler that keeps no state between episodes), its own mapping counts too."""
     n = len(seeds)
+    own = [MappingCounts() for _ in range(n)]
     names = [_name(schedulers if not isinstance(schedulers, Sequence) else schedulers[b])
              for b in range(n)]  # fmt: skip
     obs, _ = env.reset(seed=[int(s) for s in seeds])
@@ -166,7 +182,9 @@ def batched_rollouts(
     finals: list[Any] = [None] * n
     ends = np.zeros(n, dtype=np.int64)  # steps of each world's episode
     while not done.all():
-        act, fb = env.expert_actions(schedulers, time_limit=time_limit, counts=counts)
+        held = MappingCounts()  # (a held world's plans are not its episode's)
+        per = [held if done[b] else own[b] for b in range(n)]
+        act, fb = env.expert_actions(schedulers, time_limit=time_limit, counts=per)
         falls += fb & ~done
         obs, rew, _, trunc, info = env.step(act)
         keep.append(obs)
@@ -186,6 +204,7 @@ def batched_rollouts(
                       [x[b] for x in ticks[: e + 1]], [x[b] for x in ill[:e]],
                       [x[b] for x in con[:e]], scenario_key, seed, names[b])  # fmt: skip
         rec.metrics, rec.fallbacks = finals[b], int(falls[b])
+        rec.counts = _count(own[b], counts)
         out.append(rec)
     return out
 

@@ -5,7 +5,7 @@
 :class:`~fcplan.env.task.TaskEnv` (``num_envs=1``: the seeds one after another) or in one
 batched :class:`~fcplan.env.vector_task.VectorTaskEnv` of as many worlds (``num_envs > 1``).
 :func:`play_unit` plays a unit and returns its :class:`~fcplan.env.demo_episodes.EpisodeRecord`
-s in seed order with the unit's mapping counts; :func:`play_units` plays a list of units with
+s in seed order; :func:`play_units` plays a list of units with
 ``jobs=1`` in this process, else on the local process pool of
 :func:`~fcplan.experiments.compare` and :func:`~fcplan.experiments.sweep`
 (:func:`fcplan.experiments.backends.select_backend`: workers that ignore Ctrl-C, die with the
@@ -42,7 +42,6 @@ from typing import Any
 
 from fcplan.env.demo_episodes import EpisodeRecord, batched_rollouts, rollout_episode
 from fcplan.env.task import TaskEnv
-from fcplan.env.task_actions import MappingCounts
 from fcplan.errors import FcplanError
 from fcplan.scheduling import Scheduler, make_scheduler
 from fcplan.scheduling_batch import instances
@@ -85,10 +84,9 @@ class DemoUnit:
 
 @dataclass
 class UnitResult:
-    """A played unit: its episodes in seed order and how its plans mapped onto actions."""
+    """A played unit: its episodes in seed order (each with its mapping counts)."""
 
     records: list[EpisodeRecord]
-    counts: dict[str, int]
 
 
 def demo_units(
@@ -120,7 +118,6 @@ def demo_units(
 def play_unit(unit: DemoUnit) -> UnitResult:
     """Roll out ``unit``'s seeds (module docstring); a module-level function, so pool workers
     can run it."""
-    counts = MappingCounts()
     if unit.num_envs > 1:
         from fcplan.env.vector_task import VectorTaskEnv
 
@@ -130,13 +127,13 @@ def play_unit(unit: DemoUnit) -> UnitResult:
         scheds = instances(lambda: make_scheduler(spec) if isinstance(spec, str)
                            else copy.deepcopy(spec), len(unit.seeds))  # fmt: skip
         records = batched_rollouts(env, scheds, unit.scenario_key, unit.seeds,
-                                   time_limit=unit.time_limit, counts=counts)  # fmt: skip
+                                   time_limit=unit.time_limit)  # fmt: skip
     else:
         one = TaskEnv(unit.scenario, **unit.env_kwargs)
         records = [rollout_episode(one, unit.scheduler, unit.scenario_key, seed,
-                                   time_limit=unit.time_limit, counts=counts)
+                                   time_limit=unit.time_limit)
                    for seed in unit.seeds]  # fmt: skip
-    return UnitResult(records, dict(counts))
+    return UnitResult(records)
 
 
 def play_units(
@@ -152,12 +149,15 @@ def play_units(
     Raises
     ------
     FcplanError
-        For a unit whose worker failed or died (it names the scenario and the seeds); what the
+        For units that cannot be pickled for the workers (a scheduler object holding a lambda,
+        a lock ...: checked before any episode), and for a unit whose worker failed or died (it names the scenario and the seeds); what the
         episode raised comes with it. In this process a unit's exception propagates as it is.
     """
     from fcplan.experiments.backends import select_backend
     from fcplan.experiments.workers import runtime_factories
 
+    if jobs > 1 and len(units) > 1:
+        _check_sendable(units[0], jobs)
     names = sorted({u.spec for u in units if isinstance(u.spec, str)})
     _, outcomes = select_backend(list(units), jobs, runtime_factories(names), play=play_unit)
     done: dict[str, UnitResult] = {}
@@ -174,3 +174,17 @@ def play_units(
     finally:
         outcomes.close()
     return [done[u.key] for u in units]
+
+
+def _check_sendable(unit: DemoUnit, jobs: int) -> None:
+    """Fail in one line, before the pool starts, when ``unit`` (its scheduler object) cannot be
+    pickled for a worker process."""
+    import pickle
+
+    try:
+        pickle.dumps(unit)
+    except Exception as exc:  # noqa: BLE001 - whatever pickling raises, said in one line
+        raise FcplanError(
+            f"demonstrations: jobs={jobs} sends the scheduler to worker processes, and it cannot "
+            f"be pickled ({type(exc).__name__}: {exc}); pass a registered name or spec, or jobs=1"
+        ) from None

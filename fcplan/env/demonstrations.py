@@ -326,6 +326,8 @@ def _roll_out(
     for sc in scenarios:
         scenario = as_scenario(sc)
         keyed.append((scenario, _scenario_key(scen_docs, scenario)))
+        if jobs > 1:  # (bad env arguments: the env's own error here, not a worker's)
+            TaskEnv(scenario, **env_kwargs)
     units = demo_units(keyed, seeds, sched, spec, env_kwargs=env_kwargs, time_limit=time_limit,
                        num_envs=int(num_envs), jobs=jobs)  # fmt: skip
     if jobs == 1:  # (each unit's episodes go in as it finishes, in order)
@@ -390,6 +392,8 @@ class _Rollouts:
         parts["episode"].append(np.full(n * n_a, ep))
         parts["step"].append(np.repeat(np.arange(n), n_a))
         parts["agent"].append(np.tile(np.arange(n_a), n))
+        for name, count in rec.counts.items():
+            self.counts[name] += count
         self.conflicts += int(rec.conflict.sum())
         self.fallbacks += rec.fallbacks
         self.records.append(rec)
@@ -407,9 +411,7 @@ class _Rollouts:
             self.progress(len(self.episodes), self.total, {})
 
     def add_unit(self, result: UnitResult) -> None:
-        """Append a played unit's episodes in order and add its mapping counts."""
-        for name, n in result.counts.items():
-            self.counts[name] += n
+        """Append a played unit's episodes in order."""
         for rec in result.records:
             self.add(rec)
 

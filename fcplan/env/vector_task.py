@@ -411,7 +411,7 @@ class VectorTaskEnv(BatchedEnv):
         schedulers: Scheduler | Sequence[Scheduler],
         *,
         time_limit: float | None = None,
-        counts: MappingCounts | None = None,
+        counts: MappingCounts | Sequence[MappingCounts] | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """(B, A) actions of a scheduler's plans on every world's current graph, and (B,) bool:
         the plan came from the greedy fallback.
@@ -421,7 +421,8 @@ class VectorTaskEnv(BatchedEnv):
         planned in one call when it has ``plan_batch`` (greedy does), else in turn
         (:func:`fcplan.scheduling_batch.solve_batch`, with each world's controller generator,
         as :func:`fcplan.env.demonstrations.demonstrations` does on one env). Each plan becomes
-        actions by :func:`fcplan.env.task_actions.plan_to_actions`.
+        actions by :func:`fcplan.env.task_actions.plan_to_actions`, counted in ``counts`` (one
+        for all the worlds, or one per world).
         """
         a, k = self.one.n_agents, self.one.k
         out = np.full((self.num_envs, a), k, dtype=np.int64)
@@ -430,7 +431,8 @@ class VectorTaskEnv(BatchedEnv):
         plans = solve_batch(schedulers, self.graphs, time_limit=time_limit, rngs=rngs)  # type: ignore[arg-type]
         fallback = np.array([getattr(p.stats, "status", None) == "fallback" for p in plans])
         for b, plan in enumerate(plans):
-            out[b] = plan_to_actions(plan, self.graphs[b], self.candidates[b], counts)
+            c = counts if counts is None or isinstance(counts, MappingCounts) else counts[b]
+            out[b] = plan_to_actions(plan, self.graphs[b], self.candidates[b], c)
         return out, fallback
 
     def _finals(self, done: np.ndarray, infos: dict[str, Any]) -> None:

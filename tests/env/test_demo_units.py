@@ -8,6 +8,7 @@ import pytest
 
 from fcplan.env.demo_units import demo_units, play_unit, play_units
 from fcplan.env.demonstrations import DemonstrationError, demonstrations
+from fcplan.env.task import TaskEnv
 from fcplan.errors import FcplanError
 from fcplan.scenario import load_scenario
 from fcplan.scheduling import make_scheduler
@@ -65,17 +66,50 @@ def test_units():
     assert seeds(2, 8) == [(k, (s,)) for k in "ab" for s in range(5)]
 
 
-def test_a_unit_that_cannot_reach_a_worker_is_named():
-    """A unit that fails in the pool (here: a scheduler that cannot be pickled) stops the run
-    with one error naming its scenario and seeds."""
+def _refuse() -> None:
+    raise RuntimeError("refused in the worker")
+
+
+class _RefusedInWorkers(GreedyScheduler):
+    """A greedy scheduler that pickles but cannot be unpickled."""
+
+    def __reduce__(self):
+        return (_refuse, ())
+
+
+def test_a_scheduler_that_cannot_be_pickled_is_refused_before_any_episode():
+    """A scheduler object that cannot go to the workers (here: it holds a lambda) is refused in
+    one line before the pool starts; with ``jobs=1`` the same object plays."""
     sched = GreedyScheduler()
     sched.hook = lambda: None  # (a lambda does not pickle)
+    with pytest.raises(FcplanError, match="jobs=2 sends the scheduler to worker processes, and"):
+        demonstrations(sched, ["practice"], [0, 1], env_kwargs=KW, jobs=2, progress=False)
+    assert demonstrations(sched, ["practice"], [0], env_kwargs=KW, progress=False).n_episodes == 1
+
+
+def test_a_unit_that_fails_in_a_worker_is_named():
+    """A unit whose worker keeps dying (here: its scheduler cannot be unpickled there, which
+    ends the worker) stops the run with one error naming its scenario and seeds, after the
+    pool's restarts; the unit plays in this process."""
+    sched = _RefusedInWorkers()
     sc = load_scenario("practice")
     units = demo_units([(sc, "practice")], [0, 1], sched, sched, env_kwargs=KW, time_limit=None,
                        num_envs=1, jobs=2)  # fmt: skip
-    with pytest.raises(FcplanError, match=r"practice seeds \[0\] produced nothing: .*ickl"):
+    with pytest.raises(
+        FcplanError, match=r"practice seeds \[[01]\] produced nothing: worker processes died"
+    ):
         play_units(units, 2)
     assert [r.seed for r in play_unit(units[1]).records] == [1]
+
+
+def test_bad_env_arguments_fail_as_in_one_process():
+    """Bad env arguments raise the env's own error before any worker starts, as with jobs=1."""
+    from fcplan.errors import EnvError
+
+    for jobs in (1, 2):
+        with pytest.raises(EnvError, match="k"):
+            demonstrations("greedy", ["practice"], [0, 1], env_kwargs={"k": 0}, jobs=jobs,
+                           progress=False)  # fmt: skip
 
 
 @pytest.mark.parametrize("bad", [0, -1, 1.5, True, "2"])
@@ -85,3 +119,17 @@ def test_bad_counts(bad):
         demonstrations("greedy", ["practice"], [0], env_kwargs=KW, jobs=bad)
     with pytest.raises(DemonstrationError, match="num_envs: must be an integer >= 1"):
         demonstrations("greedy", ["practice"], [0], env_kwargs=KW, num_envs=bad)
+
+
+def test_each_episode_keeps_its_own_mapping_counts():
+    """A batched unit's episodes carry the mapping counts of their sequential rollouts, one
+    episode each; their sum is the dataset's ``mapping``."""
+    sc = load_scenario(24)
+    g = make_scheduler("greedy")
+    one, many = (demo_units([(sc, "24")], [3, 4, 5], g, "greedy", env_kwargs=KW, time_limit=None,
+                            num_envs=b, jobs=1) for b in (1, 3))  # fmt: skip
+    seq = [r.counts for u in one for r in play_unit(u).records]
+    assert [r.counts for r in play_unit(many[0]).records] == seq
+    demo = demonstrations("greedy", [24], [3, 4, 5], env_kwargs=KW, progress=False)
+    assert demo.metadata["mapping"] == {k: sum(c[k] for c in seq) for k in seq[0]}
+    assert sum(seq[0].values()) == KW["max_steps"] * len(TaskEnv(sc).possible_agents)
