@@ -24,7 +24,7 @@ Examples
 >>> from fcplan.scheduling import make_scheduler
 >>> from fcplan.scenario import load_scenario
 >>> sc = load_scenario("practice")
->>> units = demo_units([(sc, "practice")], [0, 1, 2], make_scheduler("greedy"), "greedy",
+>>> units = demo_units([(sc, "practice", [0, 1, 2])], make_scheduler("greedy"), "greedy",
 ...                    env_kwargs={"max_steps": 2}, time_limit=None, num_envs=1, jobs=2)
 >>> [u.seeds for u in units]
 [(0,), (1,), (2,)]
@@ -90,8 +90,7 @@ class UnitResult:
 
 
 def demo_units(
-    scenarios: Sequence[tuple[Any, str]],
-    seeds: Sequence[int],
+    plan: Sequence[tuple[Any, str, Sequence[int]]],
     scheduler: Scheduler,
     spec: str | Scheduler,
     *,
@@ -100,14 +99,14 @@ def demo_units(
     num_envs: int,
     jobs: int,
 ) -> list[DemoUnit]:
-    """The units of every ``(scenario, key)`` of ``scenarios`` and every seed, in the dataset's
+    """The units of the seeds of every ``(scenario, key, seeds)`` of ``plan``, in the dataset's
     order (scenario, then seed; module docstring for the sizes)."""
-    n = len(seeds)
-    size = 1
-    if num_envs > 1:
-        size = num_envs if jobs == 1 else max(1, min(num_envs, math.ceil(n / jobs)))
     units: list[DemoUnit] = []
-    for scenario, key in scenarios:
+    for scenario, key, seeds in plan:
+        n = len(seeds)
+        size = 1
+        if num_envs > 1:
+            size = num_envs if jobs == 1 else max(1, min(num_envs, math.ceil(n / jobs)))
         for i in range(0, n, size):
             chunk = tuple(int(s) for s in seeds[i : i + size])
             units.append(DemoUnit(str(len(units)), scenario, key, chunk, scheduler, spec,

@@ -62,13 +62,14 @@ from typing import Any
 
 import numpy as np
 
+from fcplan.env.demo_checkpoint import DemoCheckpoint
 from fcplan.env.demo_episodes import (
     EpisodeRecord,
     env_kwargs_from_metadata,
     recording_episode,
     scenario_from_metadata,
 )
-from fcplan.env.demo_units import UnitResult, demo_units, play_unit, play_units
+from fcplan.env.demo_units import demo_units, play_units
 from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import MappingCounts
 from fcplan.env.task_candidates import AGENT_FEATURES, TASK_FEATURES
@@ -208,6 +209,7 @@ def demonstrations(
     dataset_id: str | None = None,
     num_envs: int = 1,
     jobs: int = 1,
+    checkpoint: str | Path | None = None,
     progress: Any = True,
 ) -> Any:
     """Roll ``scheduler`` out through the task-level env on every (scenario, seed).
@@ -235,15 +237,16 @@ def demonstrations(
         The Minari dataset id (``format="minari"``; default ``"fcplan/task/<scheduler>-v0"``).
     num_envs : int
         Roll up to this many seeds of a scenario out at once in a batched task env
-        (:func:`fcplan.env.demo_episodes.batched_rollouts`; one greedy instance plans every
-        world in one call, ``plan_batch``; other schedulers one instance per world); the dataset is the one ``num_envs=1`` gives, for schedulers that keep no state between
-        episodes.
+        (:func:`fcplan.env.demo_episodes.batched_rollouts`; greedy plans every world in one call,
+        ``plan_batch``, other schedulers one instance per world); the dataset of ``num_envs=1``
+        for schedulers that keep no state between episodes.
     jobs : int or None
-        Worker processes (None: one per CPU). With more than one, the episodes are split into
-        units (one seed each, or batched envs of at most ``ceil(seeds / jobs)`` worlds), played
-        on a local process pool, the pool of ``compare`` and ``sweep``
-        (:mod:`fcplan.env.demo_units`); the dataset is the one ``jobs=1`` gives, for schedulers
-        that keep no state between episodes. A scheduler object is sent to each unit pickled.
+        Worker processes (None: one per CPU), the pool of ``compare`` and ``sweep``, playing the
+        episodes in units (:mod:`fcplan.env.demo_units`): the dataset of ``jobs=1``, for
+        schedulers that keep no state between episodes (a scheduler object goes pickled).
+    checkpoint : str or Path, optional
+        A folder that every episode is written into as it finishes; a call with the same folder
+        plays only the episodes not in it (:mod:`fcplan.env.demo_checkpoint`).
     progress : bool or callable
         ``True`` (default): a progress bar on stderr counted in episodes, the one of ``compare``
         and ``sweep`` (:mod:`fcplan.experiments.progress`; in place in Jupyter); ``False``:
@@ -253,11 +256,9 @@ def demonstrations(
     -------
     Demonstrations, or minari.MinariDataset with ``format="minari"``
     """
-    if format not in ("npz", "minari"):
-        raise DemonstrationError(f"format: must be 'npz' or 'minari' (got {format!r})")
     from fcplan.experiments.progress import episode_progress
 
-    jobs = _check_counts(num_envs, jobs)
+    jobs = _check_args(format, num_envs, jobs)
     sched, name, settings = _scheduler(scheduler)
     env_kwargs = dict(env_kwargs or {})
     env_kwargs.pop("render_mode", None)
@@ -265,18 +266,18 @@ def demonstrations(
     scenarios, recordings = list(scenarios), list(recordings)
     bar = episode_progress(progress, "demonstrations")
     rollouts = _Rollouts(sched, time_limit, bar, len(scenarios) * len(seeds) + len(recordings))
+    run = {"scheduler": name, "scheduler_settings": settings, "time_limit": time_limit,
+           "env_kwargs": _jsonable_kwargs(env_kwargs)}  # fmt: skip
     try:
         scen_docs = _roll_out(rollouts, sched, scheduler, scenarios, seeds, recordings, env_kwargs,
-                              time_limit, num_envs, jobs)  # fmt: skip
+                              time_limit, num_envs, jobs,
+                              None if checkpoint is None else (checkpoint, run))  # fmt: skip
     finally:
         getattr(bar, "close", lambda: None)()
     meta = {
         "format": "fcplan-demonstrations",
         "version": FORMAT_VERSION,
-        "scheduler": name,
-        "scheduler_settings": settings,
-        "time_limit": time_limit,
-        "env_kwargs": _jsonable_kwargs(env_kwargs),
+        **run,
         "k": int(env_kwargs.get("k", 8)),
         "agent_features": list(AGENT_FEATURES),
         "task_features": list(TASK_FEATURES),
@@ -297,10 +298,13 @@ def demonstrations(
     return demo
 
 
-def _check_counts(num_envs: Any, jobs: Any) -> int:
-    """``jobs`` as an int (None: one per CPU), after checking both counts (one-line errors)."""
+def _check_args(format: Any, num_envs: Any, jobs: Any) -> int:
+    """``jobs`` as an int (None: one per CPU), after checking the format and both counts
+    (one-line errors)."""
     from fcplan.experiments.workers import check_jobs
 
+    if format not in ("npz", "minari"):
+        raise DemonstrationError(f"format: must be 'npz' or 'minari' (got {format!r})")
     jobs = check_jobs(jobs)
     if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
         raise DemonstrationError(f"num_envs: must be an integer >= 1 (got {num_envs!r:.40})")
@@ -318,34 +322,47 @@ def _roll_out(
     time_limit: float | None,
     num_envs: int,
     jobs: int,
+    checkpoint: tuple[Any, dict[str, Any]] | None,
 ) -> dict[str, dict[str, Any]]:
-    """Add every (scenario, seed) episode (:mod:`fcplan.env.demo_units`) and every recording to
-    ``rollouts``; the scenario documents by dataset key."""
+    """Add every (scenario, seed) episode (:mod:`fcplan.env.demo_units`; those stored in the
+    ``(folder, run identity)`` of ``checkpoint`` read back, the others played and stored) and
+    every recording to ``rollouts``; the scenario documents by dataset key."""
     scen_docs: dict[str, dict[str, Any]] = {}
     keyed = []
     for sc in scenarios:
         scenario = as_scenario(sc)
-        keyed.append((scenario, _scenario_key(scen_docs, scenario)))
-        if jobs > 1:  # (bad env arguments: the env's own error here, not a worker's)
-            TaskEnv(scenario, **env_kwargs)
-    units = demo_units(keyed, seeds, sched, spec, env_kwargs=env_kwargs, time_limit=time_limit,
+        probe = TaskEnv(scenario, **env_kwargs)  # (bad env arguments: the env's error, here)
+        keyed.append((scenario, _scenario_key(scen_docs, scenario), probe))
+    store = None
+    if checkpoint is not None:
+        store = DemoCheckpoint(checkpoint[0], checkpoint[1], dict(scen_docs))
+    got: dict[tuple[str, int], EpisodeRecord] = {}
+    todo = []
+    for scenario, key, probe in keyed:
+        for seed in seeds:
+            rec = None if store is None else store.load(key, seed, probe.n_agents, probe.k)
+            if rec is not None:
+                got[(key, seed)] = rec
+        todo.append((scenario, key, [s for s in seeds if (key, s) not in got]))
+    units = demo_units(todo, sched, spec, env_kwargs=env_kwargs, time_limit=time_limit,
                        num_envs=int(num_envs), jobs=jobs)  # fmt: skip
-    if jobs == 1:  # (each unit's episodes go in as it finishes, in order)
-        for unit in units:
-            rollouts.add_unit(play_unit(unit))
-    else:
-        finished = [0]
 
-        def tick(unit: Any, result: Any) -> None:
-            finished[0] += len(result.records)
-            if rollouts.progress is not None:
-                rollouts.progress(finished[0], rollouts.total, {})
+    def finished(unit: Any, result: Any) -> None:
+        for rec in result.records:
+            got[(rec.scenario, rec.seed)] = rec
+            if store is not None:
+                store.save(rec)
+        if rollouts.progress is not None:
+            rollouts.progress(len(got), rollouts.total, {})
 
-        results = play_units(units, jobs, on_unit=tick)
-        progress, rollouts.progress = rollouts.progress, None
-        for result in results:
-            rollouts.add_unit(result)
-        rollouts.progress = progress
+    if got and rollouts.progress is not None:
+        rollouts.progress(len(got), rollouts.total, {})  # (the stored episodes)
+    play_units(units, jobs, on_unit=finished)
+    progress, rollouts.progress = rollouts.progress, None
+    for _, key, _ in keyed:
+        for seed in seeds:
+            rollouts.add(got[(key, seed)])
+    rollouts.progress = progress
     for rec in recordings:
         scenario = rec.scenario
         key = _scenario_key(scen_docs, scenario)
@@ -409,11 +426,6 @@ class _Rollouts:
         )
         if self.progress is not None:
             self.progress(len(self.episodes), self.total, {})
-
-    def add_unit(self, result: UnitResult) -> None:
-        """Append a played unit's episodes in order."""
-        for rec in result.records:
-            self.add(rec)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The dataset's arrays (module docstring), rows of every episode in order."""

@@ -55,7 +55,7 @@ def test_units():
     g = make_scheduler("greedy")
 
     def seeds(num_envs, jobs):
-        units = demo_units([(sc, "a"), (sc, "b")], list(range(5)), g, "greedy", env_kwargs={},
+        units = demo_units([(sc, "a", range(5)), (sc, "b", range(5))], g, "greedy", env_kwargs={},
                            time_limit=None, num_envs=num_envs, jobs=jobs)  # fmt: skip
         assert len({u.key for u in units}) == len(units)
         return [(u.scenario_key, u.seeds) for u in units]
@@ -93,7 +93,7 @@ def test_a_unit_that_fails_in_a_worker_is_named():
     pool's restarts; the unit plays in this process."""
     sched = _RefusedInWorkers()
     sc = load_scenario("practice")
-    units = demo_units([(sc, "practice")], [0, 1], sched, sched, env_kwargs=KW, time_limit=None,
+    units = demo_units([(sc, "practice", [0, 1])], sched, sched, env_kwargs=KW, time_limit=None,
                        num_envs=1, jobs=2)  # fmt: skip
     with pytest.raises(
         FcplanError, match=r"practice seeds \[[01]\] produced nothing: worker processes died"
@@ -126,7 +126,7 @@ def test_each_episode_keeps_its_own_mapping_counts():
     episode each; their sum is the dataset's ``mapping``."""
     sc = load_scenario(24)
     g = make_scheduler("greedy")
-    one, many = (demo_units([(sc, "24")], [3, 4, 5], g, "greedy", env_kwargs=KW, time_limit=None,
+    one, many = (demo_units([(sc, "24", [3, 4, 5])], g, "greedy", env_kwargs=KW, time_limit=None,
                             num_envs=b, jobs=1) for b in (1, 3))  # fmt: skip
     seq = [r.counts for u in one for r in play_unit(u).records]
     assert [r.counts for r in play_unit(many[0]).records] == seq
