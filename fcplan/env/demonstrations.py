@@ -265,7 +265,7 @@ def demonstrations(
     seeds = [int(s) for s in seeds]
     scenarios, recordings = list(scenarios), list(recordings)
     bar = episode_progress(progress, "demonstrations")
-    rollouts = _Rollouts(sched, time_limit, bar, len(scenarios) * len(seeds) + len(recordings))
+    rollouts = _Rollouts(bar, len(scenarios) * len(seeds) + len(recordings))
     run = {"scheduler": name, "scheduler_settings": settings, "time_limit": time_limit,
            "env_kwargs": _jsonable_kwargs(env_kwargs)}  # fmt: skip
     try:
@@ -383,10 +383,7 @@ def _scenario_key(docs: dict[str, dict[str, Any]], scenario: Any) -> str:
 class _Rollouts:
     """The rows, mapping counts and episode records of a dataset's episodes."""
 
-    def __init__(
-        self, scheduler: Scheduler, time_limit: float | None, progress: Any = None, total: int = 0
-    ) -> None:
-        self.scheduler, self.time_limit = scheduler, time_limit
+    def __init__(self, progress: Any = None, total: int = 0) -> None:
         self.progress, self.total = progress, total
         self.parts: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
         self.episodes: list[dict[str, Any]] = []
