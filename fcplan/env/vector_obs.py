@@ -200,15 +200,18 @@ class BatchMotionObs:
         j1 = np.minimum((y1 // c).astype(np.int64) + 1, nc)
         ok &= (i1 > i0) & (j1 > j0)
         wb, _ = np.nonzero(ok)
-        i0, i1, j0, j1 = i0[ok], i1[ok], j0[ok], j1[ok]
-        nj = j1 - j0
-        count = (i1 - i0) * nj
-        rep = np.repeat(np.arange(wb.size), count)
-        local = np.arange(rep.size) - np.repeat(np.cumsum(count) - count, count)
-        i = i0[rep] + local // nj[rep] + r
-        j = j0[rep] + local % nj[rep] + r
-        wr = wb[rep]
-        self.maps.reshape(-1)[((wr * h + i) * h + j) * N_FOV + D_SEEN] = value[wr]
+        i0, j0 = i0[ok], j0[ok]
+        ni, nj = i1[ok] - i0, j1[ok] - j0
+        # each rectangle: ni rows of nj cells; a row is a run of flat indices N_FOV apart, the
+        # rows of a rectangle h N_FOV apart (no division: runs of aranges shifted per row)
+        hs = h * N_FOV
+        base = ((wb * h + i0 + r) * h + j0 + r) * N_FOV + D_SEEN
+        start = np.repeat(base - hs * (np.cumsum(ni) - ni), ni)
+        start += hs * np.arange(start.size)
+        run = np.repeat(nj, ni)
+        flat = np.repeat(start - N_FOV * (np.cumsum(run) - run), run)
+        flat += N_FOV * np.arange(flat.size)
+        self.maps.reshape(-1)[flat] = np.repeat(np.repeat(value[wb], ni), run)
 
     # ------------------------------------------------------------------ observations
     def agent_arrays(self, batch: BatchWorld) -> tuple[np.ndarray, np.ndarray]:
