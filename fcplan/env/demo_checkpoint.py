@@ -7,7 +7,8 @@ only the (scenario, seed) episodes not in it: the dataset is the one an uninterr
 (``tests/env/test_demo_checkpoint.py``). More seeds or scenarios than the first call had may be
 asked for (the stored ones are reused); other scheduler settings, env arguments, time limit or
 scenario content are refused in one line, naming what differs, since the stored episodes would
-then not be episodes of this call.
+then not be episodes of this call. One run at a time holds a folder (an exclusive ``flock``,
+the lock of a sweep's results folder): a second run started on it meanwhile is refused.
 
 Layout
     ``run.json``: ``{"format": "fcplan-demonstrations-checkpoint", "version": 1, "run":
@@ -41,6 +42,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -84,14 +86,39 @@ class DemoCheckpoint:
     Raises
     ------
     FcplanError
-        The folder belongs to another run (what differs is named), or is not a checkpoint.
+        On entering: another process is writing into the folder, or it belongs to another run
+        (what differs is named), or it is not a checkpoint.
     """
 
     def __init__(self, folder: str | os.PathLike[str], run: dict, scenarios: dict) -> None:
         self.folder = Path(folder)
         self.episodes = self.folder / "episodes"
+        self.run = json.loads(json.dumps(run))  # (as it reads back: tuples become lists ...)
+        self.scenarios = scenarios
+        self._held = contextlib.ExitStack()
+
+    def __enter__(self) -> DemoCheckpoint:
+        """Hold the folder for this run (one run at a time: ``flock``, as a sweep holds its
+        results folder), then check or write its ``run.json``."""
+        from fcplan.experiments.results import hold_folder
+
+        self.episodes.mkdir(parents=True, exist_ok=True)
+        busy = (f"checkpoint {self.folder}: another demonstrations run is writing into it; wait "
+                "for it to finish (then re-run to resume) or use another folder")  # fmt: skip
+        self._held.enter_context(hold_folder(self.folder, lambda: FcplanError(busy)))
+        try:
+            self._check_run()
+        except BaseException:
+            self._held.close()
+            raise
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._held.close()
+
+    def _check_run(self) -> None:
+        run, scenarios = self.run, self.scenarios
         path = self.folder / "run.json"
-        run = json.loads(json.dumps(run))  # (as it reads back: tuples become lists ...)
         stored_scenarios: dict[str, Any] = {}
         if path.exists():
             old = self._read_run(path)
@@ -109,7 +136,6 @@ class DemoCheckpoint:
                         f"checkpoint {self.folder}: scenario {key!r} differs from the one its "
                         "episodes were recorded on; use another folder"
                     )
-        self.episodes.mkdir(parents=True, exist_ok=True)
         doc = {"format": CHECKPOINT_FORMAT, "version": CHECKPOINT_VERSION, "run": run,
                "scenarios": {**stored_scenarios, **scenarios}}  # fmt: skip
         _write_atomic(path, json.dumps(doc, indent=1, sort_keys=True).encode())

@@ -54,6 +54,7 @@ True
 
 from __future__ import annotations
 
+import contextlib
 import json
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -333,9 +334,38 @@ def _roll_out(
         scenario = as_scenario(sc)
         probe = TaskEnv(scenario, **env_kwargs)  # (bad env arguments: the env's error, here)
         keyed.append((scenario, _scenario_key(scen_docs, scenario), probe))
-    store = None
-    if checkpoint is not None:
-        store = DemoCheckpoint(checkpoint[0], checkpoint[1], dict(scen_docs))
+    with contextlib.ExitStack() as stack:
+        store = None
+        if checkpoint is not None:
+            store = stack.enter_context(DemoCheckpoint(*checkpoint, dict(scen_docs)))
+        got = _play_episodes(rollouts, store, keyed, seeds, sched, spec, env_kwargs, time_limit,
+                             num_envs, jobs)  # fmt: skip
+    progress, rollouts.progress = rollouts.progress, None
+    for _, key, _ in keyed:
+        for seed in seeds:
+            rollouts.add(got[(key, seed)])
+    rollouts.progress = progress
+    for rec in recordings:
+        scenario = rec.scenario
+        key = _scenario_key(scen_docs, scenario)
+        rollouts.add(recording_episode(rec, TaskEnv(scenario, **env_kwargs), key))
+    return scen_docs
+
+
+def _play_episodes(
+    rollouts: _Rollouts,
+    store: DemoCheckpoint | None,
+    keyed: list[tuple[Any, str, TaskEnv]],
+    seeds: list[int],
+    sched: Scheduler,
+    spec: str | Scheduler,
+    env_kwargs: dict[str, Any],
+    time_limit: float | None,
+    num_envs: int,
+    jobs: int,
+) -> dict[tuple[str, int], EpisodeRecord]:
+    """Every (scenario key, seed) episode: read back from ``store``, or played in units (stored
+    as they finish); progress counted in episodes."""
     got: dict[tuple[str, int], EpisodeRecord] = {}
     todo = []
     for scenario, key, probe in keyed:
@@ -358,16 +388,7 @@ def _roll_out(
     if got and rollouts.progress is not None:
         rollouts.progress(len(got), rollouts.total, {})  # (the stored episodes)
     play_units(units, jobs, on_unit=finished)
-    progress, rollouts.progress = rollouts.progress, None
-    for _, key, _ in keyed:
-        for seed in seeds:
-            rollouts.add(got[(key, seed)])
-    rollouts.progress = progress
-    for rec in recordings:
-        scenario = rec.scenario
-        key = _scenario_key(scen_docs, scenario)
-        rollouts.add(recording_episode(rec, TaskEnv(scenario, **env_kwargs), key))
-    return scen_docs
+    return got
 
 
 def _scenario_key(docs: dict[str, dict[str, Any]], scenario: Any) -> str:

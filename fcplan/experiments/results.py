@@ -64,6 +64,7 @@ __all__ = [
     "load_manifests",
     "load_results",
     "lock_results",
+    "hold_folder",
     "remove_stale_temporaries",
     "stored_status",
     "write_row",
@@ -212,6 +213,18 @@ def lock_results(directory: str | os.PathLike[str]) -> Iterator[None]:
     ...
     fcplan.experiments.results.ResultsError: ...: another sweep is writing into this results folder...
     """
+    busy = (f"{directory}: another sweep is writing into this results folder; wait for it "
+            "to finish (then re-run to resume) or choose another --results folder")  # fmt: skip
+    with hold_folder(directory, lambda: ResultsError(busy)):
+        yield
+
+
+@contextlib.contextmanager
+def hold_folder(directory: str | os.PathLike[str], busy: Any) -> Iterator[None]:
+    """Hold ``directory`` for this process (an exclusive, non-blocking ``flock`` on it), or
+    raise ``busy()`` when another process holds it; no locking where ``flock`` is missing (not
+    POSIX, some network mounts). The one folder lock of sweeps' results and demonstrations'
+    checkpoints."""
     try:
         import fcntl
     except ImportError:  # pragma: no cover - not POSIX: no locking
@@ -222,10 +235,7 @@ def lock_results(directory: str | os.PathLike[str]) -> Iterator[None]:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            raise ResultsError(
-                f"{directory}: another sweep is writing into this results folder; wait for it "
-                "to finish (then re-run to resume) or choose another --results folder"
-            ) from None
+            raise busy() from None
         except OSError:  # a file system without flock (some network mounts): no locking
             pass
         yield

@@ -156,5 +156,22 @@ def test_a_damaged_episode_is_reported_and_played_again(tmp_path, damage):
 def test_not_a_checkpoint(tmp_path):
     """A folder whose run.json is not a checkpoint's is refused in one line naming it."""
     (tmp_path / "run.json").write_text('{"format": "something else"}')
-    with pytest.raises(FcplanError, match="run.json: not a demonstrations checkpoint"):
-        DemoCheckpoint(tmp_path, {"scheduler": "greedy"}, {})
+    with (
+        pytest.raises(FcplanError, match="run.json: not a demonstrations checkpoint"),
+        DemoCheckpoint(tmp_path, {"scheduler": "greedy"}, {}),
+    ):
+        pass
+
+
+def test_one_run_at_a_time_holds_a_folder(tmp_path):
+    """While a run holds a checkpoint folder, another one is refused in one line before any
+    episode; once it is done, the folder is free again."""
+    run = {"scheduler": "greedy"}
+    with (
+        DemoCheckpoint(tmp_path, run, {}),
+        pytest.raises(FcplanError, match="another demonstrations run is writing into it"),
+    ):
+        demonstrations("greedy", ["practice"], [0], env_kwargs=KW, checkpoint=tmp_path,
+                       progress=False)  # fmt: skip
+    with DemoCheckpoint(tmp_path, run, {}):
+        pass
