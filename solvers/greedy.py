@@ -8,7 +8,10 @@ Each replan, in this order:
    ``freshness`` decays once the fire has not been sensed for ``fresh_s`` seconds, and ``eta`` is
    the agent's arrival time (seconds) after the tasks already on its route. A fire task gets one
    agent; a route holds at most ``route_length`` tasks and no more than the agent's tank; every
-   pick keeps the route plus the way home within the agent's battery.
+   pick keeps the route plus the way home within the agent's battery. A hybrid (camera and
+   water) sent to fires flies them at :meth:`fcplan.taskgraph.TaskGraph.dump_altitude` (the
+   ``dump_altitude`` setting, by default the top of its bounds: the widest dump), the rule of
+   every built-in scheduler.
 2. **Perception agents** watch: each fire that an action agent is heading to first gets the
    nearest free perception agent hovering over it at ``watch_altitude`` (low, for a high sensing
    confidence), so the cells the fire adds before the dump are sensed and can be pruned. At most
@@ -33,6 +36,7 @@ watch_altitude       float   (0, 10000]   m, clipped to each agent's bounds
 search_altitude      float   (0, 10000]   m, clipped to each agent's bounds
 max_watch_fraction   float   [0, 1]       share of perception agents that may watch
 spread_px            float   >= 0         px around a taken block that are discounted
+dump_altitude        float   (0, 10000]   m of a hybrid's dumps, clipped; None: top of bounds
 ==================== ======= ============ ===============================================
 
 The plans never depend on the wall clock or the time limit (``deterministic`` is always True):
@@ -95,6 +99,9 @@ class GreedyScheduler:
         when there is a fire being fought).
     spread_px : float
         Search blocks within this distance of a block already taken are discounted.
+    dump_altitude : float or None
+        Altitude (m) of a hybrid (camera and water) on a route of fires, clipped to its bounds;
+        None (default): the top of its bounds (:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`).
     """
 
     name = "greedy"
@@ -110,6 +117,7 @@ class GreedyScheduler:
         search_altitude: float = 70.0,
         max_watch_fraction: float = 0.5,
         spread_px: float = 250.0,
+        dump_altitude: float | None = None,
     ) -> None:
         self.route_length = int_setting("route_length", route_length, 1, MAX_ROUTE_LENGTH)
         self.search_route_length = int_setting(
@@ -124,6 +132,9 @@ class GreedyScheduler:
         )
         self.max_watch_fraction = float_setting("max_watch_fraction", max_watch_fraction, 0.0, 1.0)
         self.spread_px = float_setting("spread_px", spread_px, 0.0, unit=" px")
+        self.dump_altitude = None if dump_altitude is None else float_setting(
+            "dump_altitude", dump_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
+        )  # fmt: skip
 
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:
@@ -175,6 +186,8 @@ class GreedyScheduler:
                     if tasks:
                         routes[g.agent_ids[row]] = tuple(g.task_ids[k] for k in tasks)
                         first_fire[row] = tasks[0]
+                        if g.agent_can_sense[row]:  # a hybrid: it dumps from its dump altitude
+                            alts[g.agent_ids[row]] = g.dump_altitude(row, self.dump_altitude)
             # 2. perception agents watch the fires being fought
             sensors = np.flatnonzero(free & g.agent_can_sense & ~g.agent_can_act)
             busy = self._watch(g, sensors, first_fire, routes, alts)

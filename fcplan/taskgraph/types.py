@@ -425,6 +425,30 @@ class TaskGraph:
         lo, hi = self._alt_bounds[agent]
         return float(min(max(z, lo), hi))
 
+    def dump_altitude(self, agent: int, z: float | None = None) -> float:
+        """The altitude (m) from which agent row ``agent``, a camera agent with water (a hybrid),
+        flies a route of fires it dumps on: ``z`` clipped to its bounds, or (None) the top of
+        its bounds.
+
+        A dump puts out the sensed burning cells in the agent's field of view, ``2 z x 1.15 z``
+        px at altitude ``z`` (:mod:`fcplan.world`), so the top of the bounds is the widest dump.
+        Every built-in scheduler places its hybrids' dumps by this one rule, with the same
+        ``dump_altitude`` setting (None by default), so that comparisons between schedulers
+        are about what they assign, not where their hybrids fly (``bench/README.md``, "One dump
+        altitude for every scheduler").
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from fcplan.taskgraph import synthetic_task_graph
+        >>> g = synthetic_task_graph(2, 3, np.random.default_rng(0))
+        >>> g.dump_altitude(0) == float(g.agent_alt_range[0][1])
+        True
+        >>> g.dump_altitude(0, 1e6) == g.dump_altitude(0)
+        True
+        """
+        return self.clip_altitude(agent, self._alt_bounds[agent][1] if z is None else z)
+
     @cached_view
     def _alt_bounds(self) -> list[list[float]]:
         """:attr:`agent_alt_range` as Python floats."""

@@ -80,7 +80,9 @@ of the tasks in the final plan; ``size`` holds ``agents``, ``tasks``, ``rounds``
 converge says why), ``completed``, ``components``, ``diameter`` and ``conflicts_resolved``, and
 ``message`` says the same in words. Agents on their way home for good (``HOMING``) do not bid but
 relay messages. Camera agents fly at ``watch_altitude`` when they watch and at ``search_altitude``
-when they search. The algorithm uses no randomness (ties go to lower indices).
+when they search; a hybrid that won dumps flies them at ``dump_altitude``
+(:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`: by default the top of its bounds, the widest
+dump; the rule of every built-in scheduler). The algorithm uses no randomness (ties go to lower indices).
 """
 
 from __future__ import annotations
@@ -195,6 +197,9 @@ class CBBAScheduler:
     watch_altitude, search_altitude : float
         Altitude (m) of camera agents whose route ends with a watch / only covers search blocks
         (clipped to their bounds).
+    dump_altitude : float or None
+        Altitude (m) of a hybrid (camera and water) on its dumps, clipped to its bounds; None
+        (default): the top of its bounds.
     max_rounds : int
         Cap on the rounds of each auction (the work limit of the deterministic mode).
     time_limit : float, optional
@@ -230,6 +235,7 @@ class CBBAScheduler:
         watch_weight: float = 2.0,
         watch_altitude: float = 35.0,
         search_altitude: float = 70.0,
+        dump_altitude: float | None = None,
         max_rounds: int = 500,
         time_limit: float | None = None,
         deterministic: bool = False,
@@ -240,6 +246,9 @@ class CBBAScheduler:
         self.watch_weight = number("watch_weight", watch_weight, lo=0.0)
         self.watch_altitude = number("watch_altitude", watch_altitude, lo=0.0, unit="m")
         self.search_altitude = number("search_altitude", search_altitude, lo=0.0, unit="m")
+        self.dump_altitude = None if dump_altitude is None else number(
+            "dump_altitude", dump_altitude, lo=0.0, strict=True, unit="m"
+        )  # fmt: skip
         self.max_rounds = integer("max_rounds", max_rounds, lo=1)
         self.time_limit = (
             None
@@ -262,6 +271,8 @@ class CBBAScheduler:
                 watch = graph.task_kind[tasks[-1]] == TaskKind.FIRE
                 z = self.watch_altitude if watch else self.search_altitude
                 alts[agent] = graph.clip_altitude(i, z)
+            elif graph.agent_can_sense[i]:  # a hybrid on its dumps
+                alts[agent] = graph.dump_altitude(i, self.dump_altitude)
         return Plan(routes=routes, altitudes=alts, stats=_stats(graph, res))
 
     def run(self, graph: TaskGraph, *, time_limit: float | None = None) -> CBBAResult:

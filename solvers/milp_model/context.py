@@ -101,14 +101,13 @@ class BuildContext:
         the altitude. For a camera agent without water, whose fire routes watch, it is
         ``watch_altitude`` (low: reliable sensing)."""
         g, p = self.graph, self.p
-        z_fire = p.watch_altitude
         if bool(self.roles.dumper[agent]):
-            z_fire = (
-                float(g.agent_alt_range[agent][1]) if p.dump_altitude is None else p.dump_altitude
-            )
+            z_fire = g.dump_altitude(agent, p.dump_altitude)
+        else:
+            z_fire = g.clip_altitude(agent, p.watch_altitude)
         lo, hi = (float(v) for v in g.agent_alt_range[agent])
         speed = float(g.agent_speed[agent])
         z_search = (
             best_search_altitude(lo, hi, speed) if p.search_altitude is None else p.search_altitude
         )
-        return g.clip_altitude(agent, z_fire), g.clip_altitude(agent, z_search)
+        return z_fire, g.clip_altitude(agent, z_search)

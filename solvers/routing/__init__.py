@@ -9,8 +9,8 @@ Each replan builds and solves up to two models, first the **action** model, then
   slot.
 * **Nodes** are the tasks that role can serve: fire tasks for action agents; search blocks *and*
   fire tasks for perception agents. Hybrids (camera and water) that still have water are action
-  vehicles (fires only, no altitude is set for them, as in ``greedy``); hybrids with an empty
-  tank are perception vehicles.
+  vehicles (fires only, flown at their dump altitude, as in every built-in scheduler); hybrids
+  with an empty tank are perception vehicles.
 * **Visits are optional** (prize collecting): leaving task ``k`` unvisited costs a drop penalty
   equal to its value converted to pixels. Each task is visited at most once per model.
 

@@ -47,8 +47,10 @@ depot slot.
 
 A perception route whose first task is a fire becomes a **watch**: the route is cut to that fire
 (the agent hovers over it until the next replan) at ``watch_altitude`` (low: reliable sensing);
-other perception routes fly at ``search_altitude`` (high: a wide view). Altitudes are clipped to
-each agent's bounds. Agents with an empty route are not mentioned in the plan (they keep their
+other perception routes fly at ``search_altitude`` (high: a wide view). A hybrid on an action
+route flies it at ``dump_altitude`` (:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`: by default
+the top of its bounds, the widest dump; the rule of every built-in scheduler). Altitudes are
+clipped to each agent's bounds. Agents with an empty route are not mentioned in the plan (they keep their
 current route), as in ``greedy``.
 
 **Model size**: a role with more than ``group_vehicles`` vehicles is split into groups of at
@@ -177,6 +179,9 @@ class RoutingScheduler:
         A fire sensed within this many seconds counts as fresh.
     watch_altitude, search_altitude : float
         Altitudes (m) of watching and searching perception agents (clipped to their bounds).
+    dump_altitude : float or None
+        Altitude (m) of a hybrid (camera and water) on an action route, clipped to its bounds;
+        None (default): the top of its bounds.
     max_watch_fraction : float
         Largest share of the perception vehicles offered a fire to watch (at least one; one
         fire per connected fire), so the others keep searching.
@@ -218,6 +223,7 @@ class RoutingScheduler:
         fresh_s: float = 5.0,
         watch_altitude: float = 35.0,
         search_altitude: float = 70.0,
+        dump_altitude: float | None = None,
         max_watch_fraction: float = 0.5,
         cap_all_watch: bool = True,
         charge_return: bool = False,
@@ -250,6 +256,9 @@ class RoutingScheduler:
         self.fresh_s = float_setting("fresh_s", fresh_s, 0, unit=" s")
         self.watch_altitude = float_setting("watch_altitude", watch_altitude, 0, lo_open=True)
         self.search_altitude = float_setting("search_altitude", search_altitude, 0, lo_open=True)
+        self.dump_altitude = None if dump_altitude is None else float_setting(
+            "dump_altitude", dump_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
+        )  # fmt: skip
         self.max_watch_fraction = float_setting("max_watch_fraction", max_watch_fraction, 0, 1)
         self.cap_all_watch = bool_setting("cap_all_watch", cap_all_watch)
         self.charge_return = bool_setting("charge_return", charge_return)
@@ -293,6 +302,9 @@ class RoutingScheduler:
         alts: dict[str, float] = {}
         sols: dict[str, list[RoutesResult]] = {}
         first_fires = self._route_actors(graph, actors, sensors, deadline, warm, routes, sols)
+        for i in actors[graph.agent_can_sense[actors]].tolist():  # hybrids: from the dump altitude
+            if graph.agent_ids[i] in routes:
+                alts[graph.agent_ids[i]] = graph.dump_altitude(i, self.dump_altitude)
         if sensors.size:
             self._route_sensors(graph, sensors, first_fires, deadline, warm, routes, alts, sols)
         self._last = (graph.time_s, graph.agent_ids, dict(routes))

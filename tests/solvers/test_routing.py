@@ -107,8 +107,9 @@ def test_routes_are_feasible_on_episode_graphs(name):
 
 
 def test_hybrids_act_while_they_have_water_and_search_without():
-    """A hybrid with water is routed over fires only and gets no altitude; with an empty tank it
-    is routed like a perception agent (search blocks, with an altitude)."""
+    """A hybrid with water is routed over fires only and flies them at its dump altitude (the
+    top of its bounds by default); with an empty tank it is routed like a perception agent
+    (search blocks, with an altitude)."""
     g = next(g for g in episode_graphs("open_world_example", TICKS) if g.fire_tasks.size)
     hybrids = np.flatnonzero(g.agent_can_act & g.agent_can_sense)
     assert hybrids.size
@@ -118,7 +119,9 @@ def test_hybrids_act_while_they_have_water_and_search_without():
         a = g.agent_ids[i]
         if plan.routes.get(a):
             assert all(g.task_kind[g.task_index[t]] == TaskKind.FIRE for t in plan.routes[a])
-        assert a not in plan.altitudes
+            assert plan.altitudes[a] == g.dump_altitude(int(i)) == g.agent_alt_range[i][1]
+        else:
+            assert a not in plan.altitudes
     dry = dataclasses.replace(g, agent_tank=np.where(g.agent_can_sense, 0, g.agent_tank))
     plan = plan_of(dry, **FAST)
     check_routing_plan(dry, plan)
