@@ -145,7 +145,9 @@ class MilpParams:
         int_setting("cover_levels", self.cover_levels, 1, 1000)
         float_setting("watch_altitude", self.watch_altitude, 0.0, unit=" m")
         if self.dump_altitude is not None:
-            float_setting("dump_altitude", self.dump_altitude, 0.0, unit=" m")
+            float_setting(
+                "dump_altitude", self.dump_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
+            )
         if self.search_altitude is not None:
             float_setting("search_altitude", self.search_altitude, 0.0, unit=" m")
         int_setting("max_routes", self.max_routes, 1)

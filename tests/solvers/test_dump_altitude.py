@@ -78,10 +78,10 @@ def test_every_scheduler_flies_its_hybrids_dumps_at_the_dump_altitude(name, z):
     assert seen
 
 
-@pytest.mark.parametrize("name", ["greedy", "routing", "cbba"])
-@pytest.mark.parametrize("bad", [0.0, -5.0, float("nan"), "high"])
+@pytest.mark.parametrize("name", ["greedy", "routing", "cbba", "milp"])
+@pytest.mark.parametrize("bad", [0.0, -5.0, float("nan"), float("inf"), "high"])
 def test_a_bad_dump_altitude_is_refused_in_one_line(name, bad):
-    """A dump altitude that is not a positive finite number is refused at construction, with
-    the setting's name in the message."""
+    """A dump altitude that is not a positive finite number is refused at construction by every
+    scheduler that has the setting, with the setting's name in the message."""
     with pytest.raises((SettingError, ValueError), match="dump_altitude"):
         make_scheduler(name, dump_altitude=bad)
