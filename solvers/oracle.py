@@ -43,10 +43,11 @@ Examples
 'oracle[routing]'
 
 A greedy oracle is a reference, not a bound. It beats greedy on #24 seeds 0-2 (by 17.7-55.3
-points) and on the mean of fcplan-bench-v2's hard tier (140.4 against 119.8 over 120 pairs), but
-not everywhere: on that tier's hard-04, hard-11 and hard-12 greedy scores higher on the mean
-(hard-04: 206.3 against 168.6), the oracle's action agents leaving more sensed fire unpruned late
-in the episode. The leaderboard takes, per (scenario, seed), the best of the oracle variants run.
+points) and on the mean of fcplan-bench-v2's hard tier (148.5 against 135.4 over 120 pairs,
+``docs/leaderboard.md``), but not everywhere: on that tier's hard-04, hard-06, hard-11 and
+hard-12 greedy scores higher on the mean (hard-04: 215.5 against 182.6), the oracle's action
+agents leaving more sensed fire unpruned late in the episode. The leaderboard takes, per
+(scenario, seed), the best of the oracle variants run.
 """
 
 from __future__ import annotations
