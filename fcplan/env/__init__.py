@@ -32,10 +32,11 @@ joint action), :func:`demonstrations` / :func:`load_demonstrations` (expert data
 registered scheduler, stored as npz without pickle) and :mod:`fcplan.env.bc` (a small numpy
 behaviour-cloning baseline). Everything is imported lazily, so ``import fcplan.env`` is cheap
 and does not need PettingZoo until an environment is made; it registers the Gymnasium ids
-``fcplan/Task-v0``, ``fcplan/Motion-v0``, ``fcplan/MotionBase-v0``, ``fcplan/MotionCmplx1-v0``
-and ``fcplan/MotionCmplx2-v0`` (:mod:`fcplan.env.registration`).
+``fcplan/Task-v1``, ``fcplan/Task-v0``, ``fcplan/Motion-v0``, ``fcplan/MotionBase-v0``,
+``fcplan/MotionCmplx1-v0`` and ``fcplan/MotionCmplx2-v0`` (:mod:`fcplan.env.registration`).
 
-Standard integrations: the versioned PettingZoo modules :mod:`~fcplan.env.task_v0`,
+Standard integrations: the versioned PettingZoo modules :mod:`~fcplan.env.task_v1` (hybrids
+dump from the top of their bounds, as the schedulers' do), :mod:`~fcplan.env.task_v0`,
 :mod:`~fcplan.env.motion_v0`, :mod:`~fcplan.env.base_v0`, :mod:`~fcplan.env.cmplx1_v0` and
 :mod:`~fcplan.env.cmplx2_v0` (``env()``, ``parallel_env()``, ``raw_env``;
 :mod:`fcplan.env.versions`); the options ``obs_layout="flat"`` and ``pad_actions=True``
@@ -108,7 +109,7 @@ _LAZY = {
 
 
 #: the versioned PettingZoo modules, imported on first access as attributes
-VERSIONED = ("task_v0", "motion_v0", "base_v0", "cmplx1_v0", "cmplx2_v0")
+VERSIONED = ("task_v0", "task_v1", "motion_v0", "base_v0", "cmplx1_v0", "cmplx2_v0")
 
 
 def __getattr__(name: str) -> Any:

@@ -5,6 +5,8 @@ id                         environment                                     defau
 =========================  ==============================================  =====================
 ``fcplan/Task-v0``         :class:`fcplan.env.gym_view.TaskGymEnv`: the    ``scenario="practice"``
                            task level, joint ``MultiDiscrete`` action
+``fcplan/Task-v1``         the same, hybrids dumping from the top of their  ``scenario="practice"``,
+                           bounds (:mod:`fcplan.env.task_v1`)               ``dump_altitude=None``
 ``fcplan/Motion-v0``       :class:`fcplan.env.joint_gym.JointGymEnv` on    ``scenario="practice"``
                            :class:`fcplan.env.motion.MotionEnv`
 ``fcplan/MotionBase-v0``   the ``base`` preset (:mod:`~fcplan.env.presets`) ``preset="base"``
@@ -51,6 +53,10 @@ _JOINT = "fcplan.env.joint_gym:JointGymEnv"
 #: Gymnasium id -> (entry point, default keyword arguments).
 ENV_IDS: dict[str, tuple[str, dict[str, Any]]] = {
     "fcplan/Task-v0": ("fcplan.env.gym_view:TaskGymEnv", {"scenario": "practice"}),
+    "fcplan/Task-v1": (
+        "fcplan.env.gym_view:TaskGymEnv",
+        {"scenario": "practice", "dump_altitude": None},
+    ),
     "fcplan/Motion-v0": (_JOINT, {"scenario": "practice"}),
     "fcplan/MotionBase-v0": (_JOINT, {"preset": "base"}),
     "fcplan/MotionCmplx1-v0": (_JOINT, {"preset": "cmplx1"}),
@@ -62,6 +68,7 @@ ENV_IDS: dict[str, tuple[str, dict[str, Any]]] = {
 VECTOR_ENTRY_POINTS: dict[str, str] = {
     "fcplan/Motion-v0": "fcplan.env.vector:motion_vector_env",
     "fcplan/Task-v0": "fcplan.env.vector:task_vector_env",
+    "fcplan/Task-v1": "fcplan.env.vector:task_vector_env",
 }
 
 

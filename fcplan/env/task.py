@@ -29,6 +29,11 @@ Arguments
     Truncate earlier than the scenario's duration (handy for tests).
 ``watch_altitude``, ``search_altitude`` (35 m, 70 m)
     Altitudes given to agents with a camera sent to a fire / a search block.
+``dump_altitude`` (``"watch"``)
+    Altitude of a hybrid with water sent to a fire (it dumps there): ``"watch"``, the
+    ``task_v0`` rule, ``watch_altitude``; None, the ``task_v1`` rule and every built-in
+    scheduler's, the top of its bounds (:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`); or a
+    number of metres, clipped to its bounds.
 ``prune_bonus`` (default 0.0)
     Optional shaping: this much reward per cell put out during the step. Off by default, so the
     return is exactly minus the manual's total negative reward.
@@ -135,6 +140,22 @@ from fcplan.world import World
 __all__ = ["TaskEnv"]
 
 
+def _dump_altitude(value: Any, watch_altitude: float) -> float | None:
+    """The ``dump_altitude`` option resolved: ``"watch"`` -> ``watch_altitude``, None, or a
+    finite number in (0, 10000] m; anything else is an :class:`EnvError` naming the option."""
+    if value is None:
+        return None
+    if isinstance(value, str) and value == "watch":
+        return watch_altitude
+    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
+        z = float(value)
+        if np.isfinite(z) and 0.0 < z <= 10_000.0:
+            return z
+    raise EnvError(
+        f"dump_altitude: must be 'watch', None or a number of metres in (0, 10000] (got {value!r})"
+    )
+
+
 class TaskEnv(ParallelEnv):
     """Task-level parallel environment (the module docstring is its documentation page)."""
 
@@ -154,6 +175,7 @@ class TaskEnv(ParallelEnv):
         max_steps: int | None = None,
         watch_altitude: float = 35.0,
         search_altitude: float = 70.0,
+        dump_altitude: float | str | None = "watch",
         prune_bonus: float = 0.0,
         illegal_action: str = "noop",
         validate: bool = True,
@@ -183,6 +205,8 @@ class TaskEnv(ParallelEnv):
         self.max_steps = n_steps if max_steps is None else min(int(max_steps), n_steps)
         self.watch_altitude = float(watch_altitude)
         self.search_altitude = float(search_altitude)
+        #: the resolved dump altitude: a number (``"watch"``: ``watch_altitude``) or None
+        self.dump_altitude = _dump_altitude(dump_altitude, self.watch_altitude)
         self.prune_bonus = float(prune_bonus)
         self.illegal_action = illegal_action
         self.validate = bool(validate)
@@ -292,11 +316,16 @@ class TaskEnv(ParallelEnv):
             if not all(legal[i, rows_l[i]] for i in sent):
                 # legal_tasks is validate_plan's arithmetic for one-task routes: only a bug gets
                 # here, and validate_plan names the offending agent and task
-                alts = dict(
-                    watch_altitude=self.watch_altitude, search_altitude=self.search_altitude
+                alts = {
+                    "watch_altitude": self.watch_altitude,
+                    "search_altitude": self.search_altitude,
+                }
+                validate_plan(
+                    actions_plan(graph, rows, **alts, dump_altitude=self.dump_altitude), graph
                 )
-                validate_plan(actions_plan(graph, rows, **alts), graph)
-        commands, pos = rows_commands(graph, rows_l, self.watch_altitude, self.search_altitude)
+        commands, pos = rows_commands(
+            graph, rows_l, self.watch_altitude, self.search_altitude, self.dump_altitude
+        )
         goal = self._goal
         for i, p in zip(sent, pos, strict=True):
             goal[i] = p

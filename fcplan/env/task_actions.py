@@ -20,8 +20,11 @@ Illegal actions
 Altitude
     A perception-only agent sent to a fire watches it at ``watch_altitude`` (low: high sensing
     confidence), sent to a search block it flies at ``search_altitude`` (a wide view). A hybrid
-    flies at ``watch_altitude`` over fires and ``search_altitude`` over blocks too. Both are
-    clipped to the agent's bounds; action-only agents fly at their fixed altitude.
+    with water sent to a fire dumps on it from ``dump_altitude``: in ``task_v0`` (the default)
+    that is ``watch_altitude`` too; in ``task_v1`` it is None, the rule of every built-in
+    scheduler (:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`: the top of its bounds, the
+    widest dump). A hybrid flies at ``search_altitude`` over blocks. All are clipped to the
+    agent's bounds; action-only agents fly at their fixed altitude.
 
 Plans to actions (:func:`plan_to_actions`, used by the demonstrations)
     The first task of each agent's route becomes the slot that holds it. A task outside the
@@ -132,20 +135,54 @@ def actions_plan(
     *,
     watch_altitude: float = 35.0,
     search_altitude: float = 70.0,
+    dump_altitude: float | None | str = "watch",
 ) -> Plan:
-    """A one-task-per-agent :class:`Plan` from chosen task rows (``-1``: not mentioned)."""
+    """A one-task-per-agent :class:`Plan` from chosen task rows (``-1``: not mentioned); a
+    hybrid with water sent to a fire at ``dump_altitude`` (``"watch"``: ``watch_altitude``;
+    None: the top of its bounds)."""
     routes: dict[str, tuple[str, ...]] = {}
     alts: dict[str, float] = {}
     ids, tids = graph.agent_ids, graph.task_ids
-    fire = (graph.task_kind == _FIRE).tolist()
-    sense = graph.agent_can_sense.tolist()
     rows_l = rows.tolist()
     for i in np.flatnonzero(rows >= 0).tolist():
-        t = rows_l[i]
-        routes[ids[i]] = (tids[t],)
-        if sense[i]:
-            alts[ids[i]] = graph.clip_altitude(i, watch_altitude if fire[t] else search_altitude)
+        routes[ids[i]] = (tids[rows_l[i]],)
+    dump = _resolved(dump_altitude, watch_altitude)
+    for i, z in _altitudes(graph, rows_l, watch_altitude, search_altitude, dump).items():
+        alts[ids[i]] = z
     return Plan(routes=routes, altitudes=alts)
+
+
+def _resolved(dump_altitude: float | None | str, watch_altitude: float) -> float | None:
+    """``dump_altitude`` as a number or None (``"watch"``: ``watch_altitude``)."""
+    if isinstance(dump_altitude, str):
+        if dump_altitude != "watch":
+            raise ValueError(f"dump_altitude: 'watch', None or metres (got {dump_altitude!r})")
+        return watch_altitude
+    return dump_altitude
+
+
+def _altitudes(
+    graph: TaskGraph,
+    rows: list[int],
+    watch_altitude: float,
+    search_altitude: float,
+    dump_altitude: float | None,
+) -> dict[int, float]:
+    """Agent row -> commanded altitude of every camera agent sent to a task (the module's rule)."""
+    sense = _as_list(graph, "agent_can_sense")
+    act, tank = _as_list(graph, "agent_can_act"), graph.agent_tank.tolist()
+    kind = graph.task_kind
+    out: dict[int, float] = {}
+    for i, t in enumerate(rows):
+        if t < 0 or not sense[i]:
+            continue
+        if kind[t] != _FIRE:
+            out[i] = graph.clip_altitude(i, search_altitude)
+        elif act[i] and tank[i] > 0:
+            out[i] = graph.dump_altitude(i, dump_altitude)
+        else:
+            out[i] = graph.clip_altitude(i, watch_altitude)
+    return out
 
 
 def actions_commands(
@@ -154,6 +191,7 @@ def actions_commands(
     *,
     watch_altitude: float = 35.0,
     search_altitude: float = 70.0,
+    dump_altitude: float | None | str = "watch",
 ) -> dict[str, Command]:
     """``plan_commands(actions_plan(graph, rows, ...), graph)`` built directly from the rows
     (the environment's per-step path: no task-id lookups).
@@ -168,29 +206,31 @@ def actions_commands(
     >>> actions_commands(g, rows) == plan_commands(actions_plan(g, rows), g)
     True
     """
-    return rows_commands(graph, rows.tolist(), watch_altitude, search_altitude)[0]
+    dump = _resolved(dump_altitude, watch_altitude)
+    return rows_commands(graph, rows.tolist(), watch_altitude, search_altitude, dump)[0]
 
 
 def rows_commands(
-    graph: TaskGraph, rows: list[int], watch_altitude: float, search_altitude: float
+    graph: TaskGraph,
+    rows: list[int],
+    watch_altitude: float,
+    search_altitude: float,
+    dump_altitude: float | None,
 ) -> tuple[dict[str, Command], list[list[float]]]:
-    """:func:`actions_commands` from the rows as a list of ints; also returns the ``[x, y]``
-    task position of each agent sent somewhere (agent row order)."""
+    """:func:`actions_commands` from the rows as a list of ints (``dump_altitude`` resolved:
+    a number or None); also returns the ``[x, y]`` task position of each agent sent somewhere
+    (agent row order)."""
     sel = [i for i, t in enumerate(rows) if t >= 0]
     if not sel:
         return {}, []
     t = [rows[i] for i in sel]
     pos = graph.task_pos[t].tolist()
-    kind = graph.task_kind[t].tolist()
-    sense = _as_list(graph, "agent_can_sense")
+    alts = _altitudes(graph, rows, watch_altitude, search_altitude, dump_altitude)
     ids = graph.agent_ids
     out: dict[str, Command] = {}
     for j, i in enumerate(sel):
-        z = None
-        if sense[i]:
-            z = graph.clip_altitude(i, watch_altitude if kind[j] == _FIRE else search_altitude)
         x, y = pos[j]
-        out[ids[i]] = Command(route=((x, y),), patrol=False, altitude=z)
+        out[ids[i]] = Command(route=((x, y),), patrol=False, altitude=alts.get(i))
     return out, pos
 
 

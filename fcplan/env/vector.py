@@ -11,7 +11,8 @@ over worlds on the per-tick path):
 
 ``mode="task"`` (:class:`fcplan.env.vector_task.VectorTaskEnv`)
     One step is one replan period of every world; actions ``(B, A)`` candidate slots,
-    observations ``(B, A, ...)``; world ``i`` is ``fcplan/Task-v0`` with seed ``s + i``. The
+    observations ``(B, A, ...)``; world ``i`` is ``fcplan/Task-v0`` with seed ``s + i``
+    (``fcplan/Task-v1`` with ``dump_altitude=None``, the env option of hybrids' dumps). The
     ticks are batched; the belief, task graph, candidates and features stay per world (that
     module says why and ``bench/README.md`` measures it).
 
@@ -19,8 +20,8 @@ over worlds on the per-tick path):
 worker processes (:class:`fcplan.env.vector_shards.ShardedVectorEnv`: the same worlds and
 steps, on ``K`` cores).
 
-``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` (and ``"fcplan/Task-v0"``)
-return the same envs (the ids' ``vector_entry_point``, :func:`motion_vector_env` and
+``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` (and ``"fcplan/Task-v0"``,
+``"fcplan/Task-v1"``) return the same envs (the ids' ``vector_entry_point``, :func:`motion_vector_env` and
 :func:`task_vector_env`; ``processes=P`` too); ``vectorization_mode="sync"`` still gives
 Gymnasium's ``SyncVectorEnv`` of single envs, which the batched ones match step for step.
 

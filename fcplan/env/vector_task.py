@@ -40,7 +40,7 @@ builder path of a graph without known fire), which the schedulers (:meth:`expert
 the user read. ``bench/README.md`` measures the shares.
 
 Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
-``watch_altitude``, ``search_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
+``watch_altitude``, ``search_altitude``, ``dump_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
 (masked actions always act as the no-op, as in ``fcplan/Task-v0``).
 
 Examples
@@ -360,7 +360,13 @@ class VectorTaskEnv(BatchedEnv):
         w, slot = worlds[n], s[n, i, 0]
         goals = self._slot_pos[w, i, slot]
         team = self.batch.team
-        alt = np.where(self._slot_fire[w, i, slot], one.watch_altitude, one.search_altitude)
+        fire = self._slot_fire[w, i, slot]
+        alt = np.where(fire, one.watch_altitude, one.search_altitude)
+        dumper = fire & team.can_act[i] & (team.tank[w, i] > 0)  # hybrids among the cameras
+        if one.dump_altitude is None:
+            alt = np.where(dumper, team.alt_hi[i], alt)
+        else:
+            alt = np.where(dumper, one.dump_altitude, alt)
         alt = np.minimum(np.maximum(alt, team.alt_lo[i]), team.alt_hi[i])
         alt[~team.can_sense[i]] = np.nan
         self._goal[w, i] = goals
@@ -377,8 +383,10 @@ class VectorTaskEnv(BatchedEnv):
         sent = [i for i, t in enumerate(rows_l) if t >= 0]
         if sent and one.validate and not all(cand.legal[i, rows_l[i]] for i in sent):
             alts = {"watch_altitude": one.watch_altitude, "search_altitude": one.search_altitude}
-            validate_plan(actions_plan(graph, rows, **alts), graph)
-        commands, pos = rows_commands(graph, rows_l, one.watch_altitude, one.search_altitude)
+            validate_plan(actions_plan(graph, rows, **alts, dump_altitude=one.dump_altitude), graph)
+        commands, pos = rows_commands(
+            graph, rows_l, one.watch_altitude, one.search_altitude, one.dump_altitude
+        )
         for i, p in zip(sent, pos, strict=True):
             self._goal[b, i] = p
         self.batch.team.apply(b, commands)

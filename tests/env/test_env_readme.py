@@ -22,7 +22,7 @@ def test_gymnasium_example_runs():
     """The Gymnasium block makes fcplan/Task-v0 on scenario 24 and resets it."""
     ns: dict = {}
     exec(compile(_blocks()[0], str(README), "exec"), ns)
-    assert ns["env"].spec.id == "fcplan/Task-v0"
+    assert ns["env"].spec.id == "fcplan/Task-v1"
 
 
 def test_supersuit_recipe_runs_and_prints_what_it_says(capsys):

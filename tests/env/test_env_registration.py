@@ -18,6 +18,7 @@ from fcplan.env.registration import ENV_IDS
 # small settings per id so that the checker's episodes stay short
 SMALL = {
     "fcplan/Task-v0": {"k": 4, "max_steps": 6},
+    "fcplan/Task-v1": {"k": 4, "max_steps": 6},
     "fcplan/Motion-v0": {"render_size": 96},
     "fcplan/MotionBase-v0": {"max_steps": 20},
     "fcplan/MotionCmplx1-v0": {"max_steps": 20},
@@ -26,11 +27,12 @@ SMALL = {
 
 
 def test_every_id_is_registered():
-    """Importing fcplan.env registers every id of ENV_IDS, each with a version."""
+    """Importing fcplan.env registers every id of ENV_IDS, each with the version its name
+    ends with."""
     assert set(SMALL) == set(ENV_IDS)
     for env_id in ENV_IDS:
         spec = gymnasium.spec(env_id)
-        assert spec.namespace == "fcplan" and spec.version == 0
+        assert spec.namespace == "fcplan" and spec.version == int(env_id.rsplit("-v", 1)[1])
 
 
 @pytest.mark.parametrize("env_id", sorted(ENV_IDS))

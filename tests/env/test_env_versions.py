@@ -1,5 +1,5 @@
-"""Versioned PettingZoo modules (task_v0, motion_v0, base_v0, cmplx1_v0, cmplx2_v0) and the
-layout options (obs_layout="flat", pad_actions=True)."""
+"""Versioned PettingZoo modules (task_v0, task_v1, motion_v0, base_v0, cmplx1_v0, cmplx2_v0)
+and the layout options (obs_layout="flat", pad_actions=True)."""
 
 from __future__ import annotations
 
@@ -15,13 +15,15 @@ from fcplan.env.motion import MotionEnv
 from fcplan.env.task import TaskEnv
 from tests.conftest import scenario_with
 
-MODULES = ["task_v0", "motion_v0", "base_v0", "cmplx1_v0", "cmplx2_v0"]
+MODULES = ["task_v0", "task_v1", "motion_v0", "base_v0", "cmplx1_v0", "cmplx2_v0"]
 
 
 def _kwargs(name: str) -> dict:
     """Short episodes for every module."""
     if name == "task_v0":
         return {"scenario": 24, "k": 4, "max_steps": 8}
+    if name == "task_v1":
+        return {"scenario": "open_world_example", "k": 4, "max_steps": 8}
     if name == "motion_v0":
         return {"scenario": scenario_with("practice", duration_s=4.0)}
     return {"max_steps": 60}

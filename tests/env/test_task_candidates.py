@@ -142,6 +142,45 @@ def test_actions_commands_equal_plan_commands(seed, n_agents, k):
     assert list(fast.items()) == list(slow.items())
 
 
+@settings(max_examples=30, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n_agents=st.integers(2, 8),
+    dump=st.sampled_from(["watch", None, 20.0, 90.0, 500.0]),
+)
+def test_hybrids_sent_to_fires_fly_at_the_dump_altitude(seed, n_agents, dump):
+    """The env's altitude rule: a hybrid with water sent to a fire flies at
+    ``graph.dump_altitude(i, d)`` (``d`` = ``watch_altitude`` for ``"watch"``, v0's rule); a
+    camera agent sent to a block at ``search_altitude``, one without water sent to a fire at
+    ``watch_altitude`` (all clipped); action-only agents get no altitude; and actions_commands
+    equals plan_commands(actions_plan(...)) under every rule."""
+    import dataclasses
+
+    from fcplan.env.task_actions import actions_commands
+    from fcplan.plan import plan_commands
+
+    rng = np.random.default_rng(seed)
+    g = synthetic_task_graph(n_agents, 25, rng)
+    hybrid = g.agent_can_sense & (rng.random(n_agents) < 0.6)
+    tank = np.where(hybrid, rng.integers(0, 3, n_agents), g.agent_tank)
+    g = dataclasses.replace(g, agent_can_act=g.agent_can_act | hybrid, agent_tank=tank)
+    rows = np.where(rng.random(n_agents) < 0.2, -1, rng.integers(0, g.n_tasks, n_agents))
+    za, zs = 35.0, 70.0
+    cmds = actions_commands(g, rows, watch_altitude=za, search_altitude=zs, dump_altitude=dump)
+    plan = actions_plan(g, rows, watch_altitude=za, search_altitude=zs, dump_altitude=dump)
+    assert list(cmds.items()) == list(plan_commands(plan, g).items())
+    for i, t in enumerate(rows.tolist()):
+        z = cmds[g.agent_ids[i]].altitude if t >= 0 else None
+        if t < 0 or not g.agent_can_sense[i]:
+            assert z is None
+        elif g.task_kind[t] != TaskKind.FIRE:
+            assert z == g.clip_altitude(i, zs)
+        elif g.agent_can_act[i] and g.agent_tank[i] > 0:
+            assert z == g.dump_altitude(i, za if dump == "watch" else dump)
+        else:
+            assert z == g.clip_altitude(i, za)
+
+
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1), n_agents=st.integers(2, 6), n_tasks=st.integers(1, 30))
 def test_validate_plan_fast_path_matches_checks(seed, n_agents, n_tasks):

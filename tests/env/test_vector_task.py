@@ -71,6 +71,42 @@ def test_equals_single_envs_64(name):
     compare(sc, 64, sc.n_ticks // sc.ticks_per_second + 3)
 
 
+@pytest.mark.parametrize("dump", [None, 60.0])
+def test_equals_single_envs_with_the_dump_altitude(dump):
+    """``dump_altitude`` (``fcplan/Task-v1``'s None, or metres): the batched env's decoding of
+    hybrids sent to fires equals the single env's, on the open world's hybrids."""
+    compare(load_scenario("open_world_example").replace(duration_s=8), 5, 16, k=5,
+            dump_altitude=dump)  # fmt: skip
+
+
+def test_v1_rule_flies_hybrids_at_the_top_on_fires():
+    """Under ``fcplan/Task-v1`` a hybrid with water sent to a fire is commanded to the top of
+    its bounds; under ``fcplan/Task-v0`` to ``watch_altitude``; checked on every such choice of
+    a random 30-step open-world episode (at least one)."""
+    seen = 0
+    for dump, want in ((None, "top"), ("watch", "watch")):
+        env = VectorTaskEnv("open_world_example", 1, k=5, dump_altitude=dump)
+        obs, _ = env.reset(seed=4)
+        rng = np.random.default_rng(4)
+        team, one = env.batch.team, env.one
+        for _ in range(30):
+            m = obs["action_mask"][0]
+            act = np.array([[rng.choice(np.flatnonzero(m[j])) for j in range(m.shape[0])]])
+            g = env.graphs[0]
+            fire_slot = [j < one.k and bool(env._slot_fire[0, i, j]) for i, j in enumerate(act[0])]
+            tank = team.tank[0].copy()
+            obs, _, _, _, info = env.step(act)
+            sent = ~(info["conflict"][0] | info["illegal"][0])
+            for i in range(one.n_agents):
+                hybrid = g.agent_can_sense[i] and g.agent_can_act[i] and tank[i] > 0
+                if sent[i] and fire_slot[i] and hybrid:
+                    lo, hi = (float(v) for v in g.agent_alt_range[i])
+                    z = hi if want == "top" else min(max(one.watch_altitude, lo), hi)
+                    assert team.z_target[0, i] == z
+                    seen += 1
+    assert seen
+
+
 def test_other_modes_and_options():
     """Same-step autoreset; ``max_steps`` truncation; a replan period of one tick and shaping."""
     sc = load_scenario(24).replace(duration_s=4)
@@ -103,6 +139,9 @@ def test_errors():
         vector_env("practice", "task", 2, render_mode="rgb_array")
     with pytest.raises(EnvError, match="k:"):
         vector_env("practice", "task", 2, k=0)
+    for bad in (0.0, -1.0, float("nan"), "top", True):
+        with pytest.raises(EnvError, match="dump_altitude"):
+            vector_env("practice", "task", 2, dump_altitude=bad)
     env = vector_env("practice", "task", 2)
     with pytest.raises(EnvError, match="reset"):
         env.step(np.zeros((2, 4), dtype=np.int64))
