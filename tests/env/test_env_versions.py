@@ -115,3 +115,21 @@ def test_unknown_layout_is_one_line_error():
     """An unknown obs_layout is refused with a one-line error naming the allowed values."""
     with pytest.raises(EnvError, match=r"obs_layout: must be one of dict, flat"):
         parallel_env(24, obs_layout="nested")
+
+
+def test_task_versions_agree_without_hybrids():
+    """task_v0 and task_v1 differ only in a hybrid's dump altitude: on #24 (no hybrids) the
+    same seed and actions give the same observations and rewards step for step."""
+    from fcplan.env import task_v0, task_v1
+
+    envs = [m.parallel_env(scenario=24, k=4, max_steps=12) for m in (task_v0, task_v1)]
+    obs = [e.reset(seed=3)[0] for e in envs]
+    rng = np.random.default_rng(3)
+    while envs[0].agents:
+        act = {a: int(rng.choice(np.flatnonzero(obs[0][a]["action_mask"]))) for a in obs[0]}
+        out = [e.step(act) for e in envs]
+        for a in obs[0]:
+            for key in out[0][0][a]:
+                assert np.array_equal(out[0][0][a][key], out[1][0][a][key])
+        assert out[0][1] == out[1][1]
+        obs = [o[0] for o in out]
