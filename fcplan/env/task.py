@@ -133,8 +133,9 @@ from fcplan.env.task_candidates import (
 from fcplan.errors import EnvError
 from fcplan.metrics import compute_all
 from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario, period_ticks
-from fcplan.plan import validate_plan
+from fcplan.plan import Plan, validate_plan
 from fcplan.taskgraph import TaskGraph, TaskGraphParams
+from fcplan.team import Command
 from fcplan.world import World
 
 __all__ = ["TaskEnv"]
@@ -243,6 +244,26 @@ class TaskEnv(ParallelEnv):
         self.graph: TaskGraph | None = None
         self.candidates: Candidates | None = None
 
+    def rows_plan(self, graph: TaskGraph, rows: np.ndarray) -> Plan:
+        """The one-task plan of chosen task rows (``-1``: not mentioned) under this env's
+        altitude settings (:func:`~fcplan.env.task_actions.actions_plan`)."""
+        return actions_plan(
+            graph,
+            rows,
+            watch_altitude=self.watch_altitude,
+            search_altitude=self.search_altitude,
+            dump_altitude=self.dump_altitude,
+        )
+
+    def rows_commands(
+        self, graph: TaskGraph, rows: list[int]
+    ) -> tuple[dict[str, Command], list[list[float]]]:
+        """:func:`~fcplan.env.task_actions.rows_commands` under this env's altitude settings:
+        the commands of chosen task rows and the task position of each agent sent."""
+        return rows_commands(
+            graph, rows, self.watch_altitude, self.search_altitude, self.dump_altitude
+        )
+
     @property
     def world(self) -> World:
         """The live :class:`fcplan.world.World` (the mission's)."""
@@ -316,16 +337,8 @@ class TaskEnv(ParallelEnv):
             if not all(legal[i, rows_l[i]] for i in sent):
                 # legal_tasks is validate_plan's arithmetic for one-task routes: only a bug gets
                 # here, and validate_plan names the offending agent and task
-                alts = {
-                    "watch_altitude": self.watch_altitude,
-                    "search_altitude": self.search_altitude,
-                }
-                validate_plan(
-                    actions_plan(graph, rows, **alts, dump_altitude=self.dump_altitude), graph
-                )
-        commands, pos = rows_commands(
-            graph, rows_l, self.watch_altitude, self.search_altitude, self.dump_altitude
-        )
+                validate_plan(self.rows_plan(graph, rows), graph)
+        commands, pos = self.rows_commands(graph, rows_l)
         goal = self._goal
         for i, p in zip(sent, pos, strict=True):
             goal[i] = p

@@ -21,8 +21,8 @@ worker processes (:class:`fcplan.env.vector_shards.ShardedVectorEnv`: the same w
 steps, on ``K`` cores).
 
 ``gymnasium.make_vec("fcplan/Motion-v0", num_envs=B, scenario=...)`` (and ``"fcplan/Task-v0"``,
-``"fcplan/Task-v1"``) return the same envs (the ids' ``vector_entry_point``, :func:`motion_vector_env` and
-:func:`task_vector_env`; ``processes=P`` too); ``vectorization_mode="sync"`` still gives
+``"fcplan/Task-v1"``) return the same envs (the ids' ``vector_entry_point``,
+:func:`motion_vector_env` and :func:`task_vector_env`; ``processes=P`` too); ``vectorization_mode="sync"`` still gives
 Gymnasium's ``SyncVectorEnv`` of single envs, which the batched ones match step for step.
 
 Examples

@@ -40,8 +40,8 @@ builder path of a graph without known fire), which the schedulers (:meth:`expert
 the user read. ``bench/README.md`` measures the shares.
 
 Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
-``watch_altitude``, ``search_altitude``, ``dump_altitude``, ``prune_bonus``, ``validate``, ``graph_params``
-(masked actions always act as the no-op, as in ``fcplan/Task-v0``).
+``watch_altitude``, ``search_altitude``, ``dump_altitude``, ``prune_bonus``, ``validate``,
+``graph_params`` (masked actions always act as the no-op, as in ``fcplan/Task-v0``).
 
 Examples
 --------
@@ -71,10 +71,8 @@ from fcplan.env.action_input import integer_actions
 from fcplan.env.task import TaskEnv
 from fcplan.env.task_actions import (
     MappingCounts,
-    actions_plan,
     decode_actions,
     plan_to_actions,
-    rows_commands,
 )
 from fcplan.env.task_batch import batch_observe
 from fcplan.env.vector_base import BatchedEnv, per_world_info, reset_rows, reset_seeds
@@ -363,10 +361,8 @@ class VectorTaskEnv(BatchedEnv):
         fire = self._slot_fire[w, i, slot]
         alt = np.where(fire, one.watch_altitude, one.search_altitude)
         dumper = fire & team.can_act[i] & (team.tank[w, i] > 0)  # hybrids among the cameras
-        if one.dump_altitude is None:
-            alt = np.where(dumper, team.alt_hi[i], alt)
-        else:
-            alt = np.where(dumper, one.dump_altitude, alt)
+        dump = team.alt_hi[i] if one.dump_altitude is None else one.dump_altitude
+        alt = np.where(dumper, dump, alt)
         alt = np.minimum(np.maximum(alt, team.alt_lo[i]), team.alt_hi[i])
         alt[~team.can_sense[i]] = np.nan
         self._goal[w, i] = goals
@@ -382,11 +378,8 @@ class VectorTaskEnv(BatchedEnv):
         rows_l = rows.tolist()
         sent = [i for i, t in enumerate(rows_l) if t >= 0]
         if sent and one.validate and not all(cand.legal[i, rows_l[i]] for i in sent):
-            alts = {"watch_altitude": one.watch_altitude, "search_altitude": one.search_altitude}
-            validate_plan(actions_plan(graph, rows, **alts, dump_altitude=one.dump_altitude), graph)
-        commands, pos = rows_commands(
-            graph, rows_l, one.watch_altitude, one.search_altitude, one.dump_altitude
-        )
+            validate_plan(one.rows_plan(graph, rows), graph)
+        commands, pos = one.rows_commands(graph, rows_l)
         for i, p in zip(sent, pos, strict=True):
             self._goal[b, i] = p
         self.batch.team.apply(b, commands)
