@@ -3,14 +3,15 @@
 Each scheduler's episodes in ``OLD`` and ``NEW`` are paired by (scenario, seed); per scheduler the
 script prints the paired difference ``new - old`` of a metric with its 95 % Student-t interval,
 the wins, ties and losses of the new episodes and the two-sided Wilcoxon signed-rank p. Episodes
-present in only one folder are left out (their count is printed). Typical use, after a change
+present in only one folder, or failed in either, are left out (their count is printed). Typical use, after a change
 that alters a scheduler's behaviour and a re-run of the affected episodes::
 
     git archive <old commit> bench/results/bench-v2 | tar -x -C /tmp/old
     python bench/compare_results.py /tmp/old/bench/results/bench-v2 bench/results/bench-v2 \\
         --schedulers greedy routing cbba oracle --scenarios hard-03 hard-04
 
-The episode files are read with pyarrow (columns by name, no pickles).
+The folders are read by :func:`fcplan.experiments.results.load_results` (the leaderboard's
+reader: damaged or foreign files are refused by name).
 """
 
 from __future__ import annotations
@@ -19,20 +20,23 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-import pyarrow.parquet as pq
 
+from fcplan.experiments.results import load_results
 from fcplan.experiments.stats import paired_mean_ci, wilcoxon_p
-
-_ID = ["scheduler", "scenario", "seed"]
 
 
 def _episodes(folder: Path, metric: str) -> dict[tuple[str, str, int], float]:
-    """(scheduler, scenario, seed) -> metric of every episode file in ``folder``."""
-    out: dict[tuple[str, str, int], float] = {}
-    for f in sorted(folder.glob("*.parquet")):
-        row = pq.read_table(f, columns=[*_ID, metric]).to_pylist()[0]
-        out[(str(row["scheduler"]), str(row["scenario"]), int(row["seed"]))] = float(row[metric])
-    return out
+    """(scheduler, scenario, seed) -> metric of every finished episode in ``folder``."""
+    df = load_results(folder)
+    if "status" in df.columns and len(df):
+        df = df[df["status"] != "failed"]
+    return {
+        (str(sched), str(scen), int(seed)): float(v)
+        for sched, scen, seed, v in zip(
+            df.get("scheduler", []), df.get("scenario", []), df.get("seed", []),
+            df.get(metric, []), strict=True,
+        )
+    }  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -8,8 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pyarrow as pa
-import pyarrow.parquet as pq
+from fcplan.experiments.results import write_row
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -17,9 +16,8 @@ ROOT = Path(__file__).resolve().parents[2]
 def _write(folder: Path, rows: list[tuple[str, str, int, float]]) -> None:
     folder.mkdir()
     for i, (sched, scen, seed, score) in enumerate(rows):
-        table = pa.table({"scheduler": [sched], "scenario": [scen], "seed": [seed],
-                          "manual.final_score": [score]})  # fmt: skip
-        pq.write_table(table, folder / f"{i:04d}.parquet")
+        write_row(folder, {"key": f"{i:016x}", "status": "ok", "scheduler": sched,
+                           "scenario": scen, "seed": seed, "manual.final_score": score})  # fmt: skip
 
 
 def test_pairs_by_scenario_and_seed(tmp_path):
