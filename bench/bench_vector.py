@@ -135,8 +135,8 @@ def batched_env(sc: Any, num: int, *, parts: bool, seed: int = 0) -> tuple[int, 
 
 def sync_env(sc: Any, num: int, level: str, seed: int = 0) -> tuple[int, Clock]:
     """World-steps of one whole episode of ``num`` worlds of Gymnasium's ``SyncVectorEnv`` of the
-    single env (``fcplan/Motion-v0`` or ``fcplan/Task-v0``), timed (``step`` only)."""
-    env_id = "fcplan/Motion-v0" if level == "motion" else "fcplan/Task-v0"
+    single env (``fcplan/Motion-v0`` or ``fcplan/Task-v1``), timed (``step`` only)."""
+    env_id = "fcplan/Motion-v0" if level == "motion" else "fcplan/Task-v1"
     env = gymnasium.make_vec(env_id, num, vectorization_mode="sync", scenario=sc)
     n_steps = sc.n_ticks + 1 if level == "motion" else VectorTaskEnv(sc, 1).one.max_steps + 1
     return _batched(env, n_steps, [], seed)
@@ -190,7 +190,7 @@ def memory_per_world(sc: Any, small: int, large: int, level: str = "motion") -> 
 
 
 def single_task(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
-    """Steps of ``episodes`` episodes of ``fcplan/Task-v0`` with random legal actions, timed."""
+    """Steps of ``episodes`` episodes of ``fcplan/Task-v1`` with random legal actions, timed."""
     env = TaskGymEnv(sc)
     rng = np.random.default_rng(seed)
     clock, steps = Clock(), 0

@@ -1,8 +1,9 @@
 """Task-level episodes of a demonstrations dataset: a scheduler's rollouts and human games.
 
 An :class:`EpisodeRecord` is one episode as the centralised task-level env
-``fcplan/Task-v0`` (:class:`fcplan.env.gym_view.TaskGymEnv`) sees it: ``T + 1`` joint
-observations (``agents`` ``(A, 17)``, ``tasks`` ``(A, k, 17)``, ``action_mask`` ``(A, k + 1)``),
+(:class:`fcplan.env.gym_view.TaskGymEnv` with the dataset's env options, ``fcplan/Task-v1`` by
+default) sees it: ``T + 1`` joint observations (``agents`` ``(A, 17)``, ``tasks``
+``(A, k, 17)``, ``action_mask`` ``(A, k + 1)``),
 ``T`` joint actions, rewards and per-step infos, plus the episode's scenario, seed, source and
 final metrics. :mod:`fcplan.env.demonstrations` flattens records into its npz rows and
 :mod:`fcplan.env.demo_minari` writes them as Minari episodes.
@@ -50,7 +51,7 @@ from fcplan.taskgraph import TaskKind
 __all__ = ["EpisodeRecord", "rollout_episode", "recording_episode", "OBS_KEYS"]
 __all__ += ["batched_rollouts", "scenario_from_metadata", "env_kwargs_from_metadata"]
 
-#: the keys of a joint observation (``fcplan/Task-v0``'s)
+#: the keys of a joint observation (the Gymnasium view's)
 OBS_KEYS = ("agents", "tasks", "action_mask")
 _FIRE = int(TaskKind.FIRE)
 
@@ -320,8 +321,10 @@ def scenario_from_metadata(metadata: dict[str, Any], key: str) -> Any:
 
 
 def env_kwargs_from_metadata(metadata: dict[str, Any]) -> dict[str, Any]:
-    """The task env's keyword arguments stored in a dataset's metadata."""
+    """The task env's keyword arguments stored in a dataset's metadata (a dataset that names no
+    ``dump_altitude`` was written when the env's default was ``"watch"``, ``task_v0``'s rule)."""
     kwargs = dict(metadata["env_kwargs"])
+    kwargs.setdefault("dump_altitude", "watch")
     if kwargs.get("graph_params") is not None:
         from fcplan.taskgraph import TaskGraphParams
 

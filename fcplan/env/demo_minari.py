@@ -5,13 +5,15 @@
 with :func:`write_minari` as one Minari dataset (``arrow`` storage, so no HDF5 library is
 needed). Load it with ``minari.load_dataset(dataset_id)`` (the same datasets root), iterate
 ``dataset.iterate_episodes()``, and :func:`replay_episode` plays an episode's actions again
-through ``fcplan/Task-v0``.
+through the task env of the dataset's options (``fcplan/Task-v1``'s defaults unless the
+dataset names others: a dataset whose options name no ``dump_altitude`` replays by
+``fcplan/Task-v0``'s rule, the default when it was written).
 
 ==========================  ==========================================================================
 Minari field                content
 ==========================  ==========================================================================
 observation space           ``Dict(agents=Box(-10, 10, (A, 17)), tasks=Box(-10, 10, (A, k, 17)),
-                            action_mask=Box(0, 1, (A, k + 1), int8))``: ``fcplan/Task-v0``'s
+                            action_mask=Box(0, 1, (A, k + 1), int8))``: the Gymnasium view's
 action space                ``MultiDiscrete([k + 1] * A)``: a candidate slot per agent, ``k`` the no-op
 episode ``observations``    ``T + 1`` rows (the last: after the last step)
 ``actions``, ``rewards``    ``T`` rows; the reward is the env's (minus the manual's negative reward)
@@ -194,8 +196,8 @@ def episode_options(dataset: Any, index: int) -> dict[str, Any]:
 
 
 def replay_episode(dataset: Any, index: int) -> dict[str, Any]:
-    """Play episode ``index``'s actions through a fresh ``fcplan/Task-v0`` (offline: the
-    scenario and env arguments come from the dataset's metadata).
+    """Play episode ``index``'s actions through a fresh task env (offline: the scenario and env
+    arguments come from the dataset's metadata).
 
     Returns
     -------

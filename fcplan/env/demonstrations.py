@@ -261,8 +261,7 @@ def demonstrations(
 
     jobs = _check_args(format, num_envs, jobs)
     sched, name, settings = _scheduler(scheduler)
-    env_kwargs = dict(env_kwargs or {})
-    env_kwargs.pop("render_mode", None)
+    env_kwargs = _env_kwargs(env_kwargs)
     seeds = [int(s) for s in seeds]
     scenarios, recordings = list(scenarios), list(recordings)
     bar = episode_progress(progress, "demonstrations")
@@ -451,6 +450,16 @@ class _Rollouts:
             k: (np.concatenate(v) if v else np.zeros((0,), dt)).astype(dt, copy=False)
             for (k, dt), v in zip(_ARRAYS.items(), self.parts.values(), strict=True)
         }
+
+
+def _env_kwargs(env_kwargs: dict[str, Any] | None) -> dict[str, Any]:
+    """The caller's env arguments without ``render_mode``, with ``dump_altitude`` (the env's
+    default, None, unless given): stored, so that a dataset names its hybrids' dump rule
+    whatever the env's default later is."""
+    out = dict(env_kwargs or {})
+    out.pop("render_mode", None)
+    out.setdefault("dump_altitude", None)
+    return out
 
 
 def _jsonable_kwargs(env_kwargs: dict[str, Any]) -> dict[str, Any]:

@@ -15,7 +15,8 @@ Info                ``tick``; per-agent ``illegal``/``conflict`` arrays; at the 
                     ``metrics`` (manual and reference2020 as dicts) and ``return``
 Render modes        ``"rgb_array"`` (the task env's frame) and ``"human"`` (that frame in a
                     pygame window, :mod:`fcplan.env.human`)
-Gymnasium id        ``fcplan/Task-v0`` (:mod:`fcplan.env.registration`)
+Gymnasium ids       ``fcplan/Task-v1`` (the env's defaults) and ``fcplan/Task-v0`` (v0's hybrid
+                    rule, ``dump_altitude="watch"``; :mod:`fcplan.env.registration`)
 ==================  ==================================================================
 
 Masked-out actions (an unmasked ``action_space.sample()``, as ``check_env`` does) act as the
@@ -71,7 +72,8 @@ class TaskGymEnv(WindowedRender, gymnasium.Env):
             )
         kwargs["render_mode"], human = split_options(self.render_mode)
         #: the pygame window of ``render_mode="human"`` (else None)
-        self.window = HumanWindow("fcplan_task_v0", self.metadata["render_fps"]) if human else None
+        title = str(TaskEnv.metadata["name"])
+        self.window = HumanWindow(title, self.metadata["render_fps"]) if human else None
         self.env = TaskEnv(scenario, **kwargs)
         e = self.env
         a, k = e.n_agents, e.k

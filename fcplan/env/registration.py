@@ -3,10 +3,13 @@
 =========================  ==============================================  =====================
 id                         environment                                     default kwargs
 =========================  ==============================================  =====================
-``fcplan/Task-v0``         :class:`fcplan.env.gym_view.TaskGymEnv`: the    ``scenario="practice"``
-                           task level, joint ``MultiDiscrete`` action
-``fcplan/Task-v1``         the same, hybrids dumping from the top of their  ``scenario="practice"``,
-                           bounds (:mod:`fcplan.env.task_v1`)               ``dump_altitude=None``
+``fcplan/Task-v1``         :class:`fcplan.env.gym_view.TaskGymEnv`: the    ``scenario="practice"``,
+                           task level, joint ``MultiDiscrete`` action;     ``dump_altitude=None``
+                           hybrids dump from the top of their bounds
+                           (:mod:`fcplan.env.task_v1`)
+``fcplan/Task-v0``         the same with v0's rule: such a hybrid flies    ``scenario="practice"``,
+                           at ``watch_altitude``                           ``dump_altitude="watch"``
+                           (:mod:`fcplan.env.task_v0`)
 ``fcplan/Motion-v0``       :class:`fcplan.env.joint_gym.JointGymEnv` on    ``scenario="practice"``
                            :class:`fcplan.env.motion.MotionEnv`
 ``fcplan/MotionBase-v0``   the ``base`` preset (:mod:`~fcplan.env.presets`) ``preset="base"``
@@ -52,10 +55,13 @@ _JOINT = "fcplan.env.joint_gym:JointGymEnv"
 
 #: Gymnasium id -> (entry point, default keyword arguments).
 ENV_IDS: dict[str, tuple[str, dict[str, Any]]] = {
-    "fcplan/Task-v0": ("fcplan.env.gym_view:TaskGymEnv", {"scenario": "practice"}),
     "fcplan/Task-v1": (
         "fcplan.env.gym_view:TaskGymEnv",
         {"scenario": "practice", "dump_altitude": None},
+    ),
+    "fcplan/Task-v0": (
+        "fcplan.env.gym_view:TaskGymEnv",
+        {"scenario": "practice", "dump_altitude": "watch"},
     ),
     "fcplan/Motion-v0": (_JOINT, {"scenario": "practice"}),
     "fcplan/MotionBase-v0": (_JOINT, {"preset": "base"}),

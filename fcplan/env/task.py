@@ -1,4 +1,4 @@
-"""Task-level FireCommander environment (PettingZoo ``ParallelEnv``): ``fcplan_task_v0``.
+"""Task-level FireCommander environment (PettingZoo ``ParallelEnv``): ``fcplan_task_v1``.
 
 The team's scheduler, made learnable: every replan period each UAV picks one task of the current
 task graph (:mod:`fcplan.taskgraph`) or no-op; the simulator (:class:`fcplan.world.World`, the
@@ -29,11 +29,11 @@ Arguments
     Truncate earlier than the scenario's duration (handy for tests).
 ``watch_altitude``, ``search_altitude`` (35 m, 70 m)
     Altitudes given to agents with a camera sent to a fire / a search block.
-``dump_altitude`` (``"watch"``)
-    Altitude of a hybrid with water sent to a fire (it dumps there): ``"watch"``, the
-    ``task_v0`` rule, ``watch_altitude``; None, the ``task_v1`` rule and every built-in
-    scheduler's, the top of its bounds (:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`); or a
-    number of metres, clipped to its bounds.
+``dump_altitude`` (default None)
+    Altitude of a hybrid with water sent to a fire (it dumps there): None, the ``task_v1`` rule
+    and every built-in scheduler's, the top of its bounds
+    (:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`); ``"watch"``, the ``task_v0`` rule,
+    ``watch_altitude``; or a number of metres, clipped to its bounds.
 ``prune_bonus`` (default 0.0)
     Optional shaping: this much reward per cell put out during the step. Off by default, so the
     return is exactly minus the manual's total negative reward.
@@ -161,7 +161,7 @@ class TaskEnv(ParallelEnv):
     """Task-level parallel environment (the module docstring is its documentation page)."""
 
     metadata = {
-        "name": "fcplan_task_v0",
+        "name": "fcplan_task_v1",
         "render_modes": ["rgb_array"],
         "is_parallelizable": True,
         "render_fps": 4,
@@ -176,7 +176,7 @@ class TaskEnv(ParallelEnv):
         max_steps: int | None = None,
         watch_altitude: float = 35.0,
         search_altitude: float = 70.0,
-        dump_altitude: float | str | None = "watch",
+        dump_altitude: float | str | None = None,
         prune_bonus: float = 0.0,
         illegal_action: str = "noop",
         validate: bool = True,

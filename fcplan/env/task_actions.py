@@ -20,10 +20,10 @@ Illegal actions
 Altitude
     A perception-only agent sent to a fire watches it at ``watch_altitude`` (low: high sensing
     confidence), sent to a search block it flies at ``search_altitude`` (a wide view). A hybrid
-    with water sent to a fire dumps on it from ``dump_altitude``: in ``task_v0`` (the default)
-    that is ``watch_altitude`` too; in ``task_v1`` it is None, the rule of every built-in
-    scheduler (:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`: the top of its bounds, the
-    widest dump). A hybrid flies at ``search_altitude`` over blocks. All are clipped to the
+    with water sent to a fire dumps on it from ``dump_altitude``: in ``task_v1`` (the default)
+    it is None, the rule of every built-in scheduler
+    (:meth:`fcplan.taskgraph.TaskGraph.dump_altitude`: the top of its bounds, the widest dump);
+    in ``task_v0`` it is ``"watch"``, ``watch_altitude``. A hybrid flies at ``search_altitude`` over blocks. All are clipped to the
     agent's bounds; action-only agents fly at their fixed altitude.
 
 Plans to actions (:func:`plan_to_actions`, used by the demonstrations)
@@ -135,7 +135,7 @@ def actions_plan(
     *,
     watch_altitude: float = 35.0,
     search_altitude: float = 70.0,
-    dump_altitude: float | None | str = "watch",
+    dump_altitude: float | None | str = None,
 ) -> Plan:
     """A one-task-per-agent :class:`Plan` from chosen task rows (``-1``: not mentioned); a
     hybrid with water sent to a fire at ``dump_altitude`` (``"watch"``: ``watch_altitude``;
@@ -191,7 +191,7 @@ def actions_commands(
     *,
     watch_altitude: float = 35.0,
     search_altitude: float = 70.0,
-    dump_altitude: float | None | str = "watch",
+    dump_altitude: float | None | str = None,
 ) -> dict[str, Command]:
     """``plan_commands(actions_plan(graph, rows, ...), graph)`` built directly from the rows
     (the environment's per-step path: no task-id lookups).

@@ -11,8 +11,8 @@ over worlds on the per-tick path):
 
 ``mode="task"`` (:class:`fcplan.env.vector_task.VectorTaskEnv`)
     One step is one replan period of every world; actions ``(B, A)`` candidate slots,
-    observations ``(B, A, ...)``; world ``i`` is ``fcplan/Task-v0`` with seed ``s + i``
-    (``fcplan/Task-v1`` with ``dump_altitude=None``, the env option of hybrids' dumps). The
+    observations ``(B, A, ...)``; world ``i`` is ``fcplan/Task-v1`` with seed ``s + i``
+    (``fcplan/Task-v0`` with ``dump_altitude="watch"``, the env option of hybrids' dumps). The
     ticks are batched; the belief, task graph, candidates and features stay per world (that
     module says why and ``bench/README.md`` measures it).
 

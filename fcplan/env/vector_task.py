@@ -2,7 +2,8 @@
 
 :class:`VectorTaskEnv` is a ``gymnasium.vector.VectorEnv``: one step is one replan period of
 every world. World ``i`` is, observation for observation, reward for reward and episode for
-episode, ``fcplan/Task-v0`` (:class:`fcplan.env.gym_view.TaskGymEnv`) reset with seed ``s + i``
+episode, the single env of the same options (:class:`fcplan.env.gym_view.TaskGymEnv`;
+``fcplan/Task-v1`` by default, ``fcplan/Task-v0`` with ``dump_altitude="watch"``) reset with seed ``s + i``
 and then reset without a seed at each episode end (the task env's own seed sequence), what
 ``gymnasium.vector.SyncVectorEnv`` of that env gives, whatever ``B``.
 
@@ -41,7 +42,7 @@ the user read. ``bench/README.md`` measures the shares.
 
 Options as :class:`~fcplan.env.task.TaskEnv`: ``k``, ``replan_period``, ``max_steps``,
 ``watch_altitude``, ``search_altitude``, ``dump_altitude``, ``prune_bonus``, ``validate``,
-``graph_params`` (masked actions always act as the no-op, as in ``fcplan/Task-v0``).
+``graph_params`` (masked actions always act as the no-op, as in the Gymnasium view).
 
 Examples
 --------

@@ -47,7 +47,8 @@ def test_write_load_replay(root):
     ds = minari.load_dataset("fcplan/test/mixed-v0")
     assert ds.total_episodes == 5 and ds.storage.metadata["algorithm_name"] == "greedy+human"
     meta = dataset_metadata(ds)
-    assert meta["env_kwargs"] == KW and set(meta["scenarios"]) == {"practice", "#24", "#24'"}
+    assert meta["env_kwargs"] == {**KW, "dump_altitude": None}
+    assert set(meta["scenarios"]) == {"practice", "#24", "#24'"}
     for i, ep in enumerate(ds.iterate_episodes()):
         opts = episode_options(ds, i)
         n = len(ep.actions)

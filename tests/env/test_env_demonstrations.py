@@ -40,10 +40,11 @@ def test_round_trip_without_pickle(demo):
 
 
 def test_metadata(demo):
-    """Metadata names the scheduler, its settings, the env arguments, versions and episodes."""
+    """Metadata names the scheduler, its settings, the env arguments (the hybrids' dump rule
+    too, though the caller gave none), versions and episodes."""
     _, d = demo
     m = d.metadata
-    assert m["scheduler"] == "greedy" and m["env_kwargs"] == KW
+    assert m["scheduler"] == "greedy" and m["env_kwargs"] == {**KW, "dump_altitude": None}
     assert {"fcplan", "numpy", "pettingzoo", "gymnasium", "python"} <= set(m["versions"])
     assert [e["seed"] for e in d.episodes] == [0, 1, 0, 1]
     assert len({e["scenario"] for e in d.episodes}) == 2 == len(m["scenarios"])
@@ -114,6 +115,27 @@ def test_graph_params_survive_the_file(tmp_path):
     d = load_demonstrations(path)
     assert d.metadata["env_kwargs"]["graph_params"]["search_block_px"] == 200
     assert replay_actions(d, 0) == d.episodes[0]["metrics"]
+
+
+def test_hybrids_dump_rule_is_stored_and_replayed(demo, tmp_path):
+    """A dataset names its hybrids' dump rule: the env's default (None: the top of the bounds,
+    the schedulers' rule) when the caller gave none, ``"watch"`` when asked, and a dataset
+    written before the rule was stored (no ``dump_altitude`` key) replays by ``"watch"``, the
+    env's default then; on the scenario with hybrids the two rules give different episodes."""
+    from fcplan.env.demo_episodes import env_kwargs_from_metadata
+
+    _, d = demo
+    assert env_kwargs_from_metadata(d.metadata)["dump_altitude"] is None
+    old = {**d.metadata, "env_kwargs": dict(KW)}
+    assert env_kwargs_from_metadata(old)["dump_altitude"] == "watch"
+    path = tmp_path / "watch.npz"
+    demonstrations("greedy", ["open_world_example"], [0], path,
+                   env_kwargs={**KW, "dump_altitude": "watch"})  # fmt: skip
+    w = load_demonstrations(path)
+    assert w.metadata["env_kwargs"]["dump_altitude"] == "watch"
+    assert replay_actions(w, 0) == w.episodes[0]["metrics"]
+    new = next(e for e in d.episodes if e["scenario"] != "#24" and e["seed"] == 0)
+    assert new["metrics"] != w.episodes[0]["metrics"]
 
 
 def test_batched_rollouts_equal_sequential_ones():

@@ -19,7 +19,7 @@ def _blocks() -> list[str]:
 
 
 def test_gymnasium_example_runs():
-    """The Gymnasium block makes fcplan/Task-v0 on scenario 24 and resets it."""
+    """The Gymnasium block makes fcplan/Task-v1 on scenario 24 and resets it."""
     ns: dict = {}
     exec(compile(_blocks()[0], str(README), "exec"), ns)
     assert ns["env"].spec.id == "fcplan/Task-v1"

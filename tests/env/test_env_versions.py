@@ -133,3 +133,29 @@ def test_task_versions_agree_without_hybrids():
                 assert np.array_equal(out[0][0][a][key], out[1][0][a][key])
         assert out[0][1] == out[1][1]
         obs = [o[0] for o in out]
+
+
+def test_every_entry_point_names_its_dump_rule():
+    """The env's default is v1's rule (None: the top of the bounds, the schedulers' rule) in
+    every entry point that names no version (``TaskEnv``, ``parallel_env``, ``vector_env``) and
+    in ``task_v1`` / ``fcplan/Task-v1`` (single and ``make_vec``); ``task_v0`` and
+    ``fcplan/Task-v0`` (single and ``make_vec``) fly such a hybrid at ``watch_altitude``, and
+    an explicit ``dump_altitude`` overrides either."""
+    import gymnasium
+
+    from fcplan.env import task_v0, task_v1, vector_env
+
+    kw = {"k": 3, "max_steps": 2}
+    v1 = [TaskEnv("practice", **kw), parallel_env("practice", **kw), task_v1.raw_env(**kw),
+          vector_env("practice", "task", 2, **kw).one,
+          gymnasium.make("fcplan/Task-v1", **kw).unwrapped.env,
+          gymnasium.make_vec("fcplan/Task-v1", num_envs=2, **kw).one]  # fmt: skip
+    assert all(e.dump_altitude is None for e in v1)
+    assert TaskEnv.metadata["name"] == "fcplan_task_v1"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)  # (Gymnasium: v0 is out of date)
+        v0 = [task_v0.raw_env(**kw), gymnasium.make("fcplan/Task-v0", **kw).unwrapped.env,
+              gymnasium.make_vec("fcplan/Task-v0", num_envs=2, **kw).one]  # fmt: skip
+    assert all(e.dump_altitude == e.watch_altitude == 35.0 for e in v0)
+    assert task_v0.raw_env(dump_altitude=None, **kw).dump_altitude is None
+    assert task_v1.raw_env(dump_altitude="watch", watch_altitude=40.0, **kw).dump_altitude == 40.0

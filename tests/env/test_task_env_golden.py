@@ -43,12 +43,16 @@ from tests.golden import Digests, GoldenFile  # noqa: E402
 
 GOLDEN = Path(__file__).parent.parent / "data" / "golden_task_env.json"
 
-# (run id, scenario, policy, seed, env keyword arguments)
+# (run id, scenario, policy, seed, env keyword arguments). The open-world scenario has hybrids,
+# whose dumps the env's default rule (None: the top of their bounds) and task_v0's ("watch")
+# fly differently: its runs pin v0's rule (recorded before the default changed); the manual's
+# scenarios have no hybrids, so the rule changes nothing there.
 RUNS: list[tuple[str, str, str, int, dict]] = []
 for _sc in ("practice", "1", "12", "24", "open_world_example"):
+    _kw = {"dump_altitude": "watch"} if _sc == "open_world_example" else {}
     for _seed in (0, 1):
-        RUNS.append((f"{_sc}-random-{_seed}", _sc, "random", _seed, {}))
-    RUNS.append((f"{_sc}-greedy-0", _sc, "greedy", 0, {}))
+        RUNS.append((f"{_sc}-random-{_seed}", _sc, "random", _seed, _kw))
+    RUNS.append((f"{_sc}-greedy-0", _sc, "greedy", 0, _kw))
 RUNS += [
     ("1-any-2", "1", "any", 2, {}),
     ("24-any-3", "24", "any", 3, {"k": 4, "replan_period": 0.5, "max_steps": 150}),

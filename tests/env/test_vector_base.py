@@ -37,7 +37,7 @@ def test_reset_seeds_follow_gymnasium():
 
 _LEVELS = {
     "motion": (VectorMotionEnv, JointGymEnv, "fcplan/Motion-v0"),
-    "task": (VectorTaskEnv, TaskGymEnv, "fcplan/Task-v0"),
+    "task": (VectorTaskEnv, TaskGymEnv, "fcplan/Task-v1"),
 }
 
 
