@@ -45,8 +45,8 @@ GOLDEN = Path(__file__).parent.parent / "data" / "golden_task_env.json"
 
 # (run id, scenario, policy, seed, env keyword arguments). The open-world scenario has hybrids,
 # whose dumps the env's default rule (None: the top of their bounds) and task_v0's ("watch")
-# fly differently: its runs pin v0's rule (recorded before the default changed); the manual's
-# scenarios have no hybrids, so the rule changes nothing there.
+# fly differently: its runs pin v0's rule (recorded before the default changed) and its "-v1"
+# runs the default; the manual's scenarios have no hybrids, so the rule changes nothing there.
 RUNS: list[tuple[str, str, str, int, dict]] = []
 for _sc in ("practice", "1", "12", "24", "open_world_example"):
     _kw = {"dump_altitude": "watch"} if _sc == "open_world_example" else {}
@@ -54,6 +54,8 @@ for _sc in ("practice", "1", "12", "24", "open_world_example"):
         RUNS.append((f"{_sc}-random-{_seed}", _sc, "random", _seed, _kw))
     RUNS.append((f"{_sc}-greedy-0", _sc, "greedy", 0, _kw))
 RUNS += [
+    ("open_world_example-random-0-v1", "open_world_example", "random", 0, {}),
+    ("open_world_example-greedy-0-v1", "open_world_example", "greedy", 0, {}),
     ("1-any-2", "1", "any", 2, {}),
     ("24-any-3", "24", "any", 3, {"k": 4, "replan_period": 0.5, "max_steps": 150}),
     ("12-random-4-k3-bonus", "12", "random", 4, {"k": 3, "prune_bonus": 0.5, "validate": False}),
