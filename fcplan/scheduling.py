@@ -42,9 +42,10 @@ or a name plus keyword settings) becomes a scheduler, for every command and API:
 name, an unknown setting, a malformed spec, and *any* exception a factory raises while checking
 its settings become one :class:`~fcplan.errors.FcplanError` line naming the scheduler, the
 setting and the reason (``scheduler 'milp': bad setting slots=0: slots must be >= 1``).
-Factories check their settings at construction with :func:`int_setting`,
-:func:`float_setting`, :func:`bool_setting` and :func:`choice_setting` (types, ranges, NaN), which
-raise :class:`SettingError`. A scheduler whose plans may depend on the wall clock offers a
+Factories check their settings at construction with the helpers of :mod:`fcplan.settings`
+(:func:`int_setting`, :func:`float_setting`, :func:`~fcplan.settings.altitude_setting`,
+:func:`bool_setting`, :func:`choice_setting`: types, ranges, NaN; re-exported here), which raise
+:class:`SettingError`. A scheduler whose plans may depend on the wall clock offers a
 ``deterministic`` setting (work limits instead of time limits, fixed seeds, one worker);
 :func:`supports_deterministic` tells whether a factory takes it, which is how comparisons and
 sweeps turn it on by default.
@@ -66,7 +67,7 @@ import math
 import re
 import time
 import tomllib
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from importlib.metadata import EntryPoint, PackageNotFoundError, distribution, entry_points
 from pathlib import Path
@@ -76,6 +77,14 @@ import numpy as np
 
 from fcplan.errors import FcplanError, UnknownNameError
 from fcplan.plan import Plan, validate_plan
+from fcplan.settings import (
+    SettingError,
+    bool_setting,
+    choice_setting,
+    float_setting,
+    int_setting,
+)
+from fcplan.settings import show_value as _show
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
 
@@ -93,7 +102,6 @@ STATUSES = ("optimal", "feasible", "time_limit", "fallback", "heuristic")
 GROUP = "fcplan.schedulers"
 _PYPROJECT = Path(__file__).resolve().parents[1] / "pyproject.toml"
 _RUNTIME: dict[str, Callable[..., Any]] = {}
-_MISSING = object()
 
 
 @dataclass(frozen=True, slots=True)
@@ -231,122 +239,6 @@ def _parse_value(text: str) -> Any:
     return text
 
 
-class SettingError(FcplanError, ValueError):
-    """A scheduler setting of the wrong type or out of range.
-
-    Factories raise it from their constructor (the helpers :func:`int_setting`,
-    :func:`float_setting`, :func:`bool_setting` and :func:`choice_setting` do);
-    :func:`make_scheduler` adds the scheduler's name. The message is one line:
-    ``scheduler 'greedy': bad setting route_length=0: must be an integer in 1..1000``.
-
-    Parameters
-    ----------
-    setting : str
-        The setting's name.
-    reason : str
-        What is wrong and what is allowed.
-    value : Any, optional
-        The offending value.
-    scheduler : str, optional
-        The scheduler's registered name.
-    """
-
-    def __init__(
-        self, setting: str, reason: str, *, value: Any = _MISSING, scheduler: str | None = None
-    ) -> None:
-        self.setting, self.reason, self.value, self.scheduler = setting, reason, value, scheduler
-        what = setting if value is _MISSING else f"{setting}={_show(value)}"
-        head = f"scheduler {scheduler!r}: " if scheduler else ""
-        super().__init__(f"{head}bad setting {what}: {reason}")
-
-    def for_scheduler(self, scheduler: str) -> SettingError:
-        """The same error naming ``scheduler``."""
-        return SettingError(self.setting, self.reason, value=self.value, scheduler=scheduler)
-
-
-def _show(value: Any) -> str:
-    """A setting's value for a message: short, one line."""
-    text = repr(value) if not isinstance(value, str) else value
-    text = text.replace("\n", " ")
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def int_setting(name: str, value: Any, lo: int, hi: int | None = None) -> int:
-    """``value`` as an int in ``lo..hi`` (bools and non-integral numbers refused).
-
-    Examples
-    --------
-    >>> int_setting("route_length", 3, 1, 1000)
-    3
-    >>> int_setting("route_length", 0, 1, 1000)
-    Traceback (most recent call last):
-    ...
-    fcplan.scheduling.SettingError: bad setting route_length=0: must be an integer in 1..1000
-    """
-    allowed = f"an integer in {lo}..{hi}" if hi is not None else f"an integer >= {lo}"
-    ok = isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
-    if not ok or value < lo or (hi is not None and value > hi):
-        raise SettingError(name, f"must be {allowed}", value=value)
-    return int(value)
-
-
-def float_setting(
-    name: str,
-    value: Any,
-    lo: float,
-    hi: float = math.inf,
-    *,
-    lo_open: bool = False,
-    hi_open: bool = False,
-    unit: str = "",
-) -> float:
-    """``value`` as a finite float in the interval ``lo..hi`` (open ends as asked; NaN, infinities
-    and bools refused). ``hi=math.inf`` leaves it unbounded above (but finite).
-
-    Examples
-    --------
-    >>> float_setting("fresh_s", 2, 0, lo_open=True)
-    2.0
-    >>> float_setting("time_limit", float("nan"), 0, lo_open=True, unit=" s")
-    Traceback (most recent call last):
-    ...
-    fcplan.scheduling.SettingError: bad setting time_limit=nan: must be a finite number > 0 s
-    """
-    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-        value, (bool, np.bool_)
-    )
-    v = float(value) if ok else math.nan
-    inside = (
-        math.isfinite(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
-    )
-    if not inside:
-        raise SettingError(
-            name, f"must be {_interval(lo, hi, lo_open, hi_open)}{unit}", value=value
-        )
-    return v
-
-
-def _interval(lo: float, hi: float, lo_open: bool, hi_open: bool) -> str:
-    if math.isinf(hi):
-        return f"a finite number {'>' if lo_open else '>='} {lo:g}"
-    return f"a number in {'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
-
-
-def bool_setting(name: str, value: Any) -> bool:
-    """``value`` as a bool (only ``True``/``False``; ``"true"`` in a spec is already a bool)."""
-    if not isinstance(value, (bool, np.bool_)):
-        raise SettingError(name, "must be true or false", value=value)
-    return bool(value)
-
-
-def choice_setting(name: str, value: Any, choices: Iterable[str]) -> str:
-    """``value`` if it is one of ``choices``."""
-    options = tuple(choices)
-    if not isinstance(value, str) or value not in options:
-        raise SettingError(name, f"must be one of {', '.join(options)}", value=value)
-    return value
-
-
 def scheduler_factory(name: str) -> Callable[..., Scheduler]:
     """The factory registered under ``name`` (run-time registrations first).
 
@@ -427,7 +319,7 @@ def make_scheduler(name: str, **settings: Any) -> Scheduler:
     >>> make_scheduler("greedy:route_length=0")
     Traceback (most recent call last):
     ...
-    fcplan.scheduling.SettingError: scheduler 'greedy': bad setting route_length=0: must be an integer in 1..1000
+    fcplan.settings.SettingError: scheduler 'greedy': bad setting route_length=0: must be an integer in 1..1000
     """
     if not isinstance(name, str):
         raise FcplanError(f"schedulers are given by registered name, got {_show(name)}")

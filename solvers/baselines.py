@@ -1,7 +1,7 @@
 """Lower baselines: ``idle`` does nothing, ``random`` sends each agent to a random task.
 
 ``idle`` takes no settings; ``random`` takes ``keep_probability``, a number in [0, 1] checked at
-construction (a wrong type or NaN is a one-line :class:`fcplan.scheduling.SettingError`). Neither
+construction (a wrong type or NaN is a one-line :class:`fcplan.settings.SettingError`). Neither
 depends on the wall clock: ``random`` draws from the episode's controller stream only.
 
 Examples

@@ -23,8 +23,8 @@ Each replan, in this order:
 Agents on a forced return (battery or tank) are planned from their depot slot with a full
 battery: they resume the new route after recharging.
 
-Settings are checked at construction (:func:`fcplan.scheduling.int_setting` and friends): a wrong
-type, NaN or a value outside its range is a one-line :class:`fcplan.scheduling.SettingError`.
+Settings are checked at construction (:func:`fcplan.settings.int_setting` and friends): a wrong
+type, NaN or a value outside its range is a one-line :class:`fcplan.settings.SettingError`.
 
 ==================== ======= ============ ===============================================
 setting              type    range        meaning
@@ -67,6 +67,7 @@ import numpy as np
 
 from fcplan.plan import MAX_ROUTE_LENGTH, Plan
 from fcplan.scheduling import SolveStats, float_setting, int_setting
+from fcplan.settings import altitude_setting
 from fcplan.taskgraph import TaskGraph
 from fcplan.team import Mode
 
@@ -124,17 +125,13 @@ class GreedyScheduler:
             "search_route_length", search_route_length, 1, MAX_ROUTE_LENGTH
         )
         self.fresh_s = float_setting("fresh_s", fresh_s, 0.0, lo_open=True, unit=" s")
-        self.watch_altitude = float_setting(
-            "watch_altitude", watch_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
-        )
-        self.search_altitude = float_setting(
-            "search_altitude", search_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
-        )
+        self.watch_altitude = altitude_setting("watch_altitude", watch_altitude)
+        self.search_altitude = altitude_setting("search_altitude", search_altitude)
         self.max_watch_fraction = float_setting("max_watch_fraction", max_watch_fraction, 0.0, 1.0)
         self.spread_px = float_setting("spread_px", spread_px, 0.0, unit=" px")
-        self.dump_altitude = None if dump_altitude is None else float_setting(
-            "dump_altitude", dump_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
-        )  # fmt: skip
+        self.dump_altitude = (
+            None if dump_altitude is None else altitude_setting("dump_altitude", dump_altitude)
+        )
 
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:

@@ -48,7 +48,7 @@ Examples
 >>> MilpScheduler(slots=0)
 Traceback (most recent call last):
 ...
-fcplan.scheduling.SettingError: bad setting slots=0: must be an integer in 1..4
+fcplan.settings.SettingError: bad setting slots=0: must be an integer in 1..4
 """
 
 from __future__ import annotations

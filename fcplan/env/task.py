@@ -27,7 +27,7 @@ Arguments
     Simulated seconds per step (rounded to whole ticks, at least one).
 ``max_steps`` (default None)
     Truncate earlier than the scenario's duration (handy for tests).
-``watch_altitude``, ``search_altitude`` (35 m, 70 m)
+``watch_altitude``, ``search_altitude`` (35 m, 70 m; in (0, 10000] m, as the schedulers')
     Altitudes given to agents with a camera sent to a fire / a search block.
 ``dump_altitude`` (default None)
     Altitude of a hybrid with water sent to a fire (it dumps there): None, the ``task_v1`` rule
@@ -134,6 +134,7 @@ from fcplan.errors import EnvError
 from fcplan.metrics import compute_all
 from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario, period_ticks
 from fcplan.plan import Plan, validate_plan
+from fcplan.settings import MAX_ALTITUDE_M, SettingError, altitude_setting
 from fcplan.taskgraph import TaskGraph, TaskGraphParams
 from fcplan.team import Command
 from fcplan.world import World
@@ -141,20 +142,26 @@ from fcplan.world import World
 __all__ = ["TaskEnv"]
 
 
+def _altitude(name: str, value: Any, *, named: str = "") -> float:
+    """An altitude option as a float in the schedulers' range, (0, MAX_ALTITUDE_M] m
+    (:func:`fcplan.settings.altitude_setting`); anything else is an :class:`EnvError` naming
+    the option (``named``: the other values it takes, for the message)."""
+    try:
+        return altitude_setting(name, value)
+    except SettingError:
+        raise EnvError(
+            f"{name}: must be {named}a number of metres in (0, {MAX_ALTITUDE_M:g}] (got {value!r})"
+        ) from None
+
+
 def _dump_altitude(value: Any, watch_altitude: float) -> float | None:
-    """The ``dump_altitude`` option resolved: ``"watch"`` -> ``watch_altitude``, None, or a
-    finite number in (0, 10000] m; anything else is an :class:`EnvError` naming the option."""
+    """The ``dump_altitude`` option resolved: ``"watch"`` -> ``watch_altitude``, None, or an
+    altitude (:func:`_altitude`)."""
     if value is None:
         return None
     if isinstance(value, str) and value == "watch":
         return watch_altitude
-    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
-        z = float(value)
-        if np.isfinite(z) and 0.0 < z <= 10_000.0:
-            return z
-    raise EnvError(
-        f"dump_altitude: must be 'watch', None or a number of metres in (0, 10000] (got {value!r})"
-    )
+    return _altitude("dump_altitude", value, named="'watch', None or ")
 
 
 class TaskEnv(ParallelEnv):
@@ -204,8 +211,8 @@ class TaskEnv(ParallelEnv):
         self.period = period_ticks(replan_period, self.tps)
         n_steps = -(-self.scenario.n_ticks // self.period)
         self.max_steps = n_steps if max_steps is None else min(int(max_steps), n_steps)
-        self.watch_altitude = float(watch_altitude)
-        self.search_altitude = float(search_altitude)
+        self.watch_altitude = _altitude("watch_altitude", watch_altitude)
+        self.search_altitude = _altitude("search_altitude", search_altitude)
         #: the resolved dump altitude: a number (``"watch"``: ``watch_altitude``) or None
         self.dump_altitude = _dump_altitude(dump_altitude, self.watch_altitude)
         self.prune_bonus = float(prune_bonus)

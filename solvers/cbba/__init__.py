@@ -13,9 +13,9 @@ covering a search block). The plan keeps one holder per (task, service).
 Modules: :mod:`~solvers.cbba.comms` (who can talk to whom), :mod:`~solvers.cbba.auction` (one
 auction: bundle construction, consensus, the stopping rule), :mod:`~solvers.cbba.assembly`
 (conflict-free routes; greedy completion of an auction cut short), :mod:`~solvers.cbba.clock`
-(the wall-clock limit), :mod:`~solvers.cbba.settings` (settings checks),
-:mod:`~solvers.cbba.scheduler` (the two auctions, their scores, the modes, and the plan) and
-:mod:`~solvers.cbba.static` (the same auction on a static textbook instance, checked against an
+(the wall-clock limit), :mod:`~solvers.cbba.scheduler` (the two auctions, their scores, the
+modes, the plan, and its settings, checked by :mod:`fcplan.settings` as every scheduler's are)
+and :mod:`~solvers.cbba.static` (the same auction on a static textbook instance, checked against an
 independent implementation in ``tests/solvers/test_cbba_reference.py``).
 
 Modes: with a ``time_limit`` (argument or setting) the scheduler stops on the wall clock and
@@ -38,11 +38,15 @@ Examples
 True
 """
 
+from fcplan.settings import SettingError
 from solvers.cbba.auction import StageResult
 from solvers.cbba.comms import CommGraph, communication_graph
 from solvers.cbba.scheduler import CBBAResult, CBBAScheduler
-from solvers.cbba.settings import CBBASettingsError
 from solvers.cbba.static import StaticInstance, StaticResult, solve_static
+
+#: The error of a bad CBBA setting: :class:`fcplan.settings.SettingError`, the one every
+#: scheduler's settings raise (this name is kept for code that caught it by name).
+CBBASettingsError = SettingError
 
 __all__ = [
     "CBBAScheduler",

@@ -95,13 +95,13 @@ import numpy as np
 
 from fcplan.plan import Plan
 from fcplan.scheduling import SolveStats
+from fcplan.settings import altitude_setting, bool_setting, float_setting, int_setting
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
 from solvers.cbba.assembly import Assembly, assemble
 from solvers.cbba.auction import NO_WINNER, Auction, StageResult, run_auction
 from solvers.cbba.clock import Clock
 from solvers.cbba.comms import CommGraph, communication_graph
-from solvers.cbba.settings import flag, integer, number
 
 __all__ = ["CBBAResult", "CBBAScheduler"]
 
@@ -210,8 +210,9 @@ class CBBAScheduler:
 
     Raises
     ------
-    solvers.cbba.settings.CBBASettingsError
-        A setting has the wrong type or is out of range (one line naming it and the range).
+    fcplan.settings.SettingError
+        A setting has the wrong type or is out of range (one line naming it and the range; the
+        checks every scheduler's settings share).
 
     Examples
     --------
@@ -240,22 +241,22 @@ class CBBAScheduler:
         time_limit: float | None = None,
         deterministic: bool = False,
     ) -> None:
-        self.bundle_length = integer("bundle_length", bundle_length, lo=1)
-        self.half_life_s = number("half_life_s", half_life_s, lo=0.0, strict=True, unit="s")
-        self.fresh_s = number("fresh_s", fresh_s, lo=0.0, unit="s")
-        self.watch_weight = number("watch_weight", watch_weight, lo=0.0)
-        self.watch_altitude = number("watch_altitude", watch_altitude, lo=0.0, unit="m")
-        self.search_altitude = number("search_altitude", search_altitude, lo=0.0, unit="m")
-        self.dump_altitude = None if dump_altitude is None else number(
-            "dump_altitude", dump_altitude, lo=0.0, strict=True, unit="m"
-        )  # fmt: skip
-        self.max_rounds = integer("max_rounds", max_rounds, lo=1)
+        self.bundle_length = int_setting("bundle_length", bundle_length, 1)
+        self.half_life_s = float_setting("half_life_s", half_life_s, 0.0, lo_open=True, unit=" s")
+        self.fresh_s = float_setting("fresh_s", fresh_s, 0.0, unit=" s")
+        self.watch_weight = float_setting("watch_weight", watch_weight, 0.0)
+        self.watch_altitude = altitude_setting("watch_altitude", watch_altitude)
+        self.search_altitude = altitude_setting("search_altitude", search_altitude)
+        self.dump_altitude = (
+            None if dump_altitude is None else altitude_setting("dump_altitude", dump_altitude)
+        )
+        self.max_rounds = int_setting("max_rounds", max_rounds, 1)
         self.time_limit = (
             None
             if time_limit is None
-            else number("time_limit", time_limit, lo=0.0, strict=True, unit="s")
+            else float_setting("time_limit", time_limit, 0.0, lo_open=True, unit=" s")
         )
-        self.deterministic = flag("deterministic", deterministic)
+        self.deterministic = bool_setting("deterministic", deterministic)
 
     # ------------------------------------------------------------------ main
     def plan(self, graph: TaskGraph, *, time_limit: float | None = None, rng: Any = None) -> Plan:

@@ -9,6 +9,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fcplan.scheduling import float_setting, int_setting
+from fcplan.settings import altitude_setting
 
 __all__ = [
     "COVER",
@@ -143,13 +144,11 @@ class MilpParams:
         float_setting("recent_fire_s", self.recent_fire_s, 0.0, unit=" s")
         float_setting("search_block_px", self.search_block_px, 0.0, lo_open=True, unit=" px")
         int_setting("cover_levels", self.cover_levels, 1, 1000)
-        float_setting("watch_altitude", self.watch_altitude, 0.0, unit=" m")
+        altitude_setting("watch_altitude", self.watch_altitude)
         if self.dump_altitude is not None:
-            float_setting(
-                "dump_altitude", self.dump_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
-            )
+            altitude_setting("dump_altitude", self.dump_altitude)
         if self.search_altitude is not None:
-            float_setting("search_altitude", self.search_altitude, 0.0, unit=" m")
+            altitude_setting("search_altitude", self.search_altitude)
         int_setting("max_routes", self.max_routes, 1)
         int_setting("max_scored_ends", self.max_scored_ends, 2, 4096)
 

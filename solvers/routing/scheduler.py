@@ -122,6 +122,7 @@ from fcplan.scheduling import (
     float_setting,
     int_setting,
 )
+from fcplan.settings import altitude_setting
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Mode
 from solvers.routing.core import BACKENDS, RoutesResult
@@ -254,11 +255,11 @@ class RoutingScheduler:
         self.search_value_px = float_setting("search_value_px", search_value_px, 0)
         self.search_horizon_s = float_setting("search_horizon_s", search_horizon_s, 0, unit=" s")
         self.fresh_s = float_setting("fresh_s", fresh_s, 0, unit=" s")
-        self.watch_altitude = float_setting("watch_altitude", watch_altitude, 0, lo_open=True)
-        self.search_altitude = float_setting("search_altitude", search_altitude, 0, lo_open=True)
-        self.dump_altitude = None if dump_altitude is None else float_setting(
-            "dump_altitude", dump_altitude, 0.0, 10_000.0, lo_open=True, unit=" m"
-        )  # fmt: skip
+        self.watch_altitude = altitude_setting("watch_altitude", watch_altitude)
+        self.search_altitude = altitude_setting("search_altitude", search_altitude)
+        self.dump_altitude = (
+            None if dump_altitude is None else altitude_setting("dump_altitude", dump_altitude)
+        )
         self.max_watch_fraction = float_setting("max_watch_fraction", max_watch_fraction, 0, 1)
         self.cap_all_watch = bool_setting("cap_all_watch", cap_all_watch)
         self.charge_return = bool_setting("charge_return", charge_return)

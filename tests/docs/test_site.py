@@ -86,19 +86,23 @@ def test_metric_equations_are_quoted_from_the_docstrings():
         assert eq in doc, eq
 
 
-def test_scheduler_howto_runs(monkeypatch):
+def test_scheduler_howto_runs(monkeypatch, capsys):
     """The Python blocks of docs/howto/scheduler.md run as written (the example scheduler plays
-    an episode without fallbacks and passes the conformance kit)."""
+    an episode without fallbacks and passes the conformance kit; its settings are checked by
+    fcplan.settings, the error printed as the page says)."""
     from fcplan import scheduling
 
     monkeypatch.setattr(scheduling, "_RUNTIME", dict(scheduling._RUNTIME))  # registers "nearest"
     page = (DOCS / "howto" / "scheduler.md").read_text(encoding="utf-8")
     blocks = re.findall(r"```python\n(.*?)```", page, flags=re.S)
-    assert len(blocks) == 2
+    assert len(blocks) == 3
     namespace: dict = {"__name__": "docs_howto"}
     for block in blocks:
         exec(compile(block, "docs/howto/scheduler.md", "exec"), namespace)  # noqa: S102
     assert namespace["report"].failures == []
+    said = re.search(r"print\(err\)  # (.*)\n", blocks[1]).group(1)
+    assert capsys.readouterr().out.splitlines()[-1] == said
+    assert namespace["NearestAt"]().horizon == 1
 
 
 def test_benchmark_howto_runs(monkeypatch):

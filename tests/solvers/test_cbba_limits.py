@@ -16,10 +16,10 @@ import fcplan
 from fcplan.errors import FcplanError
 from fcplan.plan import Plan
 from fcplan.scheduling import make_scheduler, solve
+from fcplan.settings import SettingError, show_value
 from fcplan.taskgraph import synthetic_task_graph
-from solvers.cbba import CBBAResult, CBBAScheduler
+from solvers.cbba import CBBAResult, CBBAScheduler, CBBASettingsError
 from solvers.cbba.auction import insertion_scores
-from solvers.cbba.settings import CBBASettingsError
 from tests.solvers.test_cbba import check_result
 
 CLOCKED = ("solvers.cbba.clock.time", "solvers.cbba.auction.time", "solvers.cbba.assembly.time")
@@ -101,6 +101,11 @@ BAD = [
     ("watch_altitude", float("nan")),
     ("search_altitude", float("nan")),
     ("search_altitude", -5.0),
+    ("search_altitude", 0.0),
+    ("watch_altitude", 10_001.0),
+    ("dump_altitude", 0.0),
+    ("dump_altitude", 1e6),
+    ("dump_altitude", float("inf")),
     ("max_rounds", 0),
     ("max_rounds", 1.5),
     ("time_limit", 0.0),
@@ -113,14 +118,18 @@ BAD = [
 
 @pytest.mark.parametrize(("name", "value"), BAD)
 def test_bad_settings_are_rejected_in_one_line(name, value):
-    """A setting of the wrong type, out of range or NaN raises at construction an
-    FcplanError (and ValueError) whose one-line message names the setting, the allowed range
-    and the value."""
-    with pytest.raises(CBBASettingsError) as err:
+    """A setting of the wrong type, out of range or NaN raises at construction the shared
+    SettingError (an FcplanError and ValueError; CBBASettingsError is its old name) whose
+    one-line message names the setting, the value and the allowed range (altitudes: the range
+    every scheduler takes, (0, 10000] m)."""
+    with pytest.raises(SettingError) as err:
         CBBAScheduler(**{name: value})
     msg = str(err.value)
     assert isinstance(err.value, FcplanError) and isinstance(err.value, ValueError)
-    assert "\n" not in msg and msg.startswith(f"cbba: {name} must be ") and repr(value) in msg
+    assert CBBASettingsError is SettingError and err.value.setting == name
+    assert "\n" not in msg and msg.startswith(f"bad setting {name}={show_value(value)}: must be ")
+    if name.endswith("_altitude"):
+        assert msg.endswith("must be a number in (0, 10000] m")
 
 
 def test_settings_from_a_scheduler_spec():

@@ -48,7 +48,10 @@ def episode_graphs(name) -> tuple[TaskGraph, ...]:
             {"search_weight": -0.1},
             r"bad setting search_weight=-0\.1: must be a finite number >= 0$",
         ),
-        ({"search_altitude": math.nan}, r"search_altitude=nan: must be a finite number >= 0 m$"),
+        (
+            {"search_altitude": math.nan},
+            r"search_altitude=nan: must be a number in \(0, 10000\] m$",
+        ),
         ({"slot": 2}, r"bad setting slot=2: unknown setting; milp(-cvxpy)? takes: deterministic, "),
     ],
 )
