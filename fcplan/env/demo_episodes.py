@@ -49,7 +49,8 @@ from fcplan.scheduling import Scheduler, solve
 from fcplan.taskgraph import TaskKind
 
 __all__ = ["EpisodeRecord", "rollout_episode", "recording_episode", "OBS_KEYS"]
-__all__ += ["batched_rollouts", "scenario_from_metadata", "env_kwargs_from_metadata"]
+__all__ += ["batched_rollouts", "scenario_from_metadata", "env_kwargs_from_metadata",
+            "episode_mapping"]  # fmt: skip
 
 #: the keys of a joint observation (the Gymnasium view's)
 OBS_KEYS = ("agents", "tasks", "action_mask")
@@ -311,6 +312,19 @@ def _period_reward(trace: Any, start: int, stop: int, sc: Any) -> float:
     pen = np.array([f.penalty for f in sc.scored_facilities], dtype=np.float64)
     rate = penalty_rate(active, facility_penalty(in_fac, pen), sc.scoring.propagation_weight)
     return -rate / float(sc.ticks_per_second)
+
+
+def episode_mapping(rec: EpisodeRecord) -> dict[str, Any]:
+    """How episode ``rec``'s plans became actions, for its entry in a dataset's metadata:
+    ``mapping`` (its :class:`~fcplan.env.task_actions.MappingCounts` as a dict; empty for a
+    recorded game), ``conflicts`` (agent-steps whose action the env's conflict rule changed)
+    and ``fallbacks`` (steps planned by the greedy fallback). The dataset's totals are their
+    sums, so a user can leave out the episodes whose plans the env could not follow."""
+    return {
+        "mapping": {k: int(v) for k, v in sorted(rec.counts.items())},
+        "conflicts": int(rec.conflict.sum()),
+        "fallbacks": int(rec.fallbacks),
+    }
 
 
 def scenario_from_metadata(metadata: dict[str, Any], key: str) -> Any:

@@ -23,7 +23,9 @@ episode ``observations``    ``T + 1`` rows (the last: after the last step)
 episode ``seed``            the world's seed
 episode ``options``         ``scenario`` (key into the metadata's scenarios), ``source`` (the
                             scheduler's name, or ``"human"``), ``metrics`` (final, both
-                            definitions), ``return``
+                            definitions), ``return``, and how its plans became actions:
+                            ``mapping`` (the episode's mapping counts), ``conflicts``,
+                            ``fallbacks`` (:func:`~fcplan.env.demo_episodes.episode_mapping`)
 ``algorithm_name``          the sources, joined by ``+`` (``"greedy+human"``)
 metadata ``fcplan``         JSON: the npz format's metadata (env arguments, feature names, every
                             scenario's TOML document, library versions, mapping counts)
@@ -60,6 +62,7 @@ from fcplan.env.demo_episodes import (
     OBS_KEYS,
     EpisodeRecord,
     env_kwargs_from_metadata,
+    episode_mapping,
     scenario_from_metadata,
 )
 from fcplan.errors import FcplanError
@@ -169,6 +172,7 @@ def _buffer(i: int, r: EpisodeRecord, cls: Any) -> Any:
             "source": r.source,
             "metrics": r.metrics,
             "return": r.return_,
+            **episode_mapping(r),
         },  # fmt: skip
         observations={k: r.observations[k] for k in OBS_KEYS},
         actions=r.actions,

@@ -27,7 +27,8 @@ File format (``.npz``, no pickle: load with ``numpy.load(path, allow_pickle=Fals
     ``agent``         (N,) int16       agent row (scenario order)
     ``metadata``      () str           JSON: scheduler name and settings, env arguments,
                                        feature names, library versions, mapping counts,
-                                       and per episode the scenario, seed and final metrics
+                                       and per episode the scenario, seed, final metrics
+                                       and its own mapping counts, conflicts and fallbacks
     ================  ===============  =================================================
 
     Scenarios are stored whole (their TOML document as JSON), so a dataset replays without the
@@ -67,6 +68,7 @@ from fcplan.env.demo_checkpoint import DemoCheckpoint
 from fcplan.env.demo_episodes import (
     EpisodeRecord,
     env_kwargs_from_metadata,
+    episode_mapping,
     recording_episode,
     scenario_from_metadata,
 )
@@ -439,6 +441,7 @@ class _Rollouts:
                 "metrics": rec.metrics,
                 "return": rec.return_,
                 "source": rec.source,
+                **episode_mapping(rec),
             }
         )
         if self.progress is not None:

@@ -63,6 +63,11 @@ def test_write_load_replay(root):
             assert opts["seed"] == 5 and opts["scenario"] == "#24'"  # (a shorter #24)
             assert opts["metrics"] == {k: m.as_dict() for k, m in game.metrics().items()}
             assert n == 15 and (ep.actions <= 5).all()
+            assert opts["mapping"] == {} and opts["fallbacks"] == 0  # (no plans to map)
+    eps = [episode_options(ds, i) for i in range(ds.total_episodes)]
+    for key in ("conflicts", "fallbacks"):
+        assert sum(e[key] for e in eps) == meta[key]
+    assert {k: sum(e["mapping"].get(k, 0) for e in eps) for k in meta["mapping"]} == meta["mapping"]
 
 
 def test_human_game_observed_along_its_own_trajectory(root):

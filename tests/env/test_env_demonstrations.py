@@ -117,6 +117,21 @@ def test_graph_params_survive_the_file(tmp_path):
     assert replay_actions(d, 0) == d.episodes[0]["metrics"]
 
 
+def test_episodes_carry_their_own_mapping_counts(demo):
+    """Each episode's entry names how its plans became actions (mapping counts, one per row,
+    conflicts, fallbacks) and the dataset's totals are their sums, so episodes can be filtered
+    on them."""
+    _, d = demo
+    m = d.metadata
+    for key in ("conflicts", "fallbacks"):
+        assert sum(e[key] for e in d.episodes) == m[key]
+    assert sum(sum(e["mapping"].values()) for e in d.episodes) == sum(m["mapping"].values())
+    for name, total in m["mapping"].items():
+        assert sum(e["mapping"].get(name, 0) for e in d.episodes) == total
+    for i, e in enumerate(d.episodes):  # one mapped action per (step, agent): the episode's rows
+        assert sum(e["mapping"].values()) == int((d.episode == i).sum())
+
+
 def test_hybrids_dump_rule_is_stored_and_replayed(demo, tmp_path):
     """A dataset names its hybrids' dump rule: the env's default (None: the top of the bounds,
     the schedulers' rule) when the caller gave none, ``"watch"`` when asked, and a dataset
