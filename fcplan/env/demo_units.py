@@ -114,9 +114,14 @@ def demo_units(
     return units
 
 
-def play_unit(unit: DemoUnit) -> UnitResult:
+def play_unit(unit: DemoUnit, runtime: dict[str, Callable[..., Any]] | None = None) -> UnitResult:
     """Roll out ``unit``'s seeds (module docstring); a module-level function, so pool workers
-    can run it."""
+    can run it (``runtime``: schedulers registered at run time in the parent, registered here
+    first, as Dask workers need: :func:`fcplan.experiments.play.play_episode`)."""
+    if runtime:
+        from fcplan.experiments.workers import register_runtime
+
+        register_runtime(runtime)
     if unit.num_envs > 1:
         from fcplan.env.vector_task import VectorTaskEnv
 
@@ -139,11 +144,13 @@ def play_units(
     units: Sequence[DemoUnit],
     jobs: int,
     *,
+    dask: str | None = None,
     on_unit: Callable[[DemoUnit, UnitResult], None] | None = None,
 ) -> list[UnitResult]:
     """Play ``units`` (``jobs=1``: here, in order; else on a local pool of at most ``jobs``
-    workers) and return their results in the units' order; ``on_unit`` is called as each one
-    finishes (completion order).
+    workers; with ``dask``, on a Dask cluster, :func:`fcplan.experiments.backends.iter_dask`)
+    and return their results in the units' order; ``on_unit`` is called as each one finishes
+    (completion order).
 
     Raises
     ------
@@ -155,10 +162,12 @@ def play_units(
     from fcplan.experiments.backends import select_backend
     from fcplan.experiments.workers import runtime_factories
 
-    if jobs > 1 and len(units) > 1:
-        _check_sendable(units[0], jobs)
+    if units and (dask is not None or (jobs > 1 and len(units) > 1)):
+        _check_sendable(units[0], f"jobs={jobs}" if dask is None else f"dask={dask!r}")
     names = sorted({u.spec for u in units if isinstance(u.spec, str)})
-    _, outcomes = select_backend(list(units), jobs, runtime_factories(names), play=play_unit)
+    _, outcomes = select_backend(
+        list(units), jobs, runtime_factories(names), dask=dask, play=play_unit
+    )
     done: dict[str, UnitResult] = {}
     try:
         for unit, result, lost in outcomes:
@@ -175,15 +184,15 @@ def play_units(
     return [done[u.key] for u in units]
 
 
-def _check_sendable(unit: DemoUnit, jobs: int) -> None:
+def _check_sendable(unit: DemoUnit, where: str) -> None:
     """Fail in one line, before the pool starts, when ``unit`` (its scheduler object) cannot be
-    pickled for a worker process."""
+    pickled for a worker process (``where``: the argument that sends it, for the message)."""
     import pickle
 
     try:
         pickle.dumps(unit)
     except Exception as exc:  # noqa: BLE001 - whatever pickling raises, said in one line
         raise FcplanError(
-            f"demonstrations: jobs={jobs} sends the scheduler to worker processes, and it cannot "
+            f"demonstrations: {where} sends the scheduler to worker processes, and it cannot "
             f"be pickled ({type(exc).__name__}: {exc}); pass a registered name or spec, or jobs=1"
         ) from None

@@ -212,6 +212,7 @@ def demonstrations(
     dataset_id: str | None = None,
     num_envs: int = 1,
     jobs: int = 1,
+    dask: str | None = None,
     checkpoint: str | Path | None = None,
     progress: Any = True,
 ) -> Any:
@@ -247,6 +248,9 @@ def demonstrations(
         Worker processes (None: one per CPU), the pool of ``compare`` and ``sweep``, playing the
         episodes in units (:mod:`fcplan.env.demo_units`): the dataset of ``jobs=1``, for
         schedulers that keep no state between episodes (a scheduler object goes pickled).
+    dask : str, optional
+        Play the units on Dask instead, as ``sweep`` does: ``"local"`` (a LocalCluster of
+        ``jobs`` workers) or a scheduler's address (needs ``pip install fcplan[dask]``).
     checkpoint : str or Path, optional
         A folder that every episode is written into as it finishes; a call with the same folder
         plays only the episodes not in it (:mod:`fcplan.env.demo_checkpoint`).
@@ -261,7 +265,7 @@ def demonstrations(
     """
     from fcplan.experiments.progress import episode_progress
 
-    jobs = _check_args(format, num_envs, jobs)
+    workers = _check_args(format, num_envs, jobs, dask)
     sched, name, settings = _scheduler(scheduler)
     env_kwargs = _env_kwargs(env_kwargs)
     seeds = [int(s) for s in seeds]
@@ -272,11 +276,27 @@ def demonstrations(
            "env_kwargs": _jsonable_kwargs(env_kwargs)}  # fmt: skip
     try:
         scen_docs = _roll_out(rollouts, sched, scheduler, scenarios, seeds, recordings, env_kwargs,
-                              time_limit, num_envs, jobs,
+                              time_limit, num_envs, workers,
                               None if checkpoint is None else (checkpoint, run))  # fmt: skip
     finally:
         getattr(bar, "close", lambda: None)()
-    meta = {
+    meta = _metadata(run, env_kwargs, rollouts, scen_docs)
+    if format == "minari":
+        from fcplan.env.demo_minari import write_minari
+
+        return write_minari(rollouts.records, meta, dataset_id or f"fcplan/task/{name}-v0", path)
+    demo = Demonstrations(rollouts.arrays(), meta)
+    if path is not None:
+        demo.save(path)
+    return demo
+
+
+def _metadata(
+    run: dict[str, Any], env_kwargs: dict[str, Any], rollouts: _Rollouts, scen_docs: dict
+) -> dict[str, Any]:
+    """A dataset's metadata (module docstring): the run, the features, the totals, the
+    episodes and scenarios, the library versions."""
+    return {
         "format": "fcplan-demonstrations",
         "version": FORMAT_VERSION,
         **run,
@@ -290,27 +310,19 @@ def demonstrations(
         "scenarios": scen_docs,
         "versions": _versions(),
     }
-    if format == "minari":
-        from fcplan.env.demo_minari import write_minari
-
-        return write_minari(rollouts.records, meta, dataset_id or f"fcplan/task/{name}-v0", path)
-    demo = Demonstrations(rollouts.arrays(), meta)
-    if path is not None:
-        demo.save(path)
-    return demo
 
 
-def _check_args(format: Any, num_envs: Any, jobs: Any) -> int:
-    """``jobs`` as an int (None: one per CPU), after checking the format and both counts
-    (one-line errors)."""
-    from fcplan.experiments.workers import check_jobs
+def _check_args(format: Any, num_envs: Any, jobs: Any, dask: Any) -> tuple[int, str | None]:
+    """``(jobs, dask)``: ``jobs`` as an int (None: one per CPU) and the Dask address, after
+    checking them, the format and ``num_envs`` (one-line errors)."""
+    from fcplan.experiments.workers import check_dask, check_jobs
 
     if format not in ("npz", "minari"):
         raise DemonstrationError(f"format: must be 'npz' or 'minari' (got {format!r})")
     jobs = check_jobs(jobs)
     if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
         raise DemonstrationError(f"num_envs: must be an integer >= 1 (got {num_envs!r:.40})")
-    return jobs
+    return jobs, check_dask(dask)
 
 
 def _roll_out(
@@ -323,7 +335,7 @@ def _roll_out(
     env_kwargs: dict[str, Any],
     time_limit: float | None,
     num_envs: int,
-    jobs: int,
+    workers: tuple[int, str | None],
     checkpoint: tuple[Any, dict[str, Any]] | None,
 ) -> dict[str, dict[str, Any]]:
     """Add every (scenario, seed) episode (:mod:`fcplan.env.demo_units`; those stored in the
@@ -340,7 +352,7 @@ def _roll_out(
         if checkpoint is not None:
             store = stack.enter_context(DemoCheckpoint(*checkpoint, dict(scen_docs)))
         got = _play_episodes(rollouts, store, keyed, seeds, sched, spec, env_kwargs, time_limit,
-                             num_envs, jobs)  # fmt: skip
+                             num_envs, workers)  # fmt: skip
     progress, rollouts.progress = rollouts.progress, None
     for _, key, _ in keyed:
         for seed in seeds:
@@ -363,10 +375,11 @@ def _play_episodes(
     env_kwargs: dict[str, Any],
     time_limit: float | None,
     num_envs: int,
-    jobs: int,
+    workers: tuple[int, str | None],
 ) -> dict[tuple[str, int], EpisodeRecord]:
     """Every (scenario key, seed) episode: read back from ``store``, or played in units (stored
-    as they finish); progress counted in episodes."""
+    as they finish) by ``workers`` (jobs, Dask address); progress counted in episodes."""
+    jobs, dask = workers
     got: dict[tuple[str, int], EpisodeRecord] = {}
     todo = []
     for scenario, key, probe in keyed:
@@ -388,7 +401,7 @@ def _play_episodes(
 
     if got and rollouts.progress is not None:
         rollouts.progress(len(got), rollouts.total, {})  # (the stored episodes)
-    play_units(units, jobs, on_unit=finished)
+    play_units(units, jobs, dask=dask, on_unit=finished)
     return got
 
 

@@ -97,7 +97,7 @@ from fcplan.experiments.results import (
     write_row,
 )
 from fcplan.experiments.tables import check_metric
-from fcplan.experiments.workers import check_jobs, default_jobs, runtime_factories
+from fcplan.experiments.workers import check_dask, check_jobs, default_jobs, runtime_factories
 
 __all__ = ["SweepSummary", "sweep"]
 
@@ -345,8 +345,7 @@ def _check_backend_args(jobs: Any, dask: Any) -> None:
     """One-line errors for a bad ``jobs`` or ``dask`` argument."""
     if jobs is not None:
         check_jobs(jobs)
-    if dask is not None and (not isinstance(dask, str) or not dask.strip()):
-        raise FcplanError(f"dask must be 'local' or a scheduler address, got {dask!r}")
+    check_dask(dask)
 
 
 def _results_folder(results: str | os.PathLike[str]) -> Path:

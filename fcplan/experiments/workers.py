@@ -36,6 +36,7 @@ from fcplan.errors import FcplanError
 __all__ = [
     "MAX_JOBS",
     "WATCHDOG_PERIOD_S",
+    "check_dask",
     "check_jobs",
     "default_jobs",
     "die_with_parent",
@@ -60,6 +61,20 @@ def default_jobs() -> int:
 
 #: Most worker processes a local pool may start (each is a Python process of ~100 MB).
 MAX_JOBS = 1024
+
+
+def check_dask(dask: Any) -> str | None:
+    """``dask`` (None: no Dask; ``"local"``: a LocalCluster; else a scheduler address) checked,
+    or a one-line error.
+
+    Examples
+    --------
+    >>> check_dask(None), check_dask("local")
+    (None, 'local')
+    """
+    if dask is not None and (not isinstance(dask, str) or not dask.strip()):
+        raise FcplanError(f"dask must be 'local' or a scheduler address, got {dask!r:.60}")
+    return dask
 
 
 def check_jobs(jobs: Any) -> int:

@@ -39,6 +39,28 @@ def test_jobs_give_the_dataset_of_one_process(num_envs):
     assert [d for d, _ in calls] == sorted(d for d, _ in calls)
 
 
+def test_dask_local_gives_the_dataset_of_one_process(tmp_path):
+    """``dask="local"`` (a LocalCluster of two workers, the backend of ``sweep --dask``) gives
+    the dataset of one process, and its checkpoint resumes as the pool's does."""
+    pytest.importorskip("distributed")
+    one = demonstrations("greedy", ["practice", 24], [3, 4], env_kwargs=KW, progress=False)
+    ck = tmp_path / "ck"
+    on_dask = demonstrations("greedy", ["practice", 24], [3, 4], env_kwargs=KW, jobs=2,
+                             dask="local", checkpoint=ck, progress=False)  # fmt: skip
+    _same(one, on_dask)
+    again = demonstrations("greedy", ["practice", 24], [3, 4], env_kwargs=KW, jobs=2,
+                           dask="local", checkpoint=ck, progress=False)  # fmt: skip
+    _same(one, again)
+
+
+@pytest.mark.parametrize("bad", ["", "  ", 3])
+def test_a_bad_dask_address_is_one_line(bad):
+    """A ``dask`` that is not ``"local"`` or an address is refused in one line, before any
+    episode, with sweep's message."""
+    with pytest.raises(FcplanError, match="dask must be 'local' or a scheduler address"):
+        demonstrations("greedy", ["practice"], [0], env_kwargs=KW, dask=bad, progress=False)
+
+
 def test_a_scheduler_object_goes_to_the_workers():
     """A scheduler object with its settings plans in the workers as it does here."""
     sched = GreedyScheduler(route_length=1)
@@ -84,6 +106,8 @@ def test_a_scheduler_that_cannot_be_pickled_is_refused_before_any_episode():
     sched.hook = lambda: None  # (a lambda does not pickle)
     with pytest.raises(FcplanError, match="jobs=2 sends the scheduler to worker processes, and"):
         demonstrations(sched, ["practice"], [0, 1], env_kwargs=KW, jobs=2, progress=False)
+    with pytest.raises(FcplanError, match="dask='local' sends the scheduler to worker processes"):
+        demonstrations(sched, ["practice"], [0], env_kwargs=KW, dask="local", progress=False)
     assert demonstrations(sched, ["practice"], [0], env_kwargs=KW, progress=False).n_episodes == 1
 
 
