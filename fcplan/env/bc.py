@@ -151,7 +151,7 @@ def dagger(
     demo = demonstrations(scheduler, scenarios, seeds, env_kwargs=env_kwargs, time_limit=time_limit)
     data = {k: [demo.arrays[k]] for k in ("agent_obs", "task_obs", "mask", "action")}
     policy = fit_bc(demo, l2=l2)
-    expert = _scheduler(scheduler)[0]
+    expert = _scheduler(scheduler, True)[0]  # (the demonstrations' expert: deterministic mode)
     for _ in range(int(rounds)):
         for sc in scenarios:
             env = TaskEnv(sc, **(env_kwargs or {}))

@@ -79,7 +79,12 @@ from fcplan.env.task_candidates import AGENT_FEATURES, TASK_FEATURES
 from fcplan.errors import FcplanError
 from fcplan.mission import ScenarioLike, as_scenario
 from fcplan.provenance import library_versions
-from fcplan.scheduling import Scheduler, make_scheduler, parse_scheduler_spec
+from fcplan.scheduling import (
+    Scheduler,
+    make_scheduler,
+    parse_scheduler_spec,
+    supports_deterministic,
+)
 
 __all__ = [
     "Demonstrations",
@@ -187,16 +192,25 @@ def _versions() -> dict[str, str]:
     return library_versions(("fcplan", "numpy", "scipy", "pettingzoo", "gymnasium", "ortools"))
 
 
-def _scheduler(spec: str | Scheduler) -> tuple[Scheduler, str, dict[str, Any]]:
+def _scheduler(
+    spec: str | Scheduler, deterministic: bool
+) -> tuple[Scheduler, str | Scheduler, str, dict[str, Any]]:
+    """The scheduler, the spec the units rebuild it from, its name and settings; a spec of a
+    scheduler with a deterministic mode gets ``deterministic=true`` when ``deterministic`` and
+    the spec does not set it (as :func:`fcplan.experiments.compare.scheduler_variant` does)."""
+    if not isinstance(deterministic, bool):
+        raise DemonstrationError(f"deterministic: must be True or False (got {deterministic!r})")
     if isinstance(spec, str):
         name, settings = parse_scheduler_spec(spec)
-        return make_scheduler(spec), name, settings
+        if deterministic and "deterministic" not in settings and supports_deterministic(name):
+            spec, settings = f"{spec}:deterministic=true", {**settings, "deterministic": True}
+        return make_scheduler(spec), spec, name, settings
     settings = {
         k: v
         for k, v in vars(spec).items()
         if not k.startswith("_") and isinstance(v, (bool, int, float, str, type(None)))
     }
-    return spec, getattr(spec, "name", type(spec).__name__), settings
+    return spec, spec, getattr(spec, "name", type(spec).__name__), settings
 
 
 def demonstrations(
@@ -215,6 +229,7 @@ def demonstrations(
     dask: str | None = None,
     checkpoint: str | Path | None = None,
     progress: Any = True,
+    deterministic: bool = True,
 ) -> Any:
     """Roll ``scheduler`` out through the task-level env on every (scenario, seed).
 
@@ -258,6 +273,11 @@ def demonstrations(
         ``True`` (default): a progress bar on stderr counted in episodes, the one of ``compare``
         and ``sweep`` (:mod:`fcplan.experiments.progress`; in place in Jupyter); ``False``:
         silent; or a ``progress(done, total, row)`` callback.
+    deterministic : bool
+        Run a scheduler named by a spec in its deterministic mode if it has one (work limits,
+        not the wall clock: the same dataset on any machine and load), as ``compare`` and
+        ``sweep`` do, unless the spec sets ``deterministic``; ``False`` leaves the mode to the
+        spec. A scheduler object runs as it was built.
 
     Returns
     -------
@@ -266,7 +286,7 @@ def demonstrations(
     from fcplan.experiments.progress import episode_progress
 
     workers = _check_args(format, num_envs, jobs, dask)
-    sched, name, settings = _scheduler(scheduler)
+    sched, spec, name, settings = _scheduler(scheduler, deterministic)
     env_kwargs = _env_kwargs(env_kwargs)
     seeds = [int(s) for s in seeds]
     scenarios, recordings = list(scenarios), list(recordings)
@@ -275,7 +295,7 @@ def demonstrations(
     run = {"scheduler": name, "scheduler_settings": settings, "time_limit": time_limit,
            "env_kwargs": _jsonable_kwargs(env_kwargs)}  # fmt: skip
     try:
-        scen_docs = _roll_out(rollouts, sched, scheduler, scenarios, seeds, recordings, env_kwargs,
+        scen_docs = _roll_out(rollouts, sched, spec, scenarios, seeds, recordings, env_kwargs,
                               time_limit, num_envs, workers,
                               None if checkpoint is None else (checkpoint, run))  # fmt: skip
     finally:
@@ -518,15 +538,17 @@ def episode_gap(
     """Manual final score of ``scheduler`` through the env vs :func:`fcplan.run_episode`.
 
     Returns one dict per (scenario, seed): ``scenario``, ``seed``, ``env``, ``episode``
-    (final scores) and the mapping counts of the env rollout.
+    (final scores) and the mapping counts of the env rollout. Both run the scheduler in its
+    deterministic mode if it has one (the demonstrations' default).
     """
     from fcplan.episode import run_episode
 
+    spec = _scheduler(scheduler, True)[1]
     out = []
     for sc in scenarios:
         for seed in seeds:
             demo = demonstrations(scheduler, [sc], [seed], env_kwargs=env_kwargs)
-            ref = run_episode(sc, scheduler, seed=seed)
+            ref = run_episode(sc, spec, seed=seed)
             out.append(
                 {
                     "scenario": demo.episodes[0]["scenario"],

@@ -86,6 +86,32 @@ def test_scheduler_object_and_settings(tmp_path):
     assert np.array_equal(spec.action, d.action)
 
 
+@pytest.mark.parametrize("num_envs", [1, 2])
+def test_specs_run_in_their_deterministic_mode(num_envs):
+    """A spec of a scheduler with a deterministic mode runs in it by default (so the dataset
+    does not depend on the machine's load), recorded in the settings, in the single and the
+    batched rollouts alike; a spec that sets the mode keeps it; ``deterministic=False`` leaves
+    it to the spec; greedy, which has no such setting, is unchanged; a non-bool is refused."""
+    kw = {"k": 3, "max_steps": 3}
+    cbba = demonstrations("cbba", ["practice"], [0, 1], env_kwargs=kw, num_envs=num_envs,
+                          progress=False)  # fmt: skip
+    assert cbba.metadata["scheduler_settings"] == {"deterministic": True}
+    same = demonstrations("cbba:deterministic=true", ["practice"], [0, 1], env_kwargs=kw,
+                          progress=False)  # fmt: skip
+    assert np.array_equal(cbba.action, same.action)
+    assert cbba.episodes == same.episodes
+    off = demonstrations("cbba:deterministic=false", ["practice"], [0], env_kwargs=kw,
+                         progress=False)  # fmt: skip
+    assert off.metadata["scheduler_settings"] == {"deterministic": False}
+    free = demonstrations("cbba", ["practice"], [0], env_kwargs=kw, deterministic=False,
+                          progress=False)  # fmt: skip
+    assert free.metadata["scheduler_settings"] == {}
+    greedy = demonstrations("greedy", ["practice"], [0], env_kwargs=kw, progress=False)
+    assert greedy.metadata["scheduler_settings"] == {}
+    with pytest.raises(DemonstrationError, match="deterministic: must be True or False"):
+        demonstrations("cbba", ["practice"], [0], env_kwargs=kw, deterministic="yes")
+
+
 def test_bad_files(tmp_path):
     """Missing, foreign, pickled or incomplete files raise DemonstrationError naming the file."""
     with pytest.raises(DemonstrationError, match="nope.npz"):
@@ -176,3 +202,17 @@ def test_demonstrations_report_progress_per_episode():
     assert calls == [(1, 2), (2, 2)]
     assert demo.n_episodes == 2
     demonstrations("greedy", ["practice"], [0], env_kwargs={"max_steps": 3}, progress=False)
+
+
+def test_episode_gap_compares_like_for_like():
+    """episode_gap plays the scheduler through the env and in run_episode with the same spec
+    (deterministic mode when it has one): the run_episode score is run_episode's own, and the
+    env score is the demonstration's."""
+    from fcplan import run_episode
+    from fcplan.env.demonstrations import episode_gap
+
+    (row,) = episode_gap("cbba", [24], [0], env_kwargs={"k": 4})
+    ref = run_episode(24, "cbba:deterministic=true", seed=0)
+    assert row["episode"] == ref.metrics["manual"].final_score
+    demo = demonstrations("cbba", [24], [0], env_kwargs={"k": 4}, progress=False)
+    assert row["env"] == demo.episodes[0]["metrics"]["manual"]["final_score"]
