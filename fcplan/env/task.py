@@ -120,7 +120,13 @@ from pettingzoo import ParallelEnv
 from fcplan.belief import Belief
 from fcplan.env.action_input import integer_action
 from fcplan.env.reward import PenaltyReward, RewardFn
-from fcplan.env.task_actions import actions_plan, decode_actions, rows_commands
+from fcplan.env.task_actions import (
+    actions_plan,
+    altitude_option,
+    decode_actions,
+    resolve_dump_altitude,
+    rows_commands,
+)
 from fcplan.env.task_candidates import (
     AGENT_FEATURES,
     FEATURE_BOUND,
@@ -134,34 +140,11 @@ from fcplan.errors import EnvError
 from fcplan.metrics import compute_all
 from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario, period_ticks
 from fcplan.plan import Plan, validate_plan
-from fcplan.settings import MAX_ALTITUDE_M, SettingError, altitude_setting
 from fcplan.taskgraph import TaskGraph, TaskGraphParams
 from fcplan.team import Command
 from fcplan.world import World
 
 __all__ = ["TaskEnv"]
-
-
-def _altitude(name: str, value: Any, *, named: str = "") -> float:
-    """An altitude option as a float in the schedulers' range, (0, MAX_ALTITUDE_M] m
-    (:func:`fcplan.settings.altitude_setting`); anything else is an :class:`EnvError` naming
-    the option (``named``: the other values it takes, for the message)."""
-    try:
-        return altitude_setting(name, value)
-    except SettingError:
-        raise EnvError(
-            f"{name}: must be {named}a number of metres in (0, {MAX_ALTITUDE_M:g}] (got {value!r})"
-        ) from None
-
-
-def _dump_altitude(value: Any, watch_altitude: float) -> float | None:
-    """The ``dump_altitude`` option resolved: ``"watch"`` -> ``watch_altitude``, None, or an
-    altitude (:func:`_altitude`)."""
-    if value is None:
-        return None
-    if isinstance(value, str) and value == "watch":
-        return watch_altitude
-    return _altitude("dump_altitude", value, named="'watch', None or ")
 
 
 class TaskEnv(ParallelEnv):
@@ -211,10 +194,10 @@ class TaskEnv(ParallelEnv):
         self.period = period_ticks(replan_period, self.tps)
         n_steps = -(-self.scenario.n_ticks // self.period)
         self.max_steps = n_steps if max_steps is None else min(int(max_steps), n_steps)
-        self.watch_altitude = _altitude("watch_altitude", watch_altitude)
-        self.search_altitude = _altitude("search_altitude", search_altitude)
+        self.watch_altitude = altitude_option("watch_altitude", watch_altitude)
+        self.search_altitude = altitude_option("search_altitude", search_altitude)
         #: the resolved dump altitude: a number (``"watch"``: ``watch_altitude``) or None
-        self.dump_altitude = _dump_altitude(dump_altitude, self.watch_altitude)
+        self.dump_altitude = resolve_dump_altitude(dump_altitude, self.watch_altitude)
         self.prune_bonus = float(prune_bonus)
         self.illegal_action = illegal_action
         self.validate = bool(validate)

@@ -48,11 +48,14 @@ Examples
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
 from fcplan.env.task_candidates import Candidates, _as_list
+from fcplan.errors import EnvError
 from fcplan.plan import Plan
+from fcplan.settings import MAX_ALTITUDE_M, SettingError, altitude_setting
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import Command
 
@@ -63,6 +66,8 @@ __all__ = [
     "rows_commands",
     "plan_to_actions",
     "MappingCounts",
+    "altitude_option",
+    "resolve_dump_altitude",
 ]
 
 _FIRE = int(TaskKind.FIRE)
@@ -146,19 +151,45 @@ def actions_plan(
     rows_l = rows.tolist()
     for i in np.flatnonzero(rows >= 0).tolist():
         routes[ids[i]] = (tids[rows_l[i]],)
-    dump = _resolved(dump_altitude, watch_altitude)
+    dump = resolve_dump_altitude(dump_altitude, watch_altitude)
     for i, z in _altitudes(graph, rows_l, watch_altitude, search_altitude, dump).items():
         alts[ids[i]] = z
     return Plan(routes=routes, altitudes=alts)
 
 
-def _resolved(dump_altitude: float | None | str, watch_altitude: float) -> float | None:
-    """``dump_altitude`` as a number or None (``"watch"``: ``watch_altitude``)."""
-    if isinstance(dump_altitude, str):
-        if dump_altitude != "watch":
-            raise ValueError(f"dump_altitude: 'watch', None or metres (got {dump_altitude!r})")
-        return watch_altitude
-    return dump_altitude
+def altitude_option(name: str, value: Any, *, named: str = "") -> float:
+    """An altitude option of the task env as a float in the schedulers' range,
+    (0, MAX_ALTITUDE_M] m (:func:`fcplan.settings.altitude_setting`); anything else is an
+    :class:`~fcplan.errors.EnvError` naming the option (``named``: the other values it takes).
+
+    Examples
+    --------
+    >>> altitude_option("watch_altitude", 35)
+    35.0
+    """
+    try:
+        return altitude_setting(name, value)
+    except SettingError:
+        raise EnvError(
+            f"{name}: must be {named}a number of metres in (0, {MAX_ALTITUDE_M:g}] (got {value!r})"
+        ) from None
+
+
+def resolve_dump_altitude(value: Any, watch_altitude: float) -> float | None:
+    """The ``dump_altitude`` option resolved (the one rule of the env and these functions):
+    None (the top of each hybrid's bounds) stays None, ``"watch"`` is ``watch_altitude``
+    (``task_v0``'s rule), a number is an altitude (:func:`altitude_option`).
+
+    Examples
+    --------
+    >>> resolve_dump_altitude("watch", 35.0), resolve_dump_altitude(None, 35.0)
+    (35.0, None)
+    """
+    if value is None:
+        return None
+    if isinstance(value, str) and value == "watch":
+        return float(watch_altitude)
+    return altitude_option("dump_altitude", value, named="'watch', None or ")
 
 
 def _altitudes(
@@ -206,7 +237,7 @@ def actions_commands(
     >>> actions_commands(g, rows) == plan_commands(actions_plan(g, rows), g)
     True
     """
-    dump = _resolved(dump_altitude, watch_altitude)
+    dump = resolve_dump_altitude(dump_altitude, watch_altitude)
     return rows_commands(graph, rows.tolist(), watch_altitude, search_altitude, dump)[0]
 
 
