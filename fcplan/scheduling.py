@@ -47,8 +47,12 @@ Factories check their settings at construction with the helpers of :mod:`fcplan.
 :func:`bool_setting`, :func:`choice_setting`: types, ranges, NaN; re-exported here), which raise
 :class:`SettingError`. A scheduler whose plans may depend on the wall clock offers a
 ``deterministic`` setting (work limits instead of time limits, fixed seeds, one worker);
-:func:`supports_deterministic` tells whether a factory takes it, which is how comparisons and
-sweeps turn it on by default.
+:func:`supports_deterministic` tells whether a factory takes it, and
+:func:`deterministic_settings` / :func:`deterministic_spec` turn it on unless the settings set
+it: the one rule by which comparisons, sweeps, demonstrations and the env's experts
+(:class:`~fcplan.env.motion_expert.PlanFollower`, its batched form) run schedulers in their
+deterministic modes by default. :func:`make_scheduler` itself (and so ``run_episode``) uses the
+scheduler's own defaults.
 
 Examples
 --------
@@ -90,7 +94,8 @@ from fcplan.team import Mode
 
 __all__ = [
     "Scheduler", "SolveStats", "STATUSES", "SettingError", "make_scheduler", "scheduler_factory",
-    "supports_deterministic", "int_setting", "float_setting", "bool_setting", "choice_setting",
+    "supports_deterministic", "deterministic_settings", "deterministic_spec", "int_setting",
+    "float_setting", "bool_setting", "choice_setting",
     "parse_scheduler_spec", "register_scheduler", "available_schedulers", "solve", "settle",
     "effective_time_limit", "idle_team",
 ]  # fmt: skip
@@ -295,6 +300,44 @@ def supports_deterministic(name: str) -> bool:
         return flag
     accepted = _accepted(factory)
     return accepted is not None and "deterministic" in accepted
+
+
+def deterministic_settings(name: str, settings: dict[str, Any]) -> dict[str, Any]:
+    """``settings`` with ``deterministic=True`` added when the scheduler ``name`` has a
+    deterministic mode (:func:`supports_deterministic`) and ``settings`` do not set it: the one
+    rule by which comparisons, sweeps, demonstrations and the experts run schedulers in their
+    deterministic modes by default.
+
+    Examples
+    --------
+    >>> deterministic_settings("routing", {"time_limit": 0.05})
+    {'time_limit': 0.05, 'deterministic': True}
+    >>> deterministic_settings("routing", {"deterministic": False})
+    {'deterministic': False}
+    >>> deterministic_settings("greedy", {})
+    {}
+    """
+    if "deterministic" in settings or not supports_deterministic(name):
+        return dict(settings)
+    return {**settings, "deterministic": True}
+
+
+def deterministic_spec(spec: str) -> str:
+    """The scheduler spec ``spec`` in its deterministic mode (:func:`deterministic_settings`):
+    ``":deterministic=true"`` appended when that adds the setting, else ``spec`` itself.
+
+    Examples
+    --------
+    >>> deterministic_spec("cbba:max_rounds=50"), deterministic_spec("greedy")
+    ('cbba:max_rounds=50:deterministic=true', 'greedy')
+    """
+    name, settings = parse_scheduler_spec(spec)
+    if (
+        "deterministic" in deterministic_settings(name, settings)
+        and "deterministic" not in settings
+    ):
+        return f"{spec}:deterministic=true"
+    return spec
 
 
 def make_scheduler(name: str, **settings: Any) -> Scheduler:

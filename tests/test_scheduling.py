@@ -525,3 +525,22 @@ def test_solve_records_the_graph_size_of_every_scheduler(name):
     stats = solve(make_scheduler(name), g, time_limit=None, rng=rng()).stats
     assert stats.size["agents"] == g.n_agents == 5
     assert stats.size["tasks"] == g.n_tasks == 20
+
+
+def test_deterministic_settings_and_spec_are_one_rule():
+    """deterministic_settings adds deterministic=True exactly for schedulers with that setting
+    and only when the settings do not set it; deterministic_spec is the same rule on a spec
+    string (appended, the rest of the spec as written), and the scheduler it makes has
+    ``deterministic`` True."""
+    from fcplan.scheduling import deterministic_settings, deterministic_spec
+
+    assert deterministic_settings("cbba", {"max_rounds": 5}) == {
+        "max_rounds": 5,
+        "deterministic": True,
+    }
+    assert deterministic_settings("cbba", {"deterministic": False}) == {"deterministic": False}
+    assert deterministic_settings("greedy", {"route_length": 2}) == {"route_length": 2}
+    assert deterministic_spec("cbba:max_rounds=5") == "cbba:max_rounds=5:deterministic=true"
+    assert deterministic_spec("cbba:deterministic=false") == "cbba:deterministic=false"
+    assert deterministic_spec("greedy:route_length=2") == "greedy:route_length=2"
+    assert make_scheduler(deterministic_spec("routing")).deterministic is True

@@ -81,9 +81,9 @@ from fcplan.mission import ScenarioLike, as_scenario
 from fcplan.provenance import library_versions
 from fcplan.scheduling import (
     Scheduler,
+    deterministic_spec,
     make_scheduler,
     parse_scheduler_spec,
-    supports_deterministic,
 )
 
 __all__ = [
@@ -201,9 +201,9 @@ def _scheduler(
     if not isinstance(deterministic, bool):
         raise DemonstrationError(f"deterministic: must be True or False (got {deterministic!r})")
     if isinstance(spec, str):
+        if deterministic:
+            spec = deterministic_spec(spec)
         name, settings = parse_scheduler_spec(spec)
-        if deterministic and "deterministic" not in settings and supports_deterministic(name):
-            spec, settings = f"{spec}:deterministic=true", {**settings, "deterministic": True}
         return make_scheduler(spec), spec, name, settings
     settings = {
         k: v

@@ -48,7 +48,7 @@ from fcplan.env.motion import ACTION_NAMES, MotionEnv, role_letters
 from fcplan.errors import EnvError
 from fcplan.mission import Mission
 from fcplan.plan import Plan
-from fcplan.scheduling import Scheduler, make_scheduler
+from fcplan.scheduling import Scheduler, deterministic_spec, make_scheduler
 from fcplan.taskgraph import TaskGraph, TaskGraphParams, TaskKind
 from fcplan.team import Mode
 
@@ -67,6 +67,9 @@ class PlanFollower:
         The environment to drive (a scenario env, not a preset).
     scheduler : str or Scheduler
         A registered scheduler name or spec (``"greedy"``, ``"milp:slots=2"``) or an instance.
+        A spec runs in the scheduler's deterministic mode if it has one, unless it sets
+        ``deterministic`` (:func:`fcplan.scheduling.deterministic_spec`: the same actions on any
+        machine, as in ``compare``); an instance runs as it was built.
     replan_period : float
         Simulated seconds between replans (> 0).
     time_limit : float, optional
@@ -96,7 +99,11 @@ class PlanFollower:
         if not replan_period > 0:
             raise EnvError(f"replan_period: must be > 0 simulated seconds (got {replan_period!r})")
         self.env = env
-        self.scheduler = make_scheduler(scheduler) if isinstance(scheduler, str) else scheduler
+        self.scheduler = (
+            make_scheduler(deterministic_spec(scheduler))
+            if isinstance(scheduler, str)
+            else scheduler
+        )
         self.replan_period = float(replan_period)
         self.time_limit = time_limit
         self.graph_params = graph_params

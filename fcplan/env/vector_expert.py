@@ -48,7 +48,7 @@ from fcplan.env.vector_task import TeamView, world_graphs
 from fcplan.errors import EnvError
 from fcplan.mission import period_ticks
 from fcplan.plan import Plan
-from fcplan.scheduling import Scheduler, make_scheduler
+from fcplan.scheduling import Scheduler, deterministic_spec, make_scheduler
 from fcplan.scheduling_batch import batch_capable, instances, solve_batch
 from fcplan.taskgraph import TaskGraphBuilder, TaskGraphParams
 
@@ -65,7 +65,8 @@ class BatchPlanFollower:
         A registered scheduler name or spec (one instance planning every world together when it
         has ``plan_batch``, as greedy, else one instance per world); one instance with
         ``plan_batch`` (shared by the worlds); or one instance per world (a scheduler that keeps
-        state between calls sees only its own world).
+        state between calls sees only its own world). A spec runs in the scheduler's
+        deterministic mode if it has one, as :class:`~fcplan.env.motion_expert.PlanFollower`'s.
     replan_period, time_limit, graph_params
         As :class:`fcplan.env.motion_expert.PlanFollower`.
 
@@ -96,7 +97,8 @@ class BatchPlanFollower:
         self.env, num = env, env.num_envs
         self.shared: Scheduler | None = None
         if isinstance(scheduler, str):
-            made = instances(lambda: make_scheduler(scheduler), num)
+            spec = deterministic_spec(scheduler)
+            made = instances(lambda: make_scheduler(spec), num)
             self.shared = None if isinstance(made, list) else made
             self.schedulers: list[Scheduler] = made if isinstance(made, list) else [made] * num
         elif isinstance(scheduler, (list, tuple)):

@@ -113,13 +113,13 @@ def scheduler_variant(spec: str, *, deterministic: bool = True) -> tuple[str, di
     >>> scheduler_variant("greedy:route_length=2", deterministic=False)
     ('greedy', {'route_length': 2})
     """
-    from fcplan.scheduling import make_scheduler, parse_scheduler_spec, supports_deterministic
+    from fcplan.scheduling import deterministic_settings, make_scheduler, parse_scheduler_spec
 
     if not isinstance(spec, str):
         raise FcplanError(f"schedulers are given by registered name, got {spec!r}")
     name, settings = parse_scheduler_spec(spec)
-    if deterministic and "deterministic" not in settings and supports_deterministic(name):
-        settings["deterministic"] = True
+    if deterministic:
+        settings = deterministic_settings(name, settings)
     make_scheduler(name, **settings)
     return name, settings
 

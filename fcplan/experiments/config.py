@@ -356,7 +356,7 @@ def _scenarios(source: str, value: Any, base_dir: Path | None) -> tuple[Any, ...
 
 
 def _schedulers(source: str, value: Any, deterministic: bool) -> tuple[SchedulerVariant, ...]:
-    from fcplan.scheduling import make_scheduler, parse_scheduler_spec, supports_deterministic
+    from fcplan.scheduling import deterministic_settings, make_scheduler, parse_scheduler_spec
 
     if value is None:
         raise _err(source, "schedulers", 'is required, e.g. schedulers = ["greedy", "random"]')
@@ -410,9 +410,8 @@ def _schedulers(source: str, value: Any, deterministic: bool) -> tuple[Scheduler
             raise _err(source, where, "must be a name, a name:key=value spec or a table", item)
         for label, name, settings in entries:
             try:  # the one validation path of scheduler specs (unknown names included)
-                add = deterministic and "deterministic" not in settings
-                if add and supports_deterministic(name):
-                    settings = {**settings, "deterministic": True}
+                if deterministic:
+                    settings = deterministic_settings(name, settings)
                 make_scheduler(name, **settings)
             except FcplanError as exc:
                 raise _err(source, where, str(exc)) from None

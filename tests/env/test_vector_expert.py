@@ -106,3 +106,19 @@ def test_bad_arguments_are_named():
             BatchPlanFollower(venv, **kwargs)
     with pytest.raises(EnvError, match="VectorMotionEnv"):
         BatchPlanFollower(MotionEnv("practice"), "greedy")  # type: ignore[arg-type]
+
+
+def test_specs_plan_in_their_deterministic_mode():
+    """A spec given to either follower runs in the scheduler's deterministic mode unless it
+    sets the mode (cbba: ``deterministic`` True on every instance, False when the spec says
+    so); an instance is used as it was built."""
+    from solvers.cbba import CBBAScheduler
+
+    sc = load_scenario("practice").replace(duration_s=2)
+    assert PlanFollower(MotionEnv(sc), "cbba").scheduler.deterministic is True
+    off = PlanFollower(MotionEnv(sc), "cbba:deterministic=false").scheduler
+    assert off.deterministic is False
+    batch = BatchPlanFollower(VectorMotionEnv(sc, 2), "cbba")
+    assert [s.deterministic for s in batch.schedulers] == [True, True]
+    mine = CBBAScheduler()
+    assert PlanFollower(MotionEnv(sc), mine).scheduler is mine and not mine.deterministic
