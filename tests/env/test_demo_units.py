@@ -136,6 +136,20 @@ def test_bad_env_arguments_fail_as_in_one_process():
                            progress=False)  # fmt: skip
 
 
+@pytest.mark.parametrize("bad", [["x"], [-1], [1.5], [True], 3, "12"])
+def test_bad_seeds_are_one_line(bad):
+    """Seeds must be a list of integers >= 0: a string, a float, a bool, a negative seed or a
+    lone integer is a one-line DemonstrationError before any episode."""
+    with pytest.raises(DemonstrationError, match=r"^seeds: must be "):
+        demonstrations("greedy", ["practice"], bad, env_kwargs=KW, progress=False)
+
+
+def test_repeated_seeds_play_once():
+    """A seed given twice is one episode (the order of first appearance kept), as in compare."""
+    d = demonstrations("greedy", ["practice"], [1, 0, 1], env_kwargs=KW, progress=False)
+    assert [e["seed"] for e in d.episodes] == [1, 0]
+
+
 @pytest.mark.parametrize("bad", [0, -1, 1.5, True, "2"])
 def test_bad_counts(bad):
     """``jobs`` and ``num_envs`` must be positive integers: one-line errors before any episode."""
