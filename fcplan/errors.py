@@ -22,6 +22,7 @@ __all__ = [
     "UnknownNameError",
     "EnvError",
     "LegacyError",
+    "SeedError",
     "install_hint",
 ]
 
@@ -98,3 +99,8 @@ class EnvError(FcplanError, ValueError):
 class LegacyError(FcplanError, ValueError):
     """A legacy file (the 2020 GUI's pickles) is unsafe, missing, or does not have the documented
     structure. Also importable as ``fcplan.legacy.LegacyError``."""
+
+
+class SeedError(FcplanError, ValueError):
+    """A seed that is not an integer >= 0, a ``numpy.random.SeedSequence``, a
+    ``numpy.random.Generator`` (where one is taken) or None."""

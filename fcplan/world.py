@@ -44,6 +44,7 @@ import numpy.typing as npt
 from fcplan._fast.team import sensing_confidence_of
 from fcplan._fast.world import scan_box as _scan_box
 from fcplan._fast.world import step_info_builder
+from fcplan.errors import SeedError
 from fcplan.fire import _BURNING8, Fire, _unique
 from fcplan.team import Command, Team, per_tick_probability
 from fcplan.trace import TRACE_FIELDS, Trace
@@ -433,8 +434,36 @@ class World:
         self._n_recorded = k + 1
 
 
+def check_seed(seed: Any, *, generator: bool = True) -> Seed:
+    """``seed`` if it is a seed the world takes: an integer >= 0 (not a bool), a
+    ``SeedSequence``, a ``Generator`` (when ``generator``) or None; else a one-line
+    :class:`~fcplan.errors.SeedError` (numpy's own errors name neither the argument nor the
+    allowed values, and it takes ``True`` as 1).
+
+    Examples
+    --------
+    >>> check_seed(3), check_seed(None)
+    (3, None)
+    >>> check_seed(-1)
+    Traceback (most recent call last):
+    ...
+    fcplan.errors.SeedError: seed: must be an integer >= 0, a SeedSequence, a Generator or None (got -1)
+    """
+    if seed is None or isinstance(seed, np.random.SeedSequence):
+        return seed
+    if generator and isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)) and seed >= 0:
+        return seed
+    allowed = "an integer >= 0, a SeedSequence, a Generator or None"
+    if not generator:
+        allowed = "an integer >= 0, a SeedSequence or None"
+    raise SeedError(f"seed: must be {allowed} (got {seed!r:.40})")
+
+
 def _spawn(seed: Seed, n: int) -> list[np.random.Generator]:
     """``n`` independent generators from an int, SeedSequence, Generator or None."""
+    seed = check_seed(seed)
     if isinstance(seed, np.random.Generator):
         return list(seed.spawn(n))
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)

@@ -257,3 +257,35 @@ def test_fire_does_not_depend_on_the_team_until_it_prunes():
         a.step()
         b.step()
     np.testing.assert_array_equal(a.fire.state, b.fire.state)
+
+
+@pytest.mark.parametrize("bad", [-1, True, np.bool_(False), 1.5, "3", [1, 2]])
+def test_bad_seeds_are_one_line_seed_errors(bad):
+    """A seed that is not an integer >= 0, a SeedSequence, a Generator or None is refused with
+    one SeedError line naming the allowed values, at every door: World.reset, run_episode, the
+    task env and the batched streams (numpy alone raises TypeError or ValueError without the
+    argument's name, and takes True as 1)."""
+    from fcplan import run_episode
+    from fcplan.batch.streams import spawn_streams
+    from fcplan.env.task import TaskEnv
+    from fcplan.errors import FcplanError, SeedError
+
+    sc = load_scenario("practice")
+    for call in (lambda: World(sc, seed=bad), lambda: run_episode(sc, "idle", seed=bad),
+                 lambda: TaskEnv(sc, max_steps=1).reset(seed=bad),
+                 lambda: spawn_streams(bad)):  # fmt: skip
+        with pytest.raises(SeedError, match=r"^seed: must be an integer >= 0, a SeedSequence"):
+            call()
+    assert issubclass(SeedError, FcplanError) and issubclass(SeedError, ValueError)
+
+
+def test_good_seeds_are_taken():
+    """Integers >= 0 (numpy's too), SeedSequences, Generators and None start a world; the same
+    int and its SeedSequence give the same fire."""
+    sc = load_scenario("practice")
+    for seed in (0, np.int64(7), 2**70, np.random.SeedSequence(3), np.random.default_rng(1), None):
+        World(sc, seed=seed)
+    a, b = World(sc, seed=5), World(sc, seed=np.random.SeedSequence(5))
+    for _ in range(30):
+        a.step({}), b.step({})
+    assert np.array_equal(a.fire.burning_cells(), b.fire.burning_cells())

@@ -63,14 +63,15 @@ def spawn_streams(seed: int | np.integer | np.random.SeedSequence | None) -> lis
 
     Raises
     ------
-    ValueError
-        If ``seed`` is not an int, a SeedSequence or None (a batch needs PCG64 streams).
+    fcplan.errors.SeedError
+        If ``seed`` is not an integer >= 0, a SeedSequence or None (a batch needs PCG64
+        streams: :func:`fcplan.world.check_seed` without generators).
     """
-    if seed is not None and not isinstance(seed, (int, np.integer, np.random.SeedSequence)):
-        raise ValueError(
-            f"seed: must be an int, a SeedSequence or None (got {type(seed).__name__})"
-        )
-    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    from fcplan.world import check_seed
+
+    checked = check_seed(seed, generator=False)
+    assert not isinstance(checked, np.random.Generator)  # (refused above)
+    ss = checked if isinstance(checked, np.random.SeedSequence) else np.random.SeedSequence(checked)
     return [np.random.default_rng(s) for s in ss.spawn(4)]
 
 

@@ -118,7 +118,7 @@ from fcplan.errors import EnvError
 from fcplan.mission import Mission, ScenarioLike, as_scenario
 from fcplan.scenario import Scenario
 from fcplan.team import CLIMB_PER_TICK
-from fcplan.world import StepInfo, World
+from fcplan.world import StepInfo, World, check_seed
 
 __all__ = ["MotionEnv", "parallel_env", "PRESETS", "ACTION_NAMES", "role_letters"]
 
@@ -317,6 +317,7 @@ class MotionEnv(ParallelEnv):
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, Any], dict[str, Any]]:
         """Start an episode; return ``(observations, infos)``."""
+        check_seed(seed, generator=False)  # (a one-line SeedError, not numpy's)
         if seed is not None:
             self._reseed = np.random.default_rng(seed)
         elif self._reseed is None:

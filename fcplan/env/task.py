@@ -142,7 +142,7 @@ from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario, period_
 from fcplan.plan import Plan, validate_plan
 from fcplan.taskgraph import TaskGraph, TaskGraphParams
 from fcplan.team import Command
-from fcplan.world import World
+from fcplan.world import World, check_seed
 
 __all__ = ["TaskEnv"]
 
@@ -285,6 +285,7 @@ class TaskEnv(ParallelEnv):
         next seed of a deterministic sequence spawned from the last one is used (fresh OS
         entropy if no seed was ever given).
         """
+        check_seed(seed, generator=False)  # (a one-line SeedError, not numpy's)
         if seed is not None:
             self._seed_seq = np.random.SeedSequence(seed)
             world_seed: Any = seed
