@@ -272,6 +272,9 @@ def world_seeds(num: int, rows: Sequence[int] | np.ndarray, seeds: Sequence | in
     ------
     ValueError
         For a sequence of another length.
+    fcplan.errors.SeedError
+        For a seed that is not an integer >= 0, a SeedSequence or None
+        (:func:`fcplan.world.check_seed`), or a string given as the sequence.
 
     Examples
     --------
@@ -280,12 +283,20 @@ def world_seeds(num: int, rows: Sequence[int] | np.ndarray, seeds: Sequence | in
     >>> world_seeds(4, [1, 2], [7, 8])
     [7, 8]
     """
+    from fcplan.errors import SeedError
+    from fcplan.world import check_seed
+
     rows_l = np.asarray(rows, dtype=np.int64).tolist()
     if seeds is None:
         return [None] * len(rows_l)
-    if isinstance(seeds, (int, np.integer)):
-        return [int(seeds) + b for b in rows_l]
-    given = list(seeds)
+    if isinstance(seeds, (str, bytes)):
+        raise SeedError(
+            f"seed: must be an integer >= 0, a list of them or None (got {seeds!r:.40})"
+        )
+    if isinstance(seeds, (int, np.integer, np.bool_)):
+        base = check_seed(seeds, generator=False)
+        return [int(base) + b for b in rows_l]  # type: ignore[arg-type]
+    given = [check_seed(s, generator=False) for s in seeds]
     if len(given) == num:
         return [given[b] for b in rows_l]
     if len(given) == len(rows_l):

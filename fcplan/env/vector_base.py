@@ -28,7 +28,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 
 from fcplan.batch.streams import world_seeds
-from fcplan.errors import EnvError
+from fcplan.errors import EnvError, SeedError
 
 __all__ = [
     "AUTORESET_MODES",
@@ -79,6 +79,8 @@ def reset_seeds(num: int, rows: np.ndarray, seed: Any) -> list[Any]:
     """
     try:
         return world_seeds(num, rows, seed)
+    except SeedError:
+        raise
     except ValueError as exc:
         raise EnvError(str(exc)) from None
 

@@ -96,3 +96,19 @@ def test_seeds():
         spawn_streams(np.random.default_rng(0))
     a = spawn_streams(3)
     assert [g.random() for g in a] == [g.random() for g in spawn_streams(np.random.SeedSequence(3))]
+
+
+@pytest.mark.parametrize("bad", [-1, True, "x", [1, -2], [0, 1.5], [None, "3"]])
+def test_bad_seeds_are_seed_errors_in_both_vector_envs(bad):
+    """A bad seed, or a bad seed in the list, given to a batched reset is the world's one-line
+    SeedError (the check of fcplan.world.check_seed), in world_seeds and at both vector levels;
+    a string is not taken for a list of seeds."""
+    from fcplan.env import vector_env
+    from fcplan.errors import SeedError
+
+    with pytest.raises(SeedError, match=r"^seed: must be an integer >= 0"):
+        world_seeds(2, [0, 1], bad)
+    for mode in ("motion", "task"):
+        env = vector_env("practice", mode, 2)
+        with pytest.raises(SeedError, match=r"^seed: must be an integer >= 0"):
+            env.reset(seed=bad)
