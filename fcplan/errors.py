@@ -23,6 +23,7 @@ __all__ = [
     "EnvError",
     "LegacyError",
     "SeedError",
+    "ArgumentError",
     "install_hint",
 ]
 
@@ -104,3 +105,8 @@ class LegacyError(FcplanError, ValueError):
 class SeedError(FcplanError, ValueError):
     """A seed that is not an integer >= 0, a ``numpy.random.SeedSequence``, a
     ``numpy.random.Generator`` (where one is taken) or None."""
+
+
+class ArgumentError(FcplanError, ValueError):
+    """A bad argument of a public function that no more specific class covers (the message
+    names the argument, the allowed values and what it got)."""

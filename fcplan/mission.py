@@ -75,7 +75,7 @@ from typing import Any, Protocol, cast, runtime_checkable
 import numpy as np
 
 from fcplan.belief import Belief, ClairvoyantBelief
-from fcplan.errors import FcplanError
+from fcplan.errors import ArgumentError
 from fcplan.plan import Plan, plan_commands
 from fcplan.scenario import Scenario, load_scenario
 from fcplan.scheduling import Scheduler, SolveStats, solve
@@ -234,8 +234,14 @@ class Mission:
         self._next_periodic = self.world.tick
 
     def _set_rule(self, replan_period: float, event_replans: bool) -> None:
-        if not replan_period > 0:
-            raise ValueError(f"replan_period must be > 0 simulated seconds, got {replan_period!r}")
+        ok = isinstance(replan_period, (int, float, np.integer, np.floating)) and not isinstance(
+            replan_period, (bool, np.bool_)
+        )
+        if not (ok and math.isfinite(replan_period) and replan_period > 0):
+            raise ArgumentError(
+                f"replan_period: must be a finite number > 0 of simulated seconds "
+                f"(got {replan_period!r:.40})"
+            )
         self.replan_period = float(replan_period)
         #: ticks between periodic replans
         self.period = period_ticks(replan_period, self.scenario.ticks_per_second)
@@ -391,6 +397,7 @@ class Mission:
         Meanwhile the team keeps flying its last orders, and no new replan starts until the
         pending plan applies (one planner, busy while it thinks).
         """
+        check_time_limit(time_limit)
         delay = latency_rule(latency, self.scenario.ticks_per_second)
         pending: tuple[int, Commands] | None = None
         while not self.world.done:
@@ -440,4 +447,26 @@ def latency_rule(latency: str | None, ticks_per_second: int) -> Callable[[SolveS
     if kind == "ticks" and n.isdigit():
         ticks = int(n)
         return lambda stats: ticks
-    raise FcplanError(f"latency: must be None, 'wall' or 'ticks:N' with N >= 0 (got {latency!r})")
+    raise ArgumentError(f"latency: must be None, 'wall' or 'ticks:N' with N >= 0 (got {latency!r})")
+
+
+def check_time_limit(time_limit: Any) -> float | None:
+    """``time_limit`` (wall seconds per scheduler call) as a float, or None; else a one-line
+    :class:`~fcplan.errors.ArgumentError` (a NaN, an infinity, zero or less, a bool or a
+    string would reach every scheduler call).
+
+    Examples
+    --------
+    >>> check_time_limit(0.5), check_time_limit(None)
+    (0.5, None)
+    """
+    if time_limit is None:
+        return None
+    ok = isinstance(time_limit, (int, float, np.integer, np.floating)) and not isinstance(
+        time_limit, (bool, np.bool_)
+    )
+    if not (ok and math.isfinite(time_limit) and time_limit > 0):
+        raise ArgumentError(
+            f"time_limit: must be None or a finite number > 0 of seconds (got {time_limit!r:.40})"
+        )
+    return float(time_limit)

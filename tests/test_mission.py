@@ -224,3 +224,29 @@ def test_set_graph_params_builds_the_graphs_with_them_from_then_on():
     assert mission.task_graph().search_tasks.size == 36
     mission.reset(1)
     assert mission.task_graph().search_tasks.size == 36
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"time_limit": float("nan")}, r"^time_limit: must be None or a finite number > 0"),
+        ({"time_limit": 0}, r"^time_limit: must be None or a finite number > 0"),
+        ({"time_limit": -1.0}, r"^time_limit: must be None or a finite number > 0"),
+        ({"time_limit": True}, r"^time_limit: must be None or a finite number > 0"),
+        ({"time_limit": "1"}, r"^time_limit: must be None or a finite number > 0"),
+        ({"replan_period": -1}, r"^replan_period: must be a finite number > 0"),
+        ({"replan_period": float("inf")}, r"^replan_period: must be a finite number > 0"),
+        ({"replan_period": "1"}, r"^replan_period: must be a finite number > 0"),
+    ],
+)
+def test_bad_time_limits_and_periods_are_one_line_argument_errors(kwargs, match):
+    """run_episode refuses a time limit or replan period that is not a finite number > 0 (a
+    NaN time limit used to reach every scheduler call) with one ArgumentError line, an
+    FcplanError and ValueError, before any tick."""
+    from fcplan import run_episode
+    from fcplan.errors import ArgumentError, FcplanError
+
+    with pytest.raises(ArgumentError, match=match) as err:
+        run_episode("practice", "greedy", seed=0, **kwargs)
+    assert isinstance(err.value, FcplanError) and isinstance(err.value, ValueError)
+    assert "\n" not in str(err.value)
