@@ -79,6 +79,7 @@ from fcplan.errors import ArgumentError
 from fcplan.plan import Plan, plan_commands
 from fcplan.scenario import Scenario, load_scenario
 from fcplan.scheduling import Scheduler, SolveStats, solve
+from fcplan.settings import SettingError, float_setting
 from fcplan.taskgraph import TaskGraph, TaskGraphBuilder, TaskGraphParams, TaskKind
 from fcplan.team import Command
 from fcplan.world import StepInfo, World
@@ -234,15 +235,9 @@ class Mission:
         self._next_periodic = self.world.tick
 
     def _set_rule(self, replan_period: float, event_replans: bool) -> None:
-        ok = isinstance(replan_period, (int, float, np.integer, np.floating)) and not isinstance(
-            replan_period, (bool, np.bool_)
+        self.replan_period = _positive(
+            "replan_period", replan_period, "a finite number > 0 of simulated seconds"
         )
-        if not (ok and math.isfinite(replan_period) and replan_period > 0):
-            raise ArgumentError(
-                f"replan_period: must be a finite number > 0 of simulated seconds "
-                f"(got {replan_period!r:.40})"
-            )
-        self.replan_period = float(replan_period)
         #: ticks between periodic replans
         self.period = period_ticks(replan_period, self.scenario.ticks_per_second)
         self.event_replans = bool(event_replans)
@@ -462,11 +457,14 @@ def check_time_limit(time_limit: Any) -> float | None:
     """
     if time_limit is None:
         return None
-    ok = isinstance(time_limit, (int, float, np.integer, np.floating)) and not isinstance(
-        time_limit, (bool, np.bool_)
-    )
-    if not (ok and math.isfinite(time_limit) and time_limit > 0):
-        raise ArgumentError(
-            f"time_limit: must be None or a finite number > 0 of seconds (got {time_limit!r:.40})"
-        )
-    return float(time_limit)
+    return _positive("time_limit", time_limit, "None or a finite number > 0 of seconds")
+
+
+def _positive(name: str, value: Any, allowed: str) -> float:
+    """``value`` as a finite float > 0 (the number check of
+    :func:`fcplan.settings.float_setting`: bools, strings, NaN and infinities refused), else an
+    :class:`~fcplan.errors.ArgumentError` naming ``name`` and what is ``allowed``."""
+    try:
+        return float_setting(name, value, 0.0, lo_open=True)
+    except SettingError:
+        raise ArgumentError(f"{name}: must be {allowed} (got {value!r:.40})") from None

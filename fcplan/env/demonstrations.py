@@ -324,9 +324,7 @@ def _metadata(
         "k": int(env_kwargs.get("k", 8)),
         "agent_features": list(AGENT_FEATURES),
         "task_features": list(TASK_FEATURES),
-        "mapping": dict(rollouts.counts),
-        "conflicts": int(rollouts.conflicts),
-        "fallbacks": int(rollouts.fallbacks),
+        **rollouts.totals(),
         "episodes": rollouts.episodes,
         "scenarios": scen_docs,
         "versions": _versions(),
@@ -457,8 +455,6 @@ class _Rollouts:
         self.parts: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
         self.episodes: list[dict[str, Any]] = []
         self.records: list[EpisodeRecord] = []
-        self.counts = MappingCounts()
-        self.fallbacks = self.conflicts = 0
 
     def add(self, rec: EpisodeRecord) -> None:
         """Append one episode: its rows (one per step and agent) and its record; count it on
@@ -475,10 +471,6 @@ class _Rollouts:
         parts["episode"].append(np.full(n * n_a, ep))
         parts["step"].append(np.repeat(np.arange(n), n_a))
         parts["agent"].append(np.tile(np.arange(n_a), n))
-        for name, count in rec.counts.items():
-            self.counts[name] += count
-        self.conflicts += int(rec.conflict.sum())
-        self.fallbacks += rec.fallbacks
         self.records.append(rec)
         self.episodes.append(
             {
@@ -493,6 +485,19 @@ class _Rollouts:
         )
         if self.progress is not None:
             self.progress(len(self.episodes), self.total, {})
+
+    def totals(self) -> dict[str, Any]:
+        """The dataset's ``mapping``, ``conflicts`` and ``fallbacks``: the sums of its episodes'
+        entries (:func:`~fcplan.env.demo_episodes.episode_mapping`)."""
+        counts = MappingCounts()
+        for e in self.episodes:
+            for name, count in e["mapping"].items():
+                counts[name] += count
+        return {
+            "mapping": dict(counts),
+            "conflicts": sum(e["conflicts"] for e in self.episodes),
+            "fallbacks": sum(e["fallbacks"] for e in self.episodes),
+        }
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The dataset's arrays (module docstring), rows of every episode in order."""
