@@ -75,7 +75,7 @@ from typing import Any, Protocol, cast, runtime_checkable
 import numpy as np
 
 from fcplan.belief import Belief, ClairvoyantBelief
-from fcplan.errors import ArgumentError
+from fcplan.errors import ArgumentError, FcplanError
 from fcplan.plan import Plan, plan_commands
 from fcplan.scenario import Scenario, load_scenario
 from fcplan.scheduling import Scheduler, SolveStats, solve
@@ -235,9 +235,7 @@ class Mission:
         self._next_periodic = self.world.tick
 
     def _set_rule(self, replan_period: float, event_replans: bool) -> None:
-        self.replan_period = _positive(
-            "replan_period", replan_period, "a finite number > 0 of simulated seconds"
-        )
+        self.replan_period = check_replan_period(replan_period)
         #: ticks between periodic replans
         self.period = period_ticks(replan_period, self.scenario.ticks_per_second)
         self.event_replans = bool(event_replans)
@@ -460,11 +458,32 @@ def check_time_limit(time_limit: Any) -> float | None:
     return _positive("time_limit", time_limit, "None or a finite number > 0 of seconds")
 
 
-def _positive(name: str, value: Any, allowed: str) -> float:
+def check_replan_period(replan_period: Any, *, error: type[FcplanError] = ArgumentError) -> float:
+    """``replan_period`` (simulated seconds between periodic replans) as a finite float > 0,
+    else a one-line ``error`` (:class:`~fcplan.errors.ArgumentError`; the envs pass
+    :class:`~fcplan.errors.EnvError`): the one check of the mission, the task env and the plan
+    followers, before :func:`period_ticks` rounds it.
+
+    Examples
+    --------
+    >>> check_replan_period(2)
+    2.0
+    >>> check_replan_period(float("inf"))
+    Traceback (most recent call last):
+    ...
+    fcplan.errors.ArgumentError: replan_period: must be a finite number > 0 of simulated seconds (got inf)
+    """
+    allowed = "a finite number > 0 of simulated seconds"
+    return _positive("replan_period", replan_period, allowed, error)
+
+
+def _positive(
+    name: str, value: Any, allowed: str, error: type[FcplanError] = ArgumentError
+) -> float:
     """``value`` as a finite float > 0 (the number check of
     :func:`fcplan.settings.float_setting`: bools, strings, NaN and infinities refused), else an
-    :class:`~fcplan.errors.ArgumentError` naming ``name`` and what is ``allowed``."""
+    ``error`` naming ``name`` and what is ``allowed``."""
     try:
         return float_setting(name, value, 0.0, lo_open=True)
     except SettingError:
-        raise ArgumentError(f"{name}: must be {allowed} (got {value!r:.40})") from None
+        raise error(f"{name}: must be {allowed} (got {value!r:.40})") from None

@@ -453,12 +453,45 @@ def check_seed(seed: Any, *, generator: bool = True) -> Seed:
         return seed
     if generator and isinstance(seed, np.random.Generator):
         return seed
-    if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)) and seed >= 0:
+    if _is_int_seed(seed):
         return seed
     allowed = "an integer >= 0, a SeedSequence, a Generator or None"
     if not generator:
         allowed = "an integer >= 0, a SeedSequence or None"
     raise SeedError(f"seed: must be {allowed} (got {seed!r:.40})")
+
+
+def seed_list(seeds: Any, name: str = "seeds") -> list[int]:
+    """``seeds`` as a list of distinct integers >= 0 in the order given, a lone integer as a
+    list of one: the one rule of every function that plays a list of seeds
+    (:func:`fcplan.compare`, :func:`fcplan.env.demonstrations`, a sweep's ``seeds``). An
+    empty list is returned as it is (the caller says whether it may be empty); anything else
+    (a bool, a float, a negative number, a string, a non-iterable) is a one-line
+    :class:`~fcplan.errors.SeedError` naming ``name``.
+
+    Examples
+    --------
+    >>> seed_list([3, 1, 3]), seed_list(2), seed_list(range(2))
+    ([3, 1], [2], [0, 1])
+    >>> seed_list([0, -1])
+    Traceback (most recent call last):
+    ...
+    fcplan.errors.SeedError: seeds: must be integers >= 0 (got -1)
+    """
+    if _is_int_seed(seeds):
+        return [int(seeds)]
+    if isinstance(seeds, (str, bytes, dict)) or not hasattr(seeds, "__iter__"):
+        raise SeedError(f"{name}: must be a list of integers >= 0 (got {seeds!r:.40})")
+    out = []
+    for s in seeds:
+        if not _is_int_seed(s):
+            raise SeedError(f"{name}: must be integers >= 0 (got {s!r:.40})")
+        out.append(int(s))
+    return list(dict.fromkeys(out))
+
+
+def _is_int_seed(s: Any) -> bool:
+    return isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and bool(s >= 0)
 
 
 def _spawn(seed: Seed, n: int) -> list[np.random.Generator]:

@@ -289,3 +289,28 @@ def test_good_seeds_are_taken():
     for _ in range(30):
         a.step({}), b.step({})
     assert np.array_equal(a.fire.burning_cells(), b.fire.burning_cells())
+
+
+@given(st.lists(st.integers(0, 2**40), max_size=8))
+def test_seed_list_keeps_the_first_of_each_seed_in_order(seeds):
+    """seed_list returns each integer seed once, in the order of its first appearance, as
+    plain ints, for lists, tuples and numpy arrays alike."""
+    from fcplan.world import seed_list
+
+    want = list(dict.fromkeys(seeds))
+    assert seed_list(seeds) == want
+    assert seed_list(tuple(seeds)) == want
+    got = seed_list(np.array(seeds, dtype=np.int64))
+    assert got == want and all(type(s) is int for s in got)
+
+
+@pytest.mark.parametrize("bad", [[-1], [1.0], [True], ["3"], "0-4", 1.5, None, True, {0: 1}])
+def test_seed_list_refuses_what_is_not_a_list_of_seeds(bad):
+    """A negative, float, bool or string seed, and a lone value that is not an integer >= 0,
+    is a one-line SeedError naming the argument; a lone integer is a list of one."""
+    from fcplan.errors import SeedError
+    from fcplan.world import seed_list
+
+    with pytest.raises(SeedError, match=r"^sweep\.toml: seeds: must be .*\(got "):
+        seed_list(bad, name="sweep.toml: seeds")
+    assert seed_list(7) == [7] and seed_list(np.int64(7)) == [7] and seed_list([]) == []

@@ -294,8 +294,8 @@ def world_seeds(num: int, rows: Sequence[int] | np.ndarray, seeds: Sequence | in
             f"seed: must be an integer >= 0, a list of them or None (got {seeds!r:.40})"
         )
     if isinstance(seeds, (int, np.integer, np.bool_)):
-        base = check_seed(seeds, generator=False)
-        return [int(base) + b for b in rows_l]  # type: ignore[arg-type]
+        check_seed(seeds, generator=False)  # (a bool or a negative integer is refused)
+        return [int(seeds) + b for b in rows_l]
     given = [check_seed(s, generator=False) for s in seeds]
     if len(given) == num:
         return [given[b] for b in rows_l]

@@ -85,6 +85,7 @@ from fcplan.scheduling import (
     make_scheduler,
     parse_scheduler_spec,
 )
+from fcplan.world import seed_list
 
 __all__ = [
     "Demonstrations",
@@ -238,8 +239,9 @@ def demonstrations(
     scheduler : str or Scheduler
         A registered name or spec (``"milp"``, ``"greedy:route_length=2"``) or a scheduler object.
     scenarios : iterable of Scenario, str or int
-    seeds : iterable of int
-        World seeds (integers >= 0; a repeated seed is played once).
+    seeds : int or iterable of int
+        World seeds (integers >= 0; a repeated seed is played once; the rule of
+        :func:`fcplan.world.seed_list`, a bad seed a one-line :class:`~fcplan.errors.SeedError`).
     path : str or Path, optional
         Also save the dataset there: the ``.npz`` file, or with ``format="minari"`` the Minari
         datasets root (default: Minari's own, ``MINARI_DATASETS_PATH`` or ``~/.minari/datasets``).
@@ -289,7 +291,7 @@ def demonstrations(
     workers = _check_args(format, num_envs, jobs, dask)
     sched, spec, name, settings = _scheduler(scheduler, deterministic)
     env_kwargs = _env_kwargs(env_kwargs)
-    seeds = _seeds(seeds)
+    seeds = seed_list(seeds)
     scenarios, recordings = list(scenarios), list(recordings)
     bar = episode_progress(progress, "demonstrations")
     rollouts = _Rollouts(bar, len(scenarios) * len(seeds) + len(recordings))
@@ -329,19 +331,6 @@ def _metadata(
         "scenarios": scen_docs,
         "versions": _versions(),
     }
-
-
-def _seeds(seeds: Any) -> list[int]:
-    """The seeds as ints >= 0, each once, in the order given (a one-line error otherwise: a
-    bool, a non-integer or a negative seed, or a lone integer where a list was meant)."""
-    if isinstance(seeds, (int, np.integer, str)):
-        raise DemonstrationError(f"seeds: must be a list of integers >= 0 (got {seeds!r:.40})")
-    out = []
-    for s in seeds:
-        if isinstance(s, (bool, np.bool_)) or not isinstance(s, (int, np.integer)) or s < 0:
-            raise DemonstrationError(f"seeds: must be integers >= 0 (got {s!r:.40})")
-        out.append(int(s))
-    return list(dict.fromkeys(out))
 
 
 def _check_args(format: Any, num_envs: Any, jobs: Any, dask: Any) -> tuple[int, str | None]:

@@ -46,7 +46,7 @@ from typing import Any
 from fcplan.belief import Belief
 from fcplan.env.motion import ACTION_NAMES, MotionEnv, role_letters
 from fcplan.errors import EnvError
-from fcplan.mission import Mission
+from fcplan.mission import Mission, check_replan_period
 from fcplan.plan import Plan
 from fcplan.scheduling import Scheduler, deterministic_spec, make_scheduler
 from fcplan.taskgraph import TaskGraph, TaskGraphParams, TaskKind
@@ -96,8 +96,7 @@ class PlanFollower:
     ) -> None:
         if not isinstance(env, MotionEnv):
             raise EnvError("PlanFollower: env must be a scenario MotionEnv (presets have no plans)")
-        if not replan_period > 0:
-            raise EnvError(f"replan_period: must be > 0 simulated seconds (got {replan_period!r})")
+        replan_period = check_replan_period(replan_period, error=EnvError)
         self.env = env
         self.scheduler = (
             make_scheduler(deterministic_spec(scheduler))

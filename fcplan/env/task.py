@@ -138,7 +138,14 @@ from fcplan.env.task_candidates import (
 )
 from fcplan.errors import EnvError
 from fcplan.metrics import compute_all
-from fcplan.mission import Commands, Mission, ScenarioLike, as_scenario, period_ticks
+from fcplan.mission import (
+    Commands,
+    Mission,
+    ScenarioLike,
+    as_scenario,
+    check_replan_period,
+    period_ticks,
+)
 from fcplan.plan import Plan, validate_plan
 from fcplan.taskgraph import TaskGraph, TaskGraphParams
 from fcplan.team import Command
@@ -179,8 +186,7 @@ class TaskEnv(ParallelEnv):
         self.scenario = as_scenario(scenario)
         if not (isinstance(k, (int, np.integer)) and 1 <= k <= 1024):
             raise EnvError(f"k: must be an integer in 1..1024 (got {k!r})")
-        if not (np.isfinite(replan_period) and replan_period > 0):
-            raise EnvError(f"replan_period: must be > 0 simulated seconds (got {replan_period!r})")
+        replan_period = check_replan_period(replan_period, error=EnvError)
         if max_steps is not None and not (
             isinstance(max_steps, (int, np.integer)) and max_steps > 0
         ):

@@ -46,7 +46,7 @@ from fcplan.env.vector_motion import VectorMotionEnv
 from fcplan.env.vector_moves import BatchRoutes
 from fcplan.env.vector_task import TeamView, world_graphs
 from fcplan.errors import EnvError
-from fcplan.mission import period_ticks
+from fcplan.mission import check_replan_period, period_ticks
 from fcplan.plan import Plan
 from fcplan.scheduling import Scheduler, deterministic_spec, make_scheduler
 from fcplan.scheduling_batch import batch_capable, instances, solve_batch
@@ -92,8 +92,7 @@ class BatchPlanFollower:
     ) -> None:
         if not isinstance(env, VectorMotionEnv):
             raise EnvError("BatchPlanFollower: env must be a VectorMotionEnv")
-        if not replan_period > 0:
-            raise EnvError(f"replan_period: must be > 0 simulated seconds (got {replan_period!r})")
+        replan_period = check_replan_period(replan_period, error=EnvError)
         self.env, num = env, env.num_envs
         self.shared: Scheduler | None = None
         if isinstance(scheduler, str):

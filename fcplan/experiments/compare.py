@@ -45,15 +45,12 @@ Examples
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from fcplan.errors import FcplanError
 from fcplan.experiments.autoseeds import AutoSeeds
@@ -64,6 +61,7 @@ from fcplan.experiments.progress import Progress, ProgressCallback, episode_prog
 from fcplan.experiments.ranges import RangeError, parse_range
 from fcplan.experiments.tables import SCORE_COLUMNS, check_metric, fallback_majority
 from fcplan.experiments.workers import check_jobs, runtime_factories
+from fcplan.mission import check_replan_period, check_time_limit
 
 __all__ = [
     "compare",
@@ -150,27 +148,12 @@ def _load_scenarios(scenarios: Any) -> list[Any]:
 
 
 def _check_seeds(seeds: Any) -> list[int]:
-    if isinstance(seeds, (int, np.integer)):
-        seeds = [seeds]
-    out = []
-    for s in seeds:
-        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 0:
-            raise FcplanError(f"seeds must be integers >= 0, got {s!r}")
-        out.append(int(s))
+    from fcplan.world import seed_list
+
+    out = seed_list(seeds)
     if not out:
-        raise FcplanError("no seeds to compare")
-    return list(dict.fromkeys(out))
-
-
-def _positive(name: str, value: Any) -> float:
-    """``value`` as a finite number > 0, or a one-line error naming ``name``."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        v = math.nan
-    if not (math.isfinite(v) and v > 0):
-        raise FcplanError(f"{name} must be a number > 0, got {value!r}")
-    return v
+        raise FcplanError("seeds: no seeds to compare")
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -325,8 +308,8 @@ def compare(
     metric_list = _check_metrics(metrics)
     auto = AutoSeeds(seed_batch, max_seeds, metric_list[0]) if _is_auto(seeds) else None
     seed_list = [] if auto else _check_seeds(seeds)
-    tl = None if time_limit is None else _positive("time_limit", time_limit)
-    rp = _positive("replan_period", replan_period)
+    tl = check_time_limit(time_limit)
+    rp = check_replan_period(replan_period)
     jobs = _check_jobs(jobs)
     settings = {"time_limit": tl, "replan_period": rp, "deterministic": deterministic}
     study = study_hash(scen, variants, settings)

@@ -67,7 +67,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fcplan.errors import FcplanError, ScenarioError
+from fcplan.errors import FcplanError, ScenarioError, SeedError
 from fcplan.experiments.overrides import SweepConfigError, apply_overrides
 
 __all__ = [
@@ -287,11 +287,10 @@ def _number_axis(
 
 def _seeds(source: str, value: Any) -> tuple[int, ...]:
     from fcplan.experiments.ranges import RangeError, parse_range
+    from fcplan.world import seed_list
 
     if value is None:
         raise _err(source, "seeds", 'is required, e.g. seeds = "0-4" or seeds = [0, 7]')
-    if isinstance(value, int) and not isinstance(value, bool):
-        value = [value]
     if isinstance(value, str):
         if value.strip().lower() == "auto":
             raise _err(
@@ -304,12 +303,12 @@ def _seeds(source: str, value: Any) -> tuple[int, ...]:
             return tuple(parse_range(value, names=False))  # type: ignore[arg-type]
         except RangeError as exc:
             raise _err(source, "seeds", str(exc)) from None
-    if not isinstance(value, list) or not value:
+    if isinstance(value, bool) or not isinstance(value, (list, int)) or value == []:
         raise _err(source, "seeds", 'must be a range string like "0-4" or a list of integers')
-    for v in value:
-        if isinstance(v, bool) or not isinstance(v, int) or v < 0:
-            raise _err(source, "seeds", "must be integers >= 0", v)
-    return tuple(dict.fromkeys(value))
+    try:
+        return tuple(seed_list(value, name=f"{source}: seeds"))
+    except SeedError as exc:
+        raise SweepConfigError(str(exc)) from None
 
 
 def _scenarios(source: str, value: Any, base_dir: Path | None) -> tuple[Any, ...]:

@@ -9,7 +9,7 @@ import pytest
 from fcplan.env.demo_units import demo_units, play_unit, play_units
 from fcplan.env.demonstrations import DemonstrationError, demonstrations
 from fcplan.env.task import TaskEnv
-from fcplan.errors import FcplanError
+from fcplan.errors import FcplanError, SeedError
 from fcplan.scenario import load_scenario
 from fcplan.scheduling import make_scheduler
 from solvers.greedy import GreedyScheduler
@@ -136,11 +136,11 @@ def test_bad_env_arguments_fail_as_in_one_process():
                            progress=False)  # fmt: skip
 
 
-@pytest.mark.parametrize("bad", [["x"], [-1], [1.5], [True], 3, "12"])
+@pytest.mark.parametrize("bad", [["x"], [-1], [1.5], [True], "12", 1.0, None])
 def test_bad_seeds_are_one_line(bad):
-    """Seeds must be a list of integers >= 0: a string, a float, a bool, a negative seed or a
-    lone integer is a one-line DemonstrationError before any episode."""
-    with pytest.raises(DemonstrationError, match=r"^seeds: must be "):
+    """Seeds follow fcplan.world.seed_list: a string, a float, a bool, a negative seed or a
+    non-list is a one-line SeedError before any episode."""
+    with pytest.raises(SeedError, match=r"^seeds: must be "):
         demonstrations("greedy", ["practice"], bad, env_kwargs=KW, progress=False)
 
 

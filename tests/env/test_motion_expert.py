@@ -85,11 +85,13 @@ def test_idle_plans_keep_agents_at_the_depot():
 
 
 def test_bad_arguments_are_refused():
-    """Presets (no scenario, no plans) and non-positive replan periods raise EnvError."""
+    """Presets (no scenario, no plans) and replan periods that are not finite numbers > 0
+    (the mission's check_replan_period) raise EnvError."""
     with pytest.raises(EnvError, match="scenario MotionEnv"):
         PlanFollower(parallel_env(preset="base"), "greedy")
-    with pytest.raises(EnvError, match="replan_period"):
-        PlanFollower(MotionEnv("practice"), "greedy", replan_period=0.0)
+    for bad in (0.0, float("inf"), float("nan"), True, "1"):
+        with pytest.raises(EnvError, match="^replan_period: must be a finite number > 0"):
+            PlanFollower(MotionEnv("practice"), "greedy", replan_period=bad)
     with pytest.raises(EnvError, match="reset the env first"):
         PlanFollower(MotionEnv("practice"), "greedy").reset()
 

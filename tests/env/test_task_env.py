@@ -202,6 +202,8 @@ def test_state_and_spaces():
     [
         ({"k": 0}, "k"),
         ({"replan_period": 0}, "replan_period"),
+        ({"replan_period": float("inf")}, "^replan_period: must be a finite number > 0"),
+        ({"replan_period": "1"}, "^replan_period: must be a finite number > 0"),
         ({"max_steps": -1}, "max_steps"),
         ({"illegal_action": "x"}, "illegal_action"),
         ({"render_mode": "human"}, "render_mode"),

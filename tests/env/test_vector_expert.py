@@ -101,6 +101,8 @@ def test_bad_arguments_are_named():
         ({"scheduler": make_scheduler("routing")}, "one instance per world"),
         ({"scheduler": [make_scheduler("greedy")]}, "need 2 schedulers"),
         ({"scheduler": "greedy", "replan_period": 0}, "replan_period"),
+        ({"scheduler": "greedy", "replan_period": float("inf")}, "^replan_period: must be a fin"),
+        ({"scheduler": "greedy", "replan_period": "1"}, "^replan_period: must be a fin"),
     ]:
         with pytest.raises(EnvError, match=word):
             BatchPlanFollower(venv, **kwargs)
