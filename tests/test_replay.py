@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import io
-import tracemalloc
 
 import numpy as np
 import pytest
@@ -16,6 +15,7 @@ from fcplan.cli import main
 from fcplan.recording import load_recording
 from fcplan.render import panel_width, render_frame
 from fcplan.video import GifStream, VideoError, replay_ticks, write_video
+from tests.traced import traced_call
 
 
 @pytest.fixture(scope="module")
@@ -201,29 +201,24 @@ def test_gif_still_frames_longer_than_a_gif_delay_keep_their_length():
     assert sum(durations) == 700_000 and max(durations) <= 655_350
 
 
+class _Sink(io.RawIOBase):  # a file that keeps nothing (the output is not the point)
+    def write(self, b):
+        return len(b)
+
+
+def _gif_of(n: int) -> None:
+    """Write an ``n``-frame GIF of a scrolling picture to a sink (run in the traced helper)."""
+    base = PALETTE[np.random.default_rng(0).integers(0, 4, size=(96, 128))]
+    gif = GifStream(_Sink(), 10, colors=[tuple(c) for c in PALETTE])
+    for k in range(n):
+        gif.add(np.roll(base, k, axis=1))
+    gif.close()
+
+
 def test_gif_memory_does_not_grow_with_the_clip():
     """Writing ten times more frames does not raise the peak of traced memory: frames are
     encoded and written as they come, none is kept."""
-    rng = np.random.default_rng(0)
-    base = PALETTE[rng.integers(0, 4, size=(96, 128))]
-
-    class Sink(io.RawIOBase):  # a file that keeps nothing (the output is not the point)
-        def write(self, b):
-            return len(b)
-
-    def peak(n):
-        frames = (np.roll(base, k, axis=1) for k in range(n))
-        tracemalloc.start()
-        try:
-            gif = GifStream(Sink(), 10, colors=[tuple(c) for c in PALETTE])
-            for f in frames:
-                gif.add(f)
-            gif.close()
-            return tracemalloc.get_traced_memory()[1]
-        finally:
-            tracemalloc.stop()
-
-    small, large = peak(20), peak(200)
+    (_, small), (_, large) = traced_call(_gif_of, 20), traced_call(_gif_of, 200)
     assert large < 1.5 * small, (small, large)
 
 

@@ -10,9 +10,10 @@ counted as orphans) and its :class:`Outcome`.
 Two ways to start the child: ``fork=True`` forks this process and calls
 :func:`fcplan.cli.main` (no interpreter start-up: for the audit script, a single-threaded
 process), else a fresh ``python -m fcplan`` (for the test suite, whose workers have threads).
-:func:`run_in_process` runs :func:`fcplan.cli.main` in this process instead (fast, for the many
-small cases of the test suite): the time bound is a ``SIGALRM``, the memory measured is the peak
-of ``tracemalloc`` (Python and numpy allocations), orphans are this process's new children.
+:func:`run_in_process` runs :func:`fcplan.cli.main` in a long-lived helper process instead (no
+start-up per case: for the many small cases of the test suite, see :mod:`tests.traced`): the
+time bound is a ``SIGALRM``, the memory measured is the peak of ``tracemalloc`` (Python and numpy
+allocations), orphans are the helper's new children.
 
 Examples
 --------
@@ -39,6 +40,8 @@ import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from tests.traced import traced_call
 
 __all__ = [
     "MEMORY_LIMIT",
@@ -311,15 +314,22 @@ def _children() -> set[int]:
 
 
 def run_in_process(argv: list[str], *, timeout: int, grace: float = ORPHAN_GRACE_S) -> Case:
-    """Run :func:`fcplan.cli.main` on ``argv`` here (main thread only; see the module docstring).
+    """Run :func:`fcplan.cli.main` on ``argv`` in this process's traced helper (see the module
+    docstring and :mod:`tests.traced`).
 
     Examples
     --------
     >>> run_in_process(["run", "nosuch"], timeout=60).outcome
     'clean error'
     """
+    case, peak = traced_call(_in_helper, list(argv), timeout, grace)
+    case.peak_mb = peak / 2**20
+    return case
+
+
+def _in_helper(argv: list[str], timeout: int, grace: float) -> Case:
+    """The case of :func:`run_in_process`, run in the helper's main thread (``peak_mb`` 0)."""
     import io
-    import tracemalloc
 
     from fcplan.cli import main
 
@@ -329,7 +339,6 @@ def run_in_process(argv: list[str], *, timeout: int, grace: float = ORPHAN_GRACE
     before = _children()
     err, status = io.StringIO(), None
     previous = signal.signal(signal.SIGALRM, stop)
-    tracemalloc.start()
     t0 = time.monotonic()
     signal.alarm(timeout)
     try:
@@ -344,8 +353,6 @@ def run_in_process(argv: list[str], *, timeout: int, grace: float = ORPHAN_GRACE
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
         seconds = time.monotonic() - t0
-        peak = tracemalloc.get_traced_memory()[1]
-        tracemalloc.stop()
     deadline = time.monotonic() + grace
     while (left := _children() - before) and time.monotonic() < deadline:
         time.sleep(0.1)
@@ -354,4 +361,4 @@ def run_in_process(argv: list[str], *, timeout: int, grace: float = ORPHAN_GRACE
             os.kill(pid, signal.SIGKILL)
     text = err.getvalue()
     outcome = Outcome.ORPHAN if left else classify(status, text)
-    return Case(list(argv), outcome, status, text, seconds, peak / 2**20, sorted(left))
+    return Case(list(argv), outcome, status, text, seconds, 0.0, sorted(left))

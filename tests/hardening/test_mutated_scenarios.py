@@ -3,11 +3,10 @@ naming the problem, or loads and runs, within a time and a memory bound."""
 
 from __future__ import annotations
 
-import contextlib
 import random
 import signal
-import tracemalloc
-from collections.abc import Iterator
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 import pytest
 from hypothesis import HealthCheck, given, note, settings
@@ -19,6 +18,9 @@ from fcplan.scenario import load_scenario
 from fcplan.scenario.bounds import MEMORY_LIMIT_BYTES, estimate_bytes
 from fcplan.scenario.read import scenario_from_dict
 from tests.hardening.mutate import mutant, to_toml
+from tests.traced import traced_call
+
+T = TypeVar("T")
 
 TIME_BOUND_S = 120
 MEMORY_BOUND = 2 * 2**30  # bytes traced (numpy included) while loading and running one mutant,
@@ -30,26 +32,45 @@ class HangError(Exception):
     """A mutant took longer than the time bound."""
 
 
-@contextlib.contextmanager
-def bounded(seconds: int) -> Iterator[list[int]]:
-    """Raise HangError after ``seconds``; fail if the traced memory peaked above the bound (the
-    yielded one-item list, which the caller may raise to a loaded scenario's own estimate)."""
+def bounded(seconds: int, fn: Callable[..., T], *args: Any) -> T:
+    """``fn(*args)`` in the traced helper (:mod:`tests.traced`) under a ``seconds`` alarm
+    (HangError) and the memory bound: the traced peak above :data:`MEMORY_BOUND` fails, unless
+    ``fn`` returns ``(value, bound)`` with a larger bound of its own (a loaded scenario's
+    estimate); returns the value."""
+    (value, bound), peak = traced_call(_alarmed, seconds, fn, *args)
+    assert peak < max(bound, MEMORY_BOUND), f"peak traced memory {peak / 2**20:.0f} MiB"
+    return value
+
+
+def _alarmed(seconds: int, fn: Callable[..., Any], *args: Any) -> tuple[Any, int]:
+    """``fn(*args)`` under an alarm (run in the helper's main thread)."""
 
     def stop(signum, frame):
         raise HangError(f"over {seconds} s")
 
     previous = signal.signal(signal.SIGALRM, stop)
     signal.alarm(seconds)
-    tracemalloc.start()
-    bound = [MEMORY_BOUND]
     try:
-        yield bound
+        value = fn(*args)
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
-        _, peak = tracemalloc.get_traced_memory()
-        tracemalloc.stop()
-        assert peak < bound[0], f"peak traced memory {peak / 2**20:.0f} MiB"
+    return value if isinstance(value, tuple) else (value, MEMORY_BOUND)
+
+
+def _load_and_play(path: str) -> tuple[str | None, int]:
+    """The one-line message of a mutant that fails to load, or None once it loaded, validated
+    within the cap and played its first seconds; with the memory bound it may use."""
+    try:
+        s = load_scenario(path)
+    except FcplanError as exc:
+        return str(exc), MEMORY_BOUND
+    assert estimate_bytes(s) <= MEMORY_LIMIT_BYTES
+    short = s.replace(duration_s=min(s.duration_s, RUN_S))
+    res = run_episode(short, "greedy", seed=0)
+    assert res.ticks == short.n_ticks
+    # a valid big map may use what validation estimated for it, and no more
+    return None, max(MEMORY_BOUND, estimate_bytes(s))
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
@@ -62,18 +83,8 @@ def test_a_mutated_file_fails_in_one_line_or_runs(seed, tmp_path_factory):
     note(what)
     path = tmp_path_factory.mktemp("mutant") / "mutant.toml"
     path.write_text(to_toml(doc), encoding="utf-8")
-    with bounded(TIME_BOUND_S) as bound:
-        try:
-            s = load_scenario(path)
-        except FcplanError as exc:
-            assert "\n" not in str(exc)
-            return
-        assert estimate_bytes(s) <= MEMORY_LIMIT_BYTES
-        # a valid big map may use what validation estimated for it, and no more
-        bound[0] = max(MEMORY_BOUND, estimate_bytes(s))
-        short = s.replace(duration_s=min(s.duration_s, RUN_S))
-        res = run_episode(short, "greedy", seed=0)
-        assert res.ticks == short.n_ticks
+    message = bounded(TIME_BOUND_S, _load_and_play, str(path))
+    assert message is None or "\n" not in message
 
 
 @pytest.mark.parametrize(
@@ -112,6 +123,10 @@ def test_deeply_nested_arrays_are_refused_before_the_parser_recurses(tmp_path):
         load_scenario(f)
 
 
+def _team_size(doc: dict[str, Any]) -> int:
+    return len(scenario_from_dict(doc, "team.toml").agents)
+
+
 def test_a_team_of_10000_agents_validates_within_the_bound():
     """Validation is linear in the team: 10,000 agents with per-agent batteries and speeds load
     within the time bound (the quadratic check of issue 17 took 4.45 s for 1,002 agents, so
@@ -123,8 +138,7 @@ def test_a_team_of_10000_agents_validates_within_the_bound():
         team["count"] = 5_000
         team["battery"] = [400.0 + k % 200 for k in range(5_000)]
         team["speed"] = [15.0 + k % 10 for k in range(5_000)]
-    with bounded(30):
-        assert len(scenario_from_dict(doc, "team.toml").agents) == 10_000
+    assert bounded(30, _team_size, doc) == 10_000
     doc["team"]["action"]["count"] = 5_001
     doc["team"]["action"]["battery"].append(500.0)
     doc["team"]["action"]["speed"].append(20.0)

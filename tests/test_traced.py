@@ -1,0 +1,31 @@
+"""Tests of the traced helper (tests.traced): peaks, errors and a helper that dies."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from tests.traced import HelperError, traced_call
+
+
+def test_the_peak_counts_the_call_only():
+    """The peak is the call's own: a large call's bytes do not carry over to a small one."""
+    _, large = traced_call(bytes, 50 * 2**20)
+    _, small = traced_call(bytes, 10)
+    assert large >= 50 * 2**20 > 1000 * small
+
+
+def test_an_exception_is_raised_again_with_the_helpers_traceback():
+    """What the call raised is raised here, with a note giving where in the helper."""
+    with pytest.raises(ValueError, match="invalid literal") as info:
+        traced_call(int, "x")
+    assert any("traced helper" in note for note in info.value.__notes__)
+
+
+def test_a_helper_that_dies_is_an_error_and_the_next_call_starts_a_new_one():
+    """A call that kills the helper raises HelperError naming its exit code; the next call runs
+    in a fresh helper."""
+    with pytest.raises(HelperError, match="exit code 3"):
+        traced_call(os._exit, 3)
+    assert traced_call(len, "abc")[0] == 3
