@@ -6,7 +6,7 @@ import importlib
 import math
 import tomllib
 from functools import lru_cache
-from importlib.metadata import PackageNotFoundError
+from importlib.metadata import EntryPoint, PackageNotFoundError
 from pathlib import Path
 
 import numpy as np
@@ -101,13 +101,15 @@ def _pyproject_table() -> dict[str, str]:
     return doc["project"]["entry-points"][scheduling.GROUP]
 
 
-def test_source_checkout_reads_the_pyproject_table(monkeypatch):
+def test_source_checkout_reads_the_pyproject_table(monkeypatch, request):
     """Without fcplan's package metadata (a source checkout on PYTHONPATH, nothing installed)
     the registry is exactly pyproject.toml's entry-point table, and its names make schedulers."""
 
     def no_metadata(name):
         raise PackageNotFoundError(name)
 
+    scheduling._entry_points.cache_clear()
+    request.addfinalizer(scheduling._entry_points.cache_clear)  # runs before monkeypatch's undo
     monkeypatch.setattr(scheduling, "distribution", no_metadata)
     monkeypatch.setattr(scheduling, "entry_points", lambda group: [])
     monkeypatch.setattr(scheduling, "_RUNTIME", {})
@@ -145,6 +147,19 @@ def test_protocol_rejects_objects_without_plan():
     assert not isinstance(NoPlan(), Scheduler)
     assert not isinstance(NoName(), Scheduler)
     assert isinstance(Raising(), Scheduler)
+
+
+def test_a_plugin_installed_after_the_first_lookup_is_found(monkeypatch, request):
+    """The entry-point table is read once per process, but a name not in it is looked up again:
+    a scheduler installed after the first lookup (a notebook's pip install) is found."""
+    available_schedulers()  # the table is read and kept
+    real = scheduling.entry_points
+    late = EntryPoint("late-plugin", "solvers.greedy:GreedyScheduler", scheduling.GROUP)
+    monkeypatch.setattr(scheduling, "entry_points", lambda group: [*real(group=group), late])
+    request.addfinalizer(scheduling._entry_points.cache_clear)  # runs before monkeypatch's undo
+    assert "late-plugin" not in available_schedulers()
+    assert make_scheduler("late-plugin").name == "greedy"
+    assert "late-plugin" in available_schedulers()
 
 
 def test_unknown_name_lists_known_schedulers():
