@@ -22,8 +22,8 @@ per second (``B`` x steps / time) on the thread's CPU clock and on the wall cloc
 average, the median of the rounds' ratios to the single env of the same scenario with their
 range, the simulator alone (its ratio too), the batched env over the sync one at the same ``B``,
 where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
-action decoding, rewards), and the memory per world (``tracemalloc``: the growth from the
-smallest to the largest ``B``, per added world; the tables every world shares are the rest).
+action decoding, rewards), and the memory per world of each level (``tracemalloc``: the growth
+from 16 to 256 worlds, per added world; the tables every world shares are the rest).
 
 Usage::
 
@@ -189,6 +189,13 @@ def memory_per_world(sc: Any, small: int, large: int, level: str = "motion") -> 
     return per, sizes[0] - small * per
 
 
+#: what the memory shared by the worlds of a level holds
+_SHARED = {
+    "motion": "terrain jump tables, maps, team constants",
+    "task": "the motion level's and the task level's scenario tables",
+}
+
+
 def single_task(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
     """Steps of ``episodes`` episodes of ``fcplan/Task-v1`` with random legal actions, timed."""
     env = TaskGymEnv(sc)
@@ -279,11 +286,14 @@ def main(argv: list[str] | None = None) -> int:
                 level, sc, name, sizes_l, args.episodes, args.rounds, args.sync_sizes
             )
     sc = load_scenario(args.scenarios[0])
-    per, rest = memory_per_world(sc, 16, 64 if args.quick else 256)
-    print(
-        f"\nmemory, motion level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per world, "
-        f"{rest / 1e6:.1f} MB shared (terrain jump tables, maps, team constants)"
-    )
+    print()
+    for level in args.levels:
+        large = min(64 if args.quick else 256, args.task_max if level == "task" else 1024)
+        per, rest = memory_per_world(sc, 16, large, level)
+        print(
+            f"memory, {level} level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per "
+            f"world, {rest / 1e6:.1f} MB shared ({_SHARED[level]})"
+        )
     mpe_runs = [r for r in (mpe_rate() for _ in range(args.rounds)) if r is not None]
     mpe = float(np.median(mpe_runs)) if mpe_runs else None
     if mpe is None:

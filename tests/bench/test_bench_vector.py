@@ -16,7 +16,7 @@ def test_interleaved_rounds_print_medians_and_ratio_ranges(tmp_path):
     """Two rounds of tiny episodes at both levels: every level's table names its rounds, has a
     row per ``B`` and per sync ``B`` (Gymnasium's SyncVectorEnv of the single env) with a ratio
     range ``[min, max]`` that holds its median, the batched env over the sync one at their common
-    ``B``, and the plot is written (the script's own arithmetic on real runs, not the figures,
+    ``B``, the memory per world of both levels, and the plot is written (the script's own arithmetic on real runs, not the figures,
     which are timings)."""
     plot = tmp_path / "vector.png"
     out = subprocess.run(
@@ -36,4 +36,7 @@ def test_interleaved_rounds_print_medians_and_ratio_ranges(tmp_path):
         median, lo, hi = float(m[2]), float(m[3]), float(m[4])
         assert lo <= median <= hi
         assert m[1] != "single" or median == lo == hi == 1.0
+    for level in ("motion", "task"):  # the memory per world of each level
+        m = re.search(rf"memory, {level} level \(#practice, traced\): ([\d.]+) MB per world", out)
+        assert m is not None and float(m[1]) > 0, out
     assert plot.stat().st_size > 0
