@@ -29,3 +29,19 @@ def test_a_helper_that_dies_is_an_error_and_the_next_call_starts_a_new_one():
     with pytest.raises(HelperError, match="exit code 3"):
         traced_call(os._exit, 3)
     assert traced_call(len, "abc")[0] == 3
+
+
+def test_the_call_runs_in_the_callers_working_folder(tmp_path, monkeypatch):
+    """The helper follows this process's working folder at every call, so relative paths a call
+    writes land where they would here (a hostile CLI case's outputs stay in the test's
+    scratch folder, not in the checkout)."""
+    traced_call(os.getcwd)  # a helper already running, started elsewhere
+    monkeypatch.chdir(tmp_path)
+    assert traced_call(os.getcwd)[0] == str(tmp_path)
+    traced_call(_touch, "written-here")
+    assert (tmp_path / "written-here").exists()
+
+
+def _touch(name: str) -> None:
+    with open(name, "w"):
+        pass

@@ -16,8 +16,10 @@ in the test process: it makes allocation-heavy code about 6 times slower (``run_
 of that worker would pay. So tracing starts once, in a spawned helper, the peak is reset for
 each call, and the helper is killed when this process exits: tracing is never stopped.
 
-The helper runs one call at a time, in its main thread, so ``fn`` may set ``signal.alarm``;
-the processes it starts are the helper's children (a CLI case counts its orphans there). ``fn``,
+The helper runs one call at a time, in its main thread and in this process's working folder at
+the time of the call (a test's ``monkeypatch.chdir`` holds there too: relative paths land where
+they would here), so ``fn`` may set ``signal.alarm``; the processes it starts are the helper's
+children (a CLI case counts its orphans there). ``fn``,
 its arguments and its value must pickle (``fn`` a module-level function). An exception that
 ``fn`` raises is raised again here, with the helper's traceback as a note. If the helper dies
 (a crash in the code under test) or a call outlives ``limit`` seconds, the helper is killed,
@@ -73,9 +75,10 @@ def _serve(conn: Connection) -> None:
     tracemalloc.start()
     while True:
         try:
-            fn, args = conn.recv()
+            fn, args, cwd = conn.recv()
         except EOFError:  # the test process is gone: leave without stopping the tracing
             os._exit(0)
+        os.chdir(cwd)
         before = tracemalloc.get_traced_memory()[0]
         tracemalloc.reset_peak()
         kind, value = "value", None
@@ -101,7 +104,7 @@ class _Helper:
         child.close()
 
     def call(self, fn: Callable[..., Any], args: tuple[Any, ...], limit: float) -> Any:
-        self.conn.send((fn, args))
+        self.conn.send((fn, args, os.getcwd()))
         if not self.conn.poll(limit):
             raise HelperError(f"the traced helper gave no answer in {limit:g} s to {fn!r}")
         try:

@@ -315,13 +315,20 @@ def _children() -> set[int]:
 
 def run_in_process(argv: list[str], *, timeout: int, grace: float = ORPHAN_GRACE_S) -> Case:
     """Run :func:`fcplan.cli.main` on ``argv`` in this process's traced helper (see the module
-    docstring and :mod:`tests.traced`).
+    docstring and :mod:`tests.traced`), in this process's working folder, which must not be the
+    checkout: relative paths in hostile arguments (an output named ``-`` or ``0x10``) land there.
 
     Examples
     --------
+    >>> import os, tempfile
+    >>> here = os.getcwd()
+    >>> os.chdir(tempfile.mkdtemp())
     >>> run_in_process(["run", "nosuch"], timeout=60).outcome
     'clean error'
+    >>> os.chdir(here)
     """
+    if Path.cwd().resolve() == ROOT:
+        raise RuntimeError(f"run_in_process: run cases in a scratch folder, not in {ROOT}")
     case, peak = traced_call(_in_helper, list(argv), timeout, grace)
     case.peak_mb = peak / 2**20
     return case
