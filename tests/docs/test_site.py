@@ -35,7 +35,8 @@ def test_site_builds_strictly(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT), "NO_MKDOCS_2_WARNING": "1"}
     site = tmp_path / "site"
     proc = subprocess.run(
-        [sys.executable, "-m", "mkdocs", "build", "--strict", "-q", "-d", str(site)],
+        # not -q: it hides the warnings from --strict, which then passes with a broken link
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "-d", str(site)],
         cwd=ROOT,
         env=env,
         capture_output=True,
@@ -43,10 +44,14 @@ def test_site_builds_strictly(tmp_path):
         timeout=600,
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "WARNING" not in proc.stdout + proc.stderr, proc.stdout + proc.stderr
     assert (site / "index.html").is_file()
     assert "DejaVu" in (site / "reference" / "render" / "index.html").read_text(encoding="utf-8")
     bench = (site / "benchmarks" / "index.html").read_text(encoding="utf-8")
     assert "<table" in bench  # bench/README.md's tables are included
+    # and its plots, linked from bench/ as ../docs/<file>, resolve on the page
+    assert 'src="../vector_throughput.png"' in bench and "../docs/" not in bench
+    assert (site / "vector_throughput.png").is_file()
 
 
 @needs_mkdocs
