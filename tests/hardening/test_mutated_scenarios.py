@@ -32,17 +32,17 @@ class HangError(Exception):
     """A mutant took longer than the time bound."""
 
 
-def bounded(seconds: int, fn: Callable[..., T], *args: Any) -> T:
+def bounded(seconds: int, fn: Callable[..., tuple[T, int]], *args: Any) -> T:
     """``fn(*args)`` in the traced helper (:mod:`tests.traced`) under a ``seconds`` alarm
-    (HangError) and the memory bound: the traced peak above :data:`MEMORY_BOUND` fails, unless
-    ``fn`` returns ``(value, bound)`` with a larger bound of its own (a loaded scenario's
-    estimate); returns the value."""
+    (HangError) and a memory bound. ``fn`` returns ``(value, bound)``: the bound its run may
+    use (:data:`MEMORY_BOUND`, or a loaded scenario's larger estimate). Fails if the traced peak
+    reached the bound; returns the value."""
     (value, bound), peak = traced_call(_alarmed, seconds, fn, *args)
     assert peak < max(bound, MEMORY_BOUND), f"peak traced memory {peak / 2**20:.0f} MiB"
     return value
 
 
-def _alarmed(seconds: int, fn: Callable[..., Any], *args: Any) -> tuple[Any, int]:
+def _alarmed(seconds: int, fn: Callable[..., T], *args: Any) -> T:
     """``fn(*args)`` under an alarm (run in the helper's main thread)."""
 
     def stop(signum, frame):
@@ -55,7 +55,7 @@ def _alarmed(seconds: int, fn: Callable[..., Any], *args: Any) -> tuple[Any, int
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
-    return value if isinstance(value, tuple) else (value, MEMORY_BOUND)
+    return value
 
 
 def _load_and_play(path: str) -> tuple[str | None, int]:
@@ -123,8 +123,8 @@ def test_deeply_nested_arrays_are_refused_before_the_parser_recurses(tmp_path):
         load_scenario(f)
 
 
-def _team_size(doc: dict[str, Any]) -> int:
-    return len(scenario_from_dict(doc, "team.toml").agents)
+def _team_size(doc: dict[str, Any]) -> tuple[int, int]:
+    return len(scenario_from_dict(doc, "team.toml").agents), MEMORY_BOUND
 
 
 def test_a_team_of_10000_agents_validates_within_the_bound():
