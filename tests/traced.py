@@ -78,11 +78,11 @@ def _serve(conn: Connection) -> None:
             fn, args, cwd = conn.recv()
         except EOFError:  # the test process is gone: leave without stopping the tracing
             os._exit(0)
-        os.chdir(cwd)
         before = tracemalloc.get_traced_memory()[0]
         tracemalloc.reset_peak()
         kind, value = "value", None
         try:
+            os.chdir(cwd)  # (a folder gone since: the caller gets the FileNotFoundError)
             value = fn(*args)
         except BaseException as exc:  # noqa: BLE001 - raised again in the caller
             kind, value = "raised", _portable(exc)
