@@ -288,7 +288,9 @@ def main(argv: list[str] | None = None) -> int:
     sc = load_scenario(args.scenarios[0])
     print()
     for level in args.levels:
-        large = min(64 if args.quick else 256, args.task_max if level == "task" else 1024)
+        large = 64 if args.quick else 256
+        if level == "task":
+            large = min(large, args.task_max)
         per, rest = memory_per_world(sc, 16, large, level)
         print(
             f"memory, {level} level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per "

@@ -190,10 +190,10 @@ def _entry_points() -> dict[str, EntryPoint]:
     from ``pyproject.toml``; installed third-party entry points are added either way.
 
     Read once per process: ``importlib.metadata.entry_points`` reads every installed
-    distribution's metadata, 4.7 ms a call in the project's development virtualenv
-    (2026-12-04), about 3 % of an episode of #1 when each ``run_episode`` made its scheduler by
-    name. A name not found is looked up again once (:func:`scheduler_factory`), so a plug-in
-    installed while the process runs (a notebook's ``pip install``) is still found.
+    distribution's metadata, milliseconds a call (``bench/README.md``, "The scheduler registry
+    is read once per process"). A name not found is looked up again once
+    (:func:`scheduler_factory`), so a plug-in installed while the process runs (a notebook's
+    ``pip install``) is still found.
     """
     table = {ep.name: ep for ep in entry_points(group=GROUP)}
     try:

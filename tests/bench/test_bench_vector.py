@@ -16,8 +16,8 @@ def test_interleaved_rounds_print_medians_and_ratio_ranges(tmp_path):
     """Two rounds of tiny episodes at both levels: every level's table names its rounds, has a
     row per ``B`` and per sync ``B`` (Gymnasium's SyncVectorEnv of the single env) with a ratio
     range ``[min, max]`` that holds its median, the batched env over the sync one at their common
-    ``B``, the memory per world of both levels, and the plot is written (the script's own arithmetic on real runs, not the figures,
-    which are timings)."""
+    ``B``, the memory per world of both levels, and the plot is written (the script's own
+    arithmetic on real runs, not the figures, which are timings)."""
     plot = tmp_path / "vector.png"
     out = subprocess.run(
         [sys.executable, "bench/bench_vector.py", "--sizes", "1", "3", "--duration", "2",
