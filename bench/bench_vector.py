@@ -22,8 +22,10 @@ per second (``B`` x steps / time) on the thread's CPU clock and on the wall cloc
 average, the median of the rounds' ratios to the single env of the same scenario with their
 range, the simulator alone (its ratio too), the batched env over the sync one at the same ``B``,
 where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
-action decoding, rewards), and the memory per world of each level (``tracemalloc``: the growth
-from 16 to 256 worlds, per added world; the tables every world shares are the rest).
+action decoding, rewards), and the memory per world of each level: allocated (``tracemalloc``:
+the growth from 16 to 256 worlds after 5 steps, per added world; the tables every world shares
+are the rest) and resident (the growth of the peak resident size of a fresh process playing one
+whole episode, from 16 to 256 worlds: the batched belief's maps are paged in only where written).
 
 Usage::
 
@@ -41,6 +43,8 @@ import collections
 import gc
 import os
 import platform
+import subprocess
+import sys
 import time
 import tracemalloc
 from collections.abc import Callable
@@ -189,11 +193,51 @@ def memory_per_world(sc: Any, small: int, large: int, level: str = "motion") -> 
     return per, sizes[0] - small * per
 
 
+#: the child of :func:`resident_per_world`: one whole episode, then its peak resident size
+_PEAK_RSS = """
+import resource, sys
+import numpy as np
+from fcplan.env.vector_motion import VectorMotionEnv
+from fcplan.env.vector_task import VectorTaskEnv
+from fcplan.scenario import load_scenario
+name, duration, num, level = sys.argv[1], float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+sc = load_scenario(name)
+sc = sc.replace(duration_s=duration) if duration > 0 else sc
+env = (VectorMotionEnv if level == "motion" else VectorTaskEnv)(sc, num)
+rng = np.random.default_rng(0)
+obs, _ = env.reset(seed=0)
+while True:
+    m = obs["action_mask"]
+    obs, _, _, truncs, _ = env.step((rng.random(m.shape) * m).argmax(axis=2))
+    if truncs.all():
+        break
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * (1 if sys.platform == "darwin" else 1024))
+"""
+
+
+def resident_per_world(name: str, duration: float, small: int, large: int, level: str) -> float:
+    """Bytes of peak resident memory per added world: a fresh process per size plays one whole
+    episode of every world with random legal actions (``resource``'s ``ru_maxrss``), and the
+    growth from ``small`` to ``large`` worlds is divided by the worlds added. Unlike the traced
+    figure, pages allocated but never written do not count."""
+    peaks = []
+    for num in (small, large):
+        cmd = [sys.executable, "-c", _PEAK_RSS, name, str(duration), str(num), level]
+        out = subprocess.run(cmd, capture_output=True, text=True, check=True)
+        peaks.append(int(out.stdout.split()[-1]))
+    return (peaks[1] - peaks[0]) / (large - small)
+
+
 #: what the memory shared by the worlds of a level holds
 _SHARED = {
     "motion": "terrain jump tables, maps, team constants",
     "task": "the motion level's and the task level's scenario tables",
 }
+
+
+def _episode(sc: Any, duration: float) -> str:
+    """The episode length of the resident figure, e.g. ``"180-s"``."""
+    return f"{duration or sc.duration_s:g}-s"
 
 
 def single_task(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
@@ -295,6 +339,12 @@ def main(argv: list[str] | None = None) -> int:
         print(
             f"memory, {level} level (#{args.scenarios[0]}, traced): {per / 1e6:.3f} MB per "
             f"world, {rest / 1e6:.1f} MB shared ({_SHARED[level]})"
+        )
+        dur = (args.duration or 30) if args.quick or args.duration else 0.0
+        res = resident_per_world(args.scenarios[0], dur, 16, large, level)
+        print(
+            f"memory, {level} level (#{args.scenarios[0]}, resident): {res / 1e6:.3f} MB per "
+            f"world (peak RSS of a whole {_episode(sc, dur)} episode, 16 against {large} worlds)"
         )
     mpe_runs = [r for r in (mpe_rate() for _ in range(args.rounds)) if r is not None]
     mpe = float(np.median(mpe_runs)) if mpe_runs else None

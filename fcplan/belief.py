@@ -80,6 +80,20 @@ class Belief:
             self._dirty = False
         return self._known
 
+    def last_seen_at(self, cells: np.ndarray) -> np.ndarray:
+        """(n,) int32 :attr:`last_seen` of the flat ``cells``: the tick each was last sensed, -1
+        if never (what the task graph builder reads; the batched belief answers the same).
+
+        Examples
+        --------
+        >>> from fcplan import World, load_scenario
+        >>> world = World().reset(load_scenario(1), seed=0)
+        >>> belief = Belief(world.scenario)
+        >>> belief.last_seen_at(np.array([0])).tolist()
+        [-1]
+        """
+        return self._last_seen_flat[cells]
+
     def known_xy(self) -> np.ndarray:
         """(k, 2) int64 ``[x, y]`` of the known burning cells."""
         k = self.known
@@ -285,6 +299,10 @@ class ClairvoyantBelief:
         true = np.flatnonzero(fire_state == BURNING)
         k = belief.known
         self.known = np.concatenate([k, np.setdiff1d(true, k, assume_unique=True)])
+
+    def last_seen_at(self, cells: np.ndarray) -> np.ndarray:
+        """The team's own :meth:`Belief.last_seen_at` (-1 at the cells it has never sensed)."""
+        return self._belief.last_seen_at(cells)
 
     def coverage_age_s(self, block_px: int) -> np.ndarray:
         """The team's own coverage ages (:meth:`Belief.coverage_age_s`)."""

@@ -10,8 +10,12 @@ bookkeeping differs:
 ==================  ==========================  =================================================
 array               shape, dtype                notes
 ==================  ==========================  =================================================
-``last_seen``       (B, W, W) int32             the tick each cell was last sensed (-1: never)
+seen                (B, W, W) int32             one more than the tick each cell was last sensed
+                                                (0: never); :meth:`BatchBelief.last_seen` gives
+                                                world ``b``'s map as the single belief's
 known mask          (B * W * W,) bool           sensed and not pruned
+rows touched        (B, W) bool                 the map rows where a cell was ever sensed since
+                                                the world's reset
 known               B lists of (k,) int64       per world the cells in the order first sensed, as
                                                 of its last read, plus the flat ``b W^2 + cell``
                                                 cells first sensed since (one array per tick),
@@ -21,6 +25,14 @@ known               B lists of (k,) int64       per world the cells in the order
 ``coverage``        (B, nc, nc) int32           the tick each coarse cell was last covered
 ``tick``            (B,) int64                  the world's tick at its last update
 ==================  ==========================  =================================================
+
+Memory. The two maps are 7.2 MB of every world at 1,200 px, and only the cells the team sensed
+burning are ever written. So both are created by ``numpy.zeros`` (the operating system gives
+their pages, zeroed, at the first write: a map costs only the pages holding sensed cells) and
+the seen map stores ``tick + 1``, so that "never" is 0 and needs no write. A reset clears only
+the rows touched since the last one. The single belief's dense ``last_seen`` of -1 is the
+specification; :meth:`BatchBelief.last_seen` and :meth:`BeliefView.last_seen_at` read it back.
+``bench/README.md`` ("Memory per world") measures the resident size this saves.
 
 Coverage. A coarse cell's value is the largest tick of the writes covering it (ticks never
 decrease within an episode). The single belief defers the rewrite of a hovering camera's box and
@@ -47,6 +59,7 @@ Examples
 
 from __future__ import annotations
 
+import mmap
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -57,15 +70,39 @@ if TYPE_CHECKING:
     from fcplan.batch import BatchStepInfo
     from fcplan.scenario import Scenario
 
-__all__ = ["BatchBelief", "BeliefView", "coverage_ages"]
+__all__ = ["BatchBelief", "BeliefView", "coverage_ages", "paged_zeros"]
+
+
+def paged_zeros(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+    """A C-contiguous array of zeros whose memory the operating system maps at the first write
+    to each small page (4 KB on Linux), in an anonymous memory map of its own.
+
+    ``numpy.zeros`` gives the same lazily zeroed pages, but numpy advises the kernel to back large
+    arrays by 2 MB huge pages, so one write maps 2 MB: the batched belief's maps, written at a
+    few scattered cells, became resident nearly whole. Here huge pages are advised against where
+    the platform allows it (``mmap.MADV_NOHUGEPAGE``). The map lives as long as the array.
+
+    Examples
+    --------
+    >>> a = paged_zeros((2, 3), np.int32)
+    >>> a[1, 2] = 7
+    >>> a.tolist(), a.dtype.name, a.flags.c_contiguous
+    ([[0, 0, 0], [0, 0, 7]], 'int32', True)
+    """
+    dt = np.dtype(dtype)
+    count = int(np.prod(shape, dtype=np.int64))
+    buf = mmap.mmap(-1, max(count * dt.itemsize, 1))
+    if hasattr(mmap, "MADV_NOHUGEPAGE"):
+        buf.madvise(mmap.MADV_NOHUGEPAGE)
+    return np.frombuffer(buf, dtype=dt, count=count).reshape(shape)
 
 
 class BeliefView:
     """World ``b``'s belief as :class:`fcplan.taskgraph.TaskGraphBuilder` reads it: ``tick``,
-    ``known``, ``last_seen``, ``world_size`` and :meth:`coverage_age_s` (a read-only snapshot
-    of the batch at :meth:`BatchBelief.view`; do not keep it across updates)."""
+    ``known``, ``world_size``, :meth:`last_seen_at` and :meth:`coverage_age_s` (a read-only
+    snapshot of the batch at :meth:`BatchBelief.view`; do not keep it across updates)."""
 
-    __slots__ = ("tick", "known", "last_seen", "world_size", "_ages", "_block_px", "_owner", "_b")
+    __slots__ = ("tick", "known", "world_size", "_ages", "_block_px", "_owner", "_b")
 
     def __init__(
         self,
@@ -78,9 +115,13 @@ class BeliefView:
         self._owner, self._b = owner, b
         self.tick = int(owner.tick[b])
         self.known = known
-        self.last_seen = owner.last_seen[b]
         self.world_size = owner.world_size
         self._ages, self._block_px = ages, block_px
+
+    def last_seen_at(self, cells: np.ndarray) -> np.ndarray:
+        """(n,) int32 the tick each of the flat ``cells`` was last sensed, -1 if never
+        (:meth:`fcplan.belief.Belief.last_seen_at`)."""
+        return self._owner.last_seen_at(self._b, cells)
 
     def coverage_age_s(self, block_px: int) -> np.ndarray:
         """(nb, nb) mean seconds since the coarse cells of each block were covered
@@ -108,9 +149,11 @@ class BatchBelief:
         self.ticks_per_second = scenario.ticks_per_second
         self.coverage_px = c = int(coverage_px)
         self._nc = nc = -(-w // c)
-        self.last_seen = np.full((b, w, w), -1, dtype=np.int32)
-        self._seen_flat = self.last_seen.reshape(-1)
-        self._mask = np.zeros(b * w * w, dtype=bool)
+        self._seen = paged_zeros((b, w, w), np.int32)  # tick + 1 (0: never)
+        self._seen_flat = self._seen.reshape(-1)
+        self._mask = paged_zeros((b * w * w,), np.bool_)
+        self._touched = np.zeros((b, w), dtype=bool)  # rows with a sensed cell since reset
+        self._touched_flat = self._touched.reshape(-1)
         self._known: list[np.ndarray] = [np.zeros(0, dtype=np.int64) for _ in range(b)]
         self._fresh: list[np.ndarray] = []  # flat b W^2 + cell first sensed since the last read
         self._dirty = np.zeros(b, dtype=bool)
@@ -131,10 +174,12 @@ class BatchBelief:
         if not rows.size:
             return
         self._take_fresh()
-        ww = self.world_size * self.world_size
-        self.last_seen[rows] = -1
-        mask = self._mask.reshape(self.num, ww)
-        mask[rows] = False
+        w = self.world_size
+        n, row = np.nonzero(self._touched[rows])  # (clearing only these keeps the rest unpaged)
+        world = rows[n]
+        self._seen[world, row] = 0
+        self._mask.reshape(self.num, w, w)[world, row] = False
+        self._touched[rows] = False
         for b in rows.tolist():
             self._known[b] = np.zeros(0, dtype=np.int64)
         self._dirty[rows] = False
@@ -154,11 +199,12 @@ class BatchBelief:
         sw, sc = info.sensed
         if sw.size:
             key = sw * ww + sc
-            self._seen_flat[key] = ticks[sw]
+            self._seen_flat[key] = (ticks + 1)[sw]
             fresh = key[~self._mask[key]]
-            if fresh.size:
+            if fresh.size:  # (every cell written was fresh once since its world's reset)
                 self._mask[fresh] = True
                 self._fresh.append(fresh)
+                self._touched_flat[fresh // self.world_size] = True  # b W + x
         pw, pc = info.pruned
         if pw.size:
             self._mask[pw * ww + pc] = False
@@ -240,6 +286,17 @@ class BatchBelief:
             self._known[b] = np.concatenate([old, add]) if old.size else add
 
     # ------------------------------------------------------------------ reads
+    def last_seen_at(self, b: int, cells: np.ndarray) -> np.ndarray:
+        """(n,) int32 the tick each of world ``b``'s flat ``cells`` was last sensed, -1 if never
+        (:meth:`fcplan.belief.Belief.last_seen_at`)."""
+        ww = self.world_size * self.world_size
+        return self._seen_flat[b * ww + np.asarray(cells, dtype=np.int64)] - np.int32(1)
+
+    def last_seen(self, b: int) -> np.ndarray:
+        """(W, W) int32 world ``b``'s :attr:`fcplan.belief.Belief.last_seen`: the tick each cell
+        was last sensed, -1 if never (a new array)."""
+        return self._seen[b] - np.int32(1)
+
     def known(self, b: int) -> np.ndarray:
         """(k,) int64 flat indices of world ``b``'s known burning cells, in the order first
         sensed (:attr:`fcplan.belief.Belief.known`)."""

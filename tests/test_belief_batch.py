@@ -32,7 +32,7 @@ def _same(view_known, belief, batch_belief, b, blocks):
     np.testing.assert_array_equal(view_known, belief.known, strict=True)
     assert int(batch_belief.tick[b]) == belief.tick
     assert int(batch_belief.n_pruned[b]) == belief.n_pruned
-    np.testing.assert_array_equal(batch_belief.last_seen[b], belief.last_seen, strict=True)
+    np.testing.assert_array_equal(batch_belief.last_seen(b), belief.last_seen, strict=True)
     for blk in blocks:
         got = batch_belief.view(b, blk).coverage_age_s(blk)
         assert got.tobytes() == belief.coverage_age_s(blk).tobytes(), blk
@@ -97,3 +97,37 @@ def test_coverage_ages_equal_belief(block_px):
     got = coverage_ages(cov, ticks, sc.world_size, 20, sc.ticks_per_second, block_px)
     for b, bel in enumerate(beliefs):
         assert got[b].tobytes() == bel.coverage_age_s(block_px).tobytes()
+
+
+def test_reset_clears_every_cell_it_wrote_and_only_its_worlds():
+    """Property: after a reset of some worlds mid-episode, their stored maps (seen ticks and
+    known mask) are all zero, as freshly created, though only the touched rows were cleared;
+    the other worlds keep theirs; and last_seen_at of a view reads the dense last_seen map at
+    any cells (never-sensed ones give -1)."""
+    sc = load_scenario("1").replace(duration_s=30)
+    n = 3
+    batch = BatchWorld(sc, n)
+    batch.reset(seeds=[0, 1, 2])
+    bb = BatchBelief(sc, n)
+    rng = np.random.default_rng(1)
+    ids = batch.team.one.ids
+    for t in range(sc.n_ticks):
+        if t % 7 == 0:
+            for b in range(n):
+                batch.team.apply(b, random_commands(rng, sc, ids))
+        bb.update(batch.step(), batch.tick)
+    ww = sc.world_size**2
+    written = [int(np.count_nonzero(bb._seen[b])) for b in range(n)]
+    assert min(written) > 0
+    before = bb._seen[1].copy()
+    cells = rng.integers(0, ww, 500)
+    cells = np.concatenate([cells, bb.known(1)])
+    got = bb.view(1, 100).last_seen_at(cells)
+    assert got.dtype == np.int32 and (got == -1).any()
+    np.testing.assert_array_equal(got, bb.last_seen(1).reshape(-1)[cells])
+    bb.reset(np.array([0, 2]))
+    for b in (0, 2):
+        assert not bb._seen[b].any() and not bb._mask[b * ww : (b + 1) * ww].any()
+        assert (bb.last_seen(b) == -1).all() and bb.known(b).size == 0
+    np.testing.assert_array_equal(bb._seen[1], before)
+    assert not bb._touched[[0, 2]].any() and bb._touched[1].any()

@@ -236,7 +236,7 @@ class TaskGraphBuilder:
         known = belief.known
         kx, ky = np.divmod(known, w)  # known = flat x * W + y
         order, ks, starts, pos, counts = tile_runs(tile_keys(kx, ky, tile, nty), kx, ky)
-        seen = belief.last_seen.ravel()[known[order]]
+        seen = belief.last_seen_at(known[order])
         last = np.maximum.reduceat(seen, starts)
         stale = (belief.tick - last) / self._tps
         tile_x, tile_y = np.divmod(ks[starts], nty)

@@ -85,7 +85,7 @@ def _tiles(
     known = [b.known for b in beliefs]
     sizes = np.array([k.size for k in known], dtype=np.int64)
     allk = np.concatenate(known)
-    seen_all = np.concatenate([b.last_seen.ravel()[k] for b, k in zip(beliefs, known, strict=True)])
+    seen_all = np.concatenate([b.last_seen_at(k) for b, k in zip(beliefs, known, strict=True)])
     kx, ky = np.divmod(allk, w)
     key = tile_keys(kx, ky, tile, nty)
     n_tiles = ntx * nty

@@ -16,8 +16,9 @@ def test_interleaved_rounds_print_medians_and_ratio_ranges(tmp_path):
     """Two rounds of tiny episodes at both levels: every level's table names its rounds, has a
     row per ``B`` and per sync ``B`` (Gymnasium's SyncVectorEnv of the single env) with a ratio
     range ``[min, max]`` that holds its median, the batched env over the sync one at their common
-    ``B``, the memory per world of both levels, and the plot is written (the script's own
-    arithmetic on real runs, not the figures, which are timings)."""
+    ``B``, the memory per world of both levels (traced, and resident over a whole episode), and
+    the plot is written (the script's own arithmetic on real runs, not the figures, which are
+    timings)."""
     plot = tmp_path / "vector.png"
     out = subprocess.run(
         [sys.executable, "bench/bench_vector.py", "--sizes", "1", "3", "--duration", "2",
@@ -39,4 +40,9 @@ def test_interleaved_rounds_print_medians_and_ratio_ranges(tmp_path):
     for level in ("motion", "task"):  # the memory per world of each level
         m = re.search(rf"memory, {level} level \(#practice, traced\): ([\d.]+) MB per world", out)
         assert m is not None and float(m[1]) > 0, out
+        m = re.search(
+            rf"memory, {level} level \(#practice, resident\): ([\d.]+) MB per world \(peak RSS "
+            r"of a whole 2-s episode, 16 against \d+ worlds\)", out
+        )  # fmt: skip
+        assert m is not None and float(m[1]) > 0, out  # (every world's fire map is resident)
     assert plot.stat().st_size > 0
