@@ -20,7 +20,9 @@ makes it too. :class:`BatchPlanFollower` (:mod:`fcplan.env.vector_expert`) is th
 :meth:`VectorTaskEnv.expert_actions <fcplan.env.vector_task.VectorTaskEnv.expert_actions>` a
 scheduler's actions on every world of the batched task level.
 ``vector_env(..., processes=P)`` splits the worlds over ``P`` processes stepped at once
-(:mod:`fcplan.env.vector_shards`). Their ``reset(seed=s)`` seeds world ``b`` with ``s + b``, also when ``options["reset_mask"]``
+(:mod:`fcplan.env.vector_shards`), and :class:`ShardedPlanFollower` and
+:class:`ShardedTaskExpert` (:mod:`fcplan.env.vector_shard_experts`) are the two experts on it,
+each shard planning its own worlds. Their ``reset(seed=s)`` seeds world ``b`` with ``s + b``, also when ``options["reset_mask"]``
 picks the worlds, as Gymnasium's vector envs do (:func:`fcplan.env.vector_base.reset_seeds`).
 
 Actions are integers; floats of whole values are taken as those integers, and a fractional or
@@ -85,6 +87,8 @@ __all__ = [
     "VectorMotionEnv",
     "VectorTaskEnv",
     "ShardedVectorEnv",
+    "ShardedPlanFollower",
+    "ShardedTaskExpert",
 ]
 
 #: Environment levels accepted by :func:`parallel_env`.
@@ -105,6 +109,8 @@ _LAZY = {
     "VectorMotionEnv": "fcplan.env.vector_motion",
     "VectorTaskEnv": "fcplan.env.vector_task",
     "ShardedVectorEnv": "fcplan.env.vector_shards",
+    "ShardedPlanFollower": "fcplan.env.vector_shard_experts",
+    "ShardedTaskExpert": "fcplan.env.vector_shard_experts",
 }
 
 

@@ -33,7 +33,8 @@ process and against independent processes (the bound of any such design), in the
 cores between steps takes from the same budget. The experts
 (:meth:`fcplan.env.vector_task.VectorTaskEnv.expert_actions`,
 :class:`fcplan.env.vector_expert.BatchPlanFollower`) read the worlds' graphs and simulator
-objects, which are spread over the processes: they run on the one-process batched env.
+objects, which are spread over the processes: :mod:`fcplan.env.vector_shard_experts` keeps one
+in every shard (:meth:`ShardedVectorEnv.apply_shards`), so that each shard plans its own worlds.
 
 Examples
 --------
@@ -100,9 +101,11 @@ def _views(buffers: dict[str, Any], num: int) -> dict[str, np.ndarray]:
     }
 
 
-def _serve(env: Any, out: dict[str, np.ndarray], command: str, arg: Any) -> Any:
+def _serve(env: Any, out: dict[str, np.ndarray], kept: dict[str, Any], command: str,
+           arg: Any) -> Any:  # fmt: skip
     """Run one request on a shard's batched env (here or in a worker); the observations go
-    into ``out``, the shard's rows of the shared arrays."""
+    into ``out``, the shard's rows of the shared arrays; ``"apply"`` runs ``fn(env, kept,
+    *args)``, ``kept`` being the objects the shard keeps for its callers (its experts)."""
     if command in ("reset", "step"):
         obs, *rest = env.reset(**arg) if command == "reset" else env.step(arg)
         for k, v in out.items():
@@ -112,6 +115,9 @@ def _serve(env: Any, out: dict[str, np.ndarray], command: str, arg: Any) -> Any:
         name, args, kw = arg
         value = getattr(env, name)
         return value(*args, **kw) if callable(value) else value
+    if command == "apply":
+        fn, args = arg
+        return fn(env, kept, *args)
     raise ValueError(f"unknown command {command!r}")
 
 
@@ -129,6 +135,7 @@ def _worker(conn: Any, make: tuple[Any, str, int, dict[str, Any]], rows: tuple[i
         conn.close()
         return
     out = {k: v[lo:hi] for k, v in _views(buffers, num).items()}
+    kept: dict[str, Any] = {}
     try:
         while True:
             command, arg = conn.recv()
@@ -137,7 +144,7 @@ def _worker(conn: Any, make: tuple[Any, str, int, dict[str, Any]], rows: tuple[i
                 conn.send(("ok", None))
                 break
             try:
-                conn.send(("ok", _serve(env, out, command, arg)))
+                conn.send(("ok", _serve(env, out, kept, command, arg)))
             except Exception as exc:
                 conn.send(("error", traceback.format_exception_only(type(exc), exc)[-1].strip()))
     except (KeyboardInterrupt, EOFError, BrokenPipeError):
@@ -236,6 +243,7 @@ class ShardedVectorEnv(VectorEnv):
         self._fresh: dict[str, np.ndarray] | None = None
         self._closed = self._dead = False
         self._conns: list[Any] = []
+        self._kept: dict[str, Any] = {}  # (the first shard's objects kept for "apply")
         self._procs: list[Any] = []
         ctx = mp.get_context(context)
         self._method = ctx.get_start_method()
@@ -318,7 +326,8 @@ class ShardedVectorEnv(VectorEnv):
                 sent.append(False)
         results: list[tuple[bool, Any]] = []
         try:
-            results.append((True, _serve(self.local, self._local_rows(command), command, args[0])))
+            out = self._local_rows(command)
+            results.append((True, _serve(self.local, out, self._kept, command, args[0])))
         except Exception as exc:
             results.append((False, traceback.format_exception_only(type(exc), exc)[-1].strip()))
         # (every worker's answer is read, failed or not: the pipes stay in step)
@@ -389,6 +398,17 @@ class ShardedVectorEnv(VectorEnv):
         """``getattr(shard_env, name)(*args, **kwargs)`` (or the attribute) of every shard's
         batched env, in shard order."""
         return self._request("call", [(name, args, kwargs)] * len(self.shards), breaks=False)
+
+    def apply_shards(self, fn: Any, args: Sequence[tuple[Any, ...]]) -> list[Any]:
+        """``fn(shard_env, kept, *args[j])`` on every shard ``j`` at once, in shard order: ``fn``
+        a module-level function (it is pickled to the workers), ``kept`` a dict the shard keeps
+        between calls (:mod:`fcplan.env.vector_shard_experts` keeps its experts there). A
+        failure raises :class:`~fcplan.errors.EnvError` and leaves the env usable."""
+        if len(args) != len(self.shards):
+            raise EnvError(
+                f"apply_shards: need {len(self.shards)} argument tuples (got {len(args)})"
+            )
+        return self._request("apply", [(fn, tuple(a)) for a in args], breaks=False)
 
     def state(self) -> np.ndarray:
         """The global state of every world (the motion level's ``state()``, ``(B, 8, nc, nc)``)."""

@@ -18,15 +18,20 @@ ROW = re.compile(
 )
 
 
-@pytest.mark.parametrize("level", ["motion", "task"])
-def test_rows_per_process_count(level):
-    """Two rounds of a few steps of 4 worlds of practice in 1 and 2 processes: the four rows,
-    with positive rates and ratio ranges that hold their medians."""
+@pytest.mark.parametrize("level, expert", [("motion", None), ("task", None), ("motion", "greedy"),
+                                           ("task", "greedy")])  # fmt: skip
+def test_rows_per_process_count(level, expert):
+    """Two rounds of a few steps of 4 worlds of practice in 1 and 2 processes, by random actions
+    or by greedy's plans (the one-process and the sharded experts): the four rows, with positive
+    rates and ratio ranges that hold their medians, and the header names the actions."""
+    more = ["--expert", expert] if expert else []
     out = subprocess.run(
         [sys.executable, "bench/bench_vector_procs.py", "--scenario", "practice",
-         "--worlds", "4", "--procs", "2", "--steps", "3", "--rounds", "2", "--level", level],
+         "--worlds", "4", "--procs", "2", "--steps", "3", "--rounds", "2", "--level", level,
+         *more],
         cwd=ROOT, capture_output=True, text=True, check=True, timeout=300,
     ).stdout  # fmt: skip
+    assert (f"actions of the {expert} expert" if expert else "random actions") in out.splitlines()[0]
     rows = [m for m in (ROW.match(line) for line in out.splitlines()) if m]
     assert [(m[1], int(m[2])) for m in rows] == [
         ("one process", 1),
