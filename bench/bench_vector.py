@@ -211,15 +211,20 @@ while True:
     obs, _, _, truncs, _ = env.step((rng.random(m.shape) * m).argmax(axis=2))
     if truncs.all():
         break
-print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * (1 if sys.platform == "darwin" else 1024))
+try:  # (Linux: this process's own peak; ru_maxrss keeps a larger parent's across fork and exec)
+    status = open("/proc/self/status").read()
+    print(int(status.split("VmHWM:")[1].split()[0]) * 1024)
+except OSError:
+    print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * (1 if sys.platform == "darwin" else 1024))
 """
 
 
 def resident_per_world(name: str, duration: float, small: int, large: int, level: str) -> float:
     """Bytes of peak resident memory per added world: a fresh process per size plays one whole
-    episode of every world with random legal actions (``resource``'s ``ru_maxrss``), and the
-    growth from ``small`` to ``large`` worlds is divided by the worlds added. Unlike the traced
-    figure, pages allocated but never written do not count."""
+    episode of every world with random legal actions (its peak resident size: ``VmHWM`` of
+    ``/proc/self/status``, else ``resource``'s ``ru_maxrss``, which on Linux a child inherits
+    from a larger parent), and the growth from ``small`` to ``large`` worlds is divided by the
+    worlds added. Unlike the traced figure, pages allocated but never written do not count."""
     peaks = []
     for num in (small, large):
         cmd = [sys.executable, "-c", _PEAK_RSS, name, str(duration), str(num), level]
