@@ -31,7 +31,8 @@ def test_rows_per_process_count(level, expert):
          *more],
         cwd=ROOT, capture_output=True, text=True, check=True, timeout=300,
     ).stdout  # fmt: skip
-    assert (f"actions of the {expert} expert" if expert else "random actions") in out.splitlines()[0]
+    header = out.splitlines()[0]
+    assert (f"actions of the {expert} expert" if expert else "random actions") in header
     rows = [m for m in (ROW.match(line) for line in out.splitlines()) if m]
     assert [(m[1], int(m[2])) for m in rows] == [
         ("one process", 1),
