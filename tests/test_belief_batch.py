@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from fcplan import load_scenario
 from fcplan.batch import BatchWorld
@@ -131,3 +133,51 @@ def test_reset_clears_every_cell_it_wrote_and_only_its_worlds():
         assert (bb.last_seen(b) == -1).all() and bb.known(b).size == 0
     np.testing.assert_array_equal(bb._seen[1], before)
     assert not bb._touched[[0, 2]].any() and bb._touched[1].any()
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.integers(0, 199), st.integers(1, 7)), max_size=6), st.integers(0, 99))
+def test_random_resets_read_as_fresh_beliefs(resets, seed):
+    """Property: whatever worlds are reset at whatever ticks (several at once, the same world
+    twice, one before it has sensed anything), every world's dense last_seen, known cells
+    (in order) and stored maps read as a single Belief fed only its ticks since its reset; a
+    reset clears only rows that world wrote, so this checks nothing written survives one."""
+    sc = load_scenario("practice").replace(duration_s=20)
+    n = 3
+    batch = BatchWorld(sc, n)
+    batch.reset(seeds=[seed, seed + 1, seed + 2])
+    sensed = 0
+    bb = BatchBelief(sc, n)
+    ref = [Belief(sc) for _ in range(n)]
+    rng = np.random.default_rng(seed)
+    ids = batch.team.one.ids
+    tps = sc.ticks_per_second
+    when = {}
+    for t, which in resets:
+        when.setdefault(t, 0)
+        when[t] |= which
+    for t in range(sc.n_ticks):
+        if t % 5 == 0:
+            for b in range(n):
+                batch.team.apply(b, random_commands(rng, sc, ids))
+        info = batch.step()
+        bb.update(info, batch.tick)
+        sensed += info.sensed[0].size
+        for b in range(n):
+            ref[b].update(_step_info(info, batch.tick, tps, b))
+        rows = [b for b in range(n) if when.get(t, 0) >> b & 1]
+        if rows:
+            mask = np.isin(np.arange(n), rows)
+            batch.reset(seeds=[seed + 10 + b for b in rows], mask=mask)
+            bb.reset(np.array(rows))
+            for b in rows:
+                ref[b] = Belief(sc)
+        if t % 25 == 24 or t == sc.n_ticks - 1:
+            for b in range(n):
+                np.testing.assert_array_equal(bb.known(b), ref[b].known, strict=True)
+                np.testing.assert_array_equal(bb.last_seen(b), ref[b].last_seen, strict=True)
+    assert sensed > 0
+    ww = sc.world_size**2
+    for b in range(n):  # the stored maps hold exactly what the world sensed since its reset
+        assert np.count_nonzero(bb._seen[b]) == np.count_nonzero(ref[b].last_seen >= 0)
+        assert np.count_nonzero(bb._mask[b * ww : (b + 1) * ww]) == ref[b].known.size
