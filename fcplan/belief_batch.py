@@ -27,13 +27,14 @@ known               B lists of (k,) int64       per world the cells in the order
 ==================  ==========================  =================================================
 
 Memory. The two maps are 7.2 MB of every world at 1,200 px, and only the cells the team sensed
-burning are ever written. So both are created by :func:`paged_zeros` (the operating system
-gives their small pages, zeroed, at the first write: a map costs only the pages holding sensed
-cells) and the seen map stores ``tick + 1``, so that "never" is 0 and needs no write. A reset clears only
-the rows touched since the last one. The single belief's dense ``last_seen`` of -1 is the
-specification; :meth:`BatchBelief.last_seen` and :meth:`BeliefView.last_seen_at` read it back.
-``bench/README.md`` ("The batched belief is paged in only where written") measures the
-resident size this saves (about 6.8 MB of 9.1 per world on #1) and what the page faults cost.
+burning are ever written. So both are created by :func:`fcplan.batch.pages.paged_zeros` (the
+operating system gives their small pages, zeroed, at the first write: a map costs only the
+pages holding sensed cells), and the seen map stores ``tick + 1``, so that "never" is 0 and
+needs no write. A reset clears only the rows touched since the last one. The single belief's
+dense ``last_seen`` of -1 is the specification; :meth:`BatchBelief.last_seen` and
+:meth:`BeliefView.last_seen_at` read it back. ``bench/README.md`` ("The batched belief is paged
+in only where written") measures the resident size this saves (about 6.8 MB of 9.1 per world on
+#1) and what the page faults cost.
 
 Coverage. A coarse cell's value is the largest tick of the writes covering it (ticks never
 decrease within an episode). The single belief defers the rewrite of a hovering camera's box and
@@ -60,42 +61,18 @@ Examples
 
 from __future__ import annotations
 
-import mmap
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from fcplan.batch.pages import paged_zeros
 from fcplan.belief import _block_layout
 
 if TYPE_CHECKING:
     from fcplan.batch import BatchStepInfo
     from fcplan.scenario import Scenario
 
-__all__ = ["BatchBelief", "BeliefView", "coverage_ages", "paged_zeros"]
-
-
-def paged_zeros(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
-    """A C-contiguous array of zeros whose memory the operating system maps at the first write
-    to each small page (4 KB on Linux), in an anonymous memory map of its own.
-
-    ``numpy.zeros`` gives the same lazily zeroed pages, but numpy advises the kernel to back large
-    arrays by 2 MB huge pages, so one write maps 2 MB: the batched belief's maps, written at a
-    few scattered cells, became resident nearly whole. Here huge pages are advised against where
-    the platform allows it (``mmap.MADV_NOHUGEPAGE``). The map lives as long as the array.
-
-    Examples
-    --------
-    >>> a = paged_zeros((2, 3), np.int32)
-    >>> a[1, 2] = 7
-    >>> a.tolist(), a.dtype.name, a.flags.c_contiguous
-    ([[0, 0, 0], [0, 0, 7]], 'int32', True)
-    """
-    dt = np.dtype(dtype)
-    count = int(np.prod(shape, dtype=np.int64))
-    buf = mmap.mmap(-1, max(count * dt.itemsize, 1))
-    if hasattr(mmap, "MADV_NOHUGEPAGE"):
-        buf.madvise(mmap.MADV_NOHUGEPAGE)
-    return np.frombuffer(buf, dtype=dt, count=count).reshape(shape)
+__all__ = ["BatchBelief", "BeliefView", "coverage_ages"]
 
 
 class BeliefView:

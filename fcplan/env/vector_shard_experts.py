@@ -1,9 +1,9 @@
 """Scheduling experts on a sharded batched env: every shard plans its own worlds, all at once.
 
 The experts of the batched envs (:class:`fcplan.env.vector_expert.BatchPlanFollower` at the
-motion level, :meth:`fcplan.env.vector_task.VectorTaskEnv.expert_actions` at the task level) read
-the worlds' simulator, beliefs and graphs, which a :class:`fcplan.env.vector_shards.ShardedVectorEnv`
-spreads over its processes. The experts here put one of them in every shard, next to the
+motion level, :meth:`fcplan.env.vector_task.VectorTaskEnv.expert_actions` at the task level)
+read the worlds' simulator, beliefs and graphs, which a
+:class:`fcplan.env.vector_shards.ShardedVectorEnv` spreads over its processes. The experts here put one of them in every shard, next to the
 shard's batched env (in the worker process that steps it, or in this one for the first shard),
 and keep it there as long as the expert lives: each call sends every shard only its part of
 the request (its rows of the action masks), the shards plan at the same time, and the answers

@@ -1,0 +1,43 @@
+"""Arrays of zeros that take memory only where they are written.
+
+A batch holds per-world maps of the whole world (the fire's cell grid, the team's belief) of
+which an episode writes a small part: the cells near the fire. ``numpy.zeros`` already gets
+its memory lazily, zeroed by the operating system at the first write to each page, but numpy
+advises the kernel to back large arrays by 2 MB huge pages (with transparent huge pages on
+``madvise``, Linux's usual setting), so a single write makes 2 MB resident and a batch of such
+maps, written at scattered cells, becomes resident nearly whole. :func:`paged_zeros` gives the
+same zeros in an anonymous memory map of its own, advised against huge pages where the platform
+allows it (``mmap.MADV_NOHUGEPAGE``), so that memory is taken one small page (4 KB on Linux) at
+a time. :class:`fcplan.belief_batch.BatchBelief` keeps its maps in them. ``bench/README.md``
+("The batched belief is paged in only where written", and the section after it) measures what
+this saves and what the page faults cost, and why the fire's cell grid
+(:class:`fcplan.batch.cells.CellGrid`) stays written whole when it is made.
+"""
+
+from __future__ import annotations
+
+import mmap
+from typing import Any
+
+import numpy as np
+
+__all__ = ["paged_zeros"]
+
+
+def paged_zeros(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+    """A C-contiguous array of zeros whose memory the operating system maps at the first write
+    to each small page (module docstring). The map lives as long as the array.
+
+    Examples
+    --------
+    >>> a = paged_zeros((2, 3), np.int32)
+    >>> a[1, 2] = 7
+    >>> a.tolist(), a.dtype.name, a.flags.c_contiguous
+    ([[0, 0, 0], [0, 0, 7]], 'int32', True)
+    """
+    dt = np.dtype(dtype)
+    count = int(np.prod(shape, dtype=np.int64))
+    buf = mmap.mmap(-1, max(count * dt.itemsize, 1))
+    if hasattr(mmap, "MADV_NOHUGEPAGE"):
+        buf.madvise(mmap.MADV_NOHUGEPAGE)
+    return np.frombuffer(buf, dtype=dt, count=count).reshape(shape)
