@@ -33,7 +33,9 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import itertools
+import weakref
 from collections.abc import Sequence
 from typing import Any
 
@@ -102,7 +104,8 @@ class _ShardedExpert:
             )
         parts = _cut(env, schedulers, "scheduler")
         self.env, self.key = env, f"expert-{next(_KEYS)}"
-        self._live = True
+        #: forgets the shards' experts once: at :meth:`close`, or when this object is collected
+        self._forget = weakref.finalize(self, _forget, env, self.key)
         try:
             env.apply_shards(_keep, [(self.key, make, (s,), kw) for s in parts])
         except EnvError:  # (the shards that made theirs forget it)
@@ -110,15 +113,22 @@ class _ShardedExpert:
             raise
 
     def _apply(self, fn: Any, per_shard: Sequence[tuple]) -> list[Any]:
-        if not self._live:
+        if not self._forget.alive:
             raise EnvError(f"{type(self).__name__}: the expert is closed")
         return self.env.apply_shards(fn, [(self.key, *a) for a in per_shard])
 
     def close(self) -> None:
-        """Forget the expert in every shard (a closed env has forgotten it already)."""
-        if self._live and not self.env._closed and self.env._broken is None:
-            self.env.apply_shards(_drop, [(self.key,)] * len(self.env.shards))
-        self._live = False
+        """Forget the expert in every shard (a closed env has forgotten it already). An expert
+        that is collected without ``close`` is forgotten then."""
+        self._forget()
+
+
+def _forget(env: ShardedVectorEnv, key: str) -> None:
+    """Drop the expert ``key`` from every shard of ``env``, if the env still runs."""
+    if env._closed or env._broken is not None:
+        return
+    with contextlib.suppress(EnvError, OSError):  # (a worker gone: nothing left to drop)
+        env.apply_shards(_drop, [(key,)] * len(env.shards))
 
 
 class ShardedPlanFollower(_ShardedExpert):

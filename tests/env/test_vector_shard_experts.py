@@ -117,3 +117,30 @@ def test_bad_input_is_refused_and_the_env_goes_on():
         assert env.local._started
     finally:
         env.close()
+
+
+def _keys(env, kept):
+    """The keys a shard keeps (run in every shard)."""
+    return sorted(kept)
+
+
+def test_an_expert_lives_in_the_shards_as_long_as_its_object():
+    """Every shard keeps an expert while its object lives; close() or the object's collection
+    drops it from every shard, and closing twice, or after the env, is harmless."""
+    import gc
+
+    sc = load_scenario("practice").replace(duration_s=3)
+    env = vector_env(sc, mode="motion", num_envs=4, processes=2)
+    try:
+        a, b = ShardedPlanFollower(env, "greedy"), ShardedPlanFollower(env, "greedy")
+        assert env.apply_shards(_keys, [()] * 2) == [sorted([a.key, b.key])] * 2
+        a.close()
+        a.close()
+        assert env.apply_shards(_keys, [()] * 2) == [[b.key]] * 2
+        del b
+        gc.collect()
+        assert env.apply_shards(_keys, [()] * 2) == [[]] * 2
+        c = ShardedPlanFollower(env, "greedy")
+    finally:
+        env.close()
+    c.close()
