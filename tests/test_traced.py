@@ -10,10 +10,14 @@ from tests.traced import HelperError, traced_call
 
 
 def test_the_peak_counts_the_call_only():
-    """The peak is the call's own: a large call's bytes do not carry over to a small one."""
+    """The peak is the call's own: a large call's bytes do not carry over to a small one. (The
+    peak is taken over the traced memory at the call's start, so objects of the helper freed
+    during the call lower it a little: CI once saw 21 bytes short of the 50 MiB; 64 KiB of
+    slack.)"""
     _, large = traced_call(bytes, 50 * 2**20)
     _, small = traced_call(bytes, 10)
-    assert large >= 50 * 2**20 > 1000 * small
+    assert large >= 50 * 2**20 - 2**16
+    assert 1000 * small < 50 * 2**20
 
 
 def test_an_exception_is_raised_again_with_the_helpers_traceback():
