@@ -241,11 +241,6 @@ _SHARED = {
 }
 
 
-def _episode(sc: Any, duration: float) -> str:
-    """The episode length of the resident figure, e.g. ``"180-s"``."""
-    return f"{duration or sc.duration_s:g}-s"
-
-
 def single_task(sc: Any, episodes: int, seed: int = 0) -> tuple[int, Clock]:
     """Steps of ``episodes`` episodes of ``fcplan/Task-v1`` with random legal actions, timed."""
     env = TaskGymEnv(sc)
@@ -350,7 +345,7 @@ def main(argv: list[str] | None = None) -> int:
         res = resident_per_world(args.scenarios[0], dur, 16, large, level)
         print(
             f"memory, {level} level (#{args.scenarios[0]}, resident): {res / 1e6:.3f} MB per "
-            f"world (peak RSS of a whole {_episode(sc, dur)} episode, 16 against {large} worlds)"
+            f"world (peak RSS of a whole {dur or sc.duration_s:g}-s episode, 16 against {large} worlds)"
         )
     mpe_runs = [r for r in (mpe_rate() for _ in range(args.rounds)) if r is not None]
     mpe = float(np.median(mpe_runs)) if mpe_runs else None

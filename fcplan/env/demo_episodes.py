@@ -152,8 +152,7 @@ def rollout_episode(
 def _count(own: MappingCounts, total: MappingCounts | None) -> dict[str, int]:
     """An episode's mapping counts as a plain dict, added to ``total`` when given."""
     if total is not None:
-        for name, n in own.items():
-            total[name] += n
+        total.add(own)
     return dict(own)
 
 

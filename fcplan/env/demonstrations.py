@@ -480,8 +480,7 @@ class _Rollouts:
         entries (:func:`~fcplan.env.demo_episodes.episode_mapping`)."""
         counts = MappingCounts()
         for e in self.episodes:
-            for name, count in e["mapping"].items():
-                counts[name] += count
+            counts.add(e["mapping"])
         return {
             "mapping": dict(counts),
             "conflicts": sum(e["conflicts"] for e in self.episodes),

@@ -273,6 +273,18 @@ class MappingCounts(dict):
     def __init__(self) -> None:
         super().__init__(exact=0, outside_top_k=0, noop=0, home=0)
 
+    def add(self, other: Mapping[str, int]) -> None:
+        """Add ``other``'s counts to these (an episode's into a dataset's, a shard's into the
+        caller's).
+
+        >>> c = MappingCounts()
+        >>> c.add({"exact": 2, "noop": 1})
+        >>> c["exact"], c["noop"], c["home"]
+        (2, 1, 0)
+        """
+        for name, n in other.items():
+            self[name] += n
+
 
 def plan_to_actions(
     plan: Plan, graph: TaskGraph, cand: Candidates, counts: MappingCounts | None = None

@@ -54,12 +54,11 @@ _KEYS = itertools.count()
 
 
 # -------------------------------------------------------------- run in every shard
-def _keep(env: Any, kept: dict[str, Any], key: str, make: str, args: tuple, kw: dict) -> None:
-    """Make a shard's expert and keep it under ``key``."""
-    if make == "follower":
-        kept[key] = BatchPlanFollower(env, *args, **kw)
-    else:
-        kept[key] = args[0]  # (the task level's schedulers: env.expert_actions plans with them)
+def _keep(env: Any, kept: dict[str, Any], key: str, follow: bool, scheduler: Any,
+          kw: dict[str, Any]) -> None:  # fmt: skip
+    """Keep a shard's expert under ``key``: a follower of ``scheduler`` (the motion level), or
+    the schedulers themselves, which ``env.expert_actions`` plans with (the task level)."""
+    kept[key] = BatchPlanFollower(env, scheduler, **kw) if follow else scheduler
 
 
 def _drop(env: Any, kept: dict[str, Any], key: str) -> None:
@@ -72,10 +71,9 @@ def _follow(env: Any, kept: dict[str, Any], key: str, mask: np.ndarray) -> np.nd
     return kept[key].actions({"action_mask": mask})
 
 
-def _follower_state(env: Any, kept: dict[str, Any], key: str, what: str) -> Any:
-    """The shard's follower's ``replans`` (a copy) or ``plans``."""
-    follower = kept[key]
-    return follower.replans.copy() if what == "replans" else list(follower.plans)
+def _attribute(env: Any, kept: dict[str, Any], key: str, name: str) -> Any:
+    """An attribute of the shard's expert (``replans``, ``plans``)."""
+    return getattr(kept[key], name)
 
 
 def _follower_reset(env: Any, kept: dict[str, Any], key: str, rows: np.ndarray) -> None:
@@ -94,7 +92,7 @@ def _plan(env: Any, kept: dict[str, Any], key: str, time_limit: Any,
 class _ShardedExpert:
     """An expert kept in every shard of ``env`` under one key (module docstring)."""
 
-    def __init__(self, env: ShardedVectorEnv, mode: str, make: str, schedulers: Any,
+    def __init__(self, env: ShardedVectorEnv, mode: str, schedulers: Any,
                  kw: dict[str, Any]) -> None:  # fmt: skip
         if not isinstance(env, ShardedVectorEnv):
             raise EnvError(f"{type(self).__name__}: env must be a ShardedVectorEnv")
@@ -107,7 +105,8 @@ class _ShardedExpert:
         #: forgets the shards' experts once: at :meth:`close`, or when this object is collected
         self._forget = weakref.finalize(self, _forget, env, self.key)
         try:
-            env.apply_shards(_keep, [(self.key, make, (s,), kw) for s in parts])
+            follow = mode == "motion"
+            env.apply_shards(_keep, [(self.key, follow, s, kw) for s in parts])
         except EnvError:  # (the shards that made theirs forget it)
             self.close()
             raise
@@ -146,7 +145,7 @@ class ShardedPlanFollower(_ShardedExpert):
     """
 
     def __init__(self, env: ShardedVectorEnv, scheduler: Any, **kwargs: Any) -> None:
-        super().__init__(env, "motion", "follower", scheduler, kwargs)
+        super().__init__(env, "motion", scheduler, kwargs)
 
     def actions(self, observations: dict[str, np.ndarray]) -> np.ndarray:
         """(B, N) int64 actions of every world for the current tick (0 in finished worlds)."""
@@ -163,12 +162,12 @@ class ShardedPlanFollower(_ShardedExpert):
     @property
     def replans(self) -> np.ndarray:
         """(B,) int64 plans made in each world since its episode started."""
-        return np.concatenate(self._apply(_follower_state, [("replans",)] * len(self.env.shards)))
+        return np.concatenate(self._apply(_attribute, [("replans",)] * len(self.env.shards)))
 
     @property
     def plans(self) -> list[Plan | None]:
         """Each world's last plan (copies from the shards)."""
-        parts = self._apply(_follower_state, [("plans",)] * len(self.env.shards))
+        parts = self._apply(_attribute, [("plans",)] * len(self.env.shards))
         return [p for part in parts for p in part]
 
 
@@ -199,7 +198,7 @@ class ShardedTaskExpert(_ShardedExpert):
 
     def __init__(self, env: ShardedVectorEnv, schedulers: Any, *,
                  time_limit: float | None = None) -> None:  # fmt: skip
-        super().__init__(env, "task", "schedulers", schedulers, {})
+        super().__init__(env, "task", schedulers, {})
         self.time_limit = time_limit
 
     def actions(
@@ -208,23 +207,16 @@ class ShardedTaskExpert(_ShardedExpert):
         """(B, A) actions of the schedulers' plans on every world's current graph, and (B,)
         bool: the plan came from the greedy fallback. ``counts`` (one for all the worlds, or
         one per world) are added to as ``VectorTaskEnv.expert_actions`` adds to them."""
-        one = counts is None or isinstance(counts, MappingCounts)
-        fresh: list[Any] = (
-            [None if counts is None else MappingCounts() for _ in self.env.shards]
-            if one
-            else [[MappingCounts() for _ in part] for part in _cut(self.env, counts, "counts")]
-        )
+        mine: list[MappingCounts] = []
+        if isinstance(counts, MappingCounts):
+            mine = [counts] * self.env.num_envs
+        elif counts is not None:
+            mine = [c for part in _cut(self.env, counts, "counts") for c in part]
+        fresh = [[MappingCounts() for _ in range(hi - lo)] for lo, hi in self.env.shards]
         parts = self._apply(_plan, [(self.time_limit, c) for c in fresh])
-        if counts is not None:
-            got = [p[2] for p in parts]
-            pairs: list[tuple[MappingCounts, MappingCounts]] = (
-                [(counts, g) for g in got]
-                if isinstance(counts, MappingCounts)
-                else list(zip(counts, [c for part in got for c in part], strict=True))
-            )
-            for mine, theirs in pairs:
-                for k, v in theirs.items():
-                    mine[k] += v
+        if mine:
+            for total, theirs in zip(mine, [c for p in parts for c in p[2]], strict=True):
+                total.add(theirs)
         return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
 
