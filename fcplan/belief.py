@@ -30,6 +30,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from fcplan.shared_views import KeepsViews
+
 if TYPE_CHECKING:
     from fcplan.scenario import Scenario
     from fcplan.world import StepInfo
@@ -37,7 +39,7 @@ if TYPE_CHECKING:
 __all__ = ["Belief", "ClairvoyantBelief"]
 
 
-class Belief:
+class Belief(KeepsViews):
     """The team's knowledge, updated from each tick's :class:`fcplan.world.StepInfo`.
 
     Parameters

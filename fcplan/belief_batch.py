@@ -65,8 +65,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fcplan.batch.pages import paged_zeros
+from fcplan.batch.pages import PagedRows, paged_zeros
 from fcplan.belief import _block_layout
+from fcplan.shared_views import KeepsViews
 
 if TYPE_CHECKING:
     from fcplan.batch import BatchStepInfo
@@ -109,7 +110,7 @@ class BeliefView:
         return self._owner.coverage_ages(int(block_px), np.array([self._b]))[0]
 
 
-class BatchBelief:
+class BatchBelief(KeepsViews):
     """The beliefs of ``num`` worlds of ``scenario`` (module docstring).
 
     Parameters
@@ -145,6 +146,26 @@ class BatchBelief:
         self._box = np.zeros((b, n_s, 4), dtype=np.int64)
         self._has_box = np.zeros((b, n_s), dtype=bool)
         self._pending = np.full((b, n_s), -1, dtype=np.int64)  # deferred tick (-1: none)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The state for a copy or pickle: the paged maps as their touched rows only
+        (:class:`fcplan.batch.pages.PagedRows`), the other views of shared memory as records
+        (:class:`fcplan.shared_views.KeepsViews`)."""
+        state = super().__getstate__()
+        w = self.world_size
+        state["_seen"] = PagedRows(self._seen, self._touched)
+        state["_mask"] = PagedRows(self._mask.reshape(self.num, w, w), self._touched)
+        del state["_seen_flat"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """Restore a copied state (:meth:`__getstate__`)."""
+        super().__setstate__(state)
+        for name in ("_seen", "_mask"):  # (a shallow copy leaves the records as they were)
+            if isinstance(getattr(self, name), PagedRows):
+                setattr(self, name, getattr(self, name).array())
+        self._seen_flat = self._seen.reshape(-1)
+        self._mask = self._mask.reshape(-1)
 
     def reset(self, rows: np.ndarray) -> None:
         """Empty beliefs in the worlds ``rows`` (new episodes)."""

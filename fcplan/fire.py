@@ -110,6 +110,7 @@ from fcplan.farsite import (
     wind_tables,
 )
 from fcplan.scenario.parts import DEFAULT_WIND_MODEL, WIND_MODELS
+from fcplan.shared_views import KeepsViews
 
 __all__ = ["Fire", "spread_rate_ratio", "wind_draws", "INTENSITY_COEFF", "STEPS_PER_SECOND"]
 __all__ += ["UNBURNT", "BURNING", "PRUNED", "WIND_SPEED_SD", "WIND_DIR_SD_RAD"]
@@ -124,7 +125,7 @@ UNBURNT, BURNING, PRUNED = 0, 1, 2
 BLOCK = 16
 
 
-class Fire:
+class Fire(KeepsViews):
     """All fire regions of one episode.
 
     Parameters

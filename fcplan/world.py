@@ -46,6 +46,7 @@ from fcplan._fast.world import scan_box as _scan_box
 from fcplan._fast.world import step_info_builder
 from fcplan.errors import SeedError
 from fcplan.fire import _BURNING8, Fire, _unique
+from fcplan.shared_views import KeepsViews
 from fcplan.team import Command, Team, per_tick_probability
 from fcplan.trace import TRACE_FIELDS, Trace
 
@@ -87,7 +88,7 @@ class StepInfo:
 _step_info = step_info_builder(StepInfo)  # StepInfo(...), cheaper
 
 
-class World:
+class World(KeepsViews):
     """Fire, team and scoring state of one episode.
 
     Parameters

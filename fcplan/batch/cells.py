@@ -34,6 +34,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from fcplan.shared_views import KeepsViews
+
 __all__ = ["CellGrid", "scan_boxes", "runs", "SENSED", "BLOCK", "STATE_BITS"]
 
 #: side of a block (px); equal to :data:`fcplan.fire.BLOCK`
@@ -52,7 +54,7 @@ _LX = np.arange(BLOCK, dtype=np.int64)
 _ONE = np.int32(1)
 
 
-class CellGrid:
+class CellGrid(KeepsViews):
     """Fire state and sensing of every cell of ``num`` worlds (module docstring: the layout).
 
     Parameters

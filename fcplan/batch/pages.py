@@ -12,6 +12,11 @@ a time. :class:`fcplan.belief_batch.BatchBelief` keeps its maps in them. ``bench
 ("The batched belief is paged in only where written", and the section after it) measures what
 this saves and what the page faults cost, and why the fire's cell grid
 (:class:`fcplan.batch.cells.CellGrid`) stays written whole when it is made.
+
+Copies. ``pickle`` and ``copy.deepcopy`` would copy such an array whole, into ordinary memory,
+every page of it made resident. :class:`PagedRows` stands for one in a copied state and keeps
+only the rows its owner says were written: the copy is a :func:`paged_zeros` array again, with
+those rows filled.
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["paged_zeros"]
+__all__ = ["PagedRows", "paged_zeros"]
 
 
 def paged_zeros(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
@@ -41,3 +46,43 @@ def paged_zeros(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
     if hasattr(mmap, "MADV_NOHUGEPAGE"):
         buf.madvise(mmap.MADV_NOHUGEPAGE)
     return np.frombuffer(buf, dtype=dt, count=count).reshape(shape)
+
+
+class PagedRows:
+    """A :func:`paged_zeros` array ``a`` of shape ``(B, W, ...)`` in a copied state, with only
+    the rows ``written`` ((B, W) bool; every other row must be all zeros) kept: it pickles and
+    deep-copies as those rows, and comes back as a paged array (module docstring).
+
+    Examples
+    --------
+    >>> import pickle
+    >>> a = paged_zeros((2, 3, 4), np.int32)
+    >>> a[1, 2, 3] = 5
+    >>> written = np.zeros((2, 3), dtype=bool)
+    >>> written[1, 2] = True
+    >>> b = pickle.loads(pickle.dumps(PagedRows(a, written)))
+    >>> bool((b == a).all()), int(b[1, 2, 3])
+    (True, 5)
+    """
+
+    __slots__ = ("_state",)
+
+    def __init__(self, a: np.ndarray, written: np.ndarray) -> None:
+        index = np.nonzero(written)
+        self._state = (a.shape, a.dtype.str, index, a[index])
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        return _paged_rows, self._state
+
+    def array(self) -> np.ndarray:
+        """The paged array again (what a copy gets)."""
+        return _paged_rows(*self._state)
+
+
+def _paged_rows(
+    shape: tuple[int, ...], dtype: str, index: tuple[np.ndarray, ...], rows: np.ndarray
+) -> np.ndarray:
+    """A :func:`paged_zeros` array of ``shape`` with ``rows`` written at ``index``."""
+    out = paged_zeros(shape, np.dtype(dtype))
+    out[index] = rows
+    return out

@@ -59,6 +59,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from fcplan.shared_views import KeepsViews
+
 if TYPE_CHECKING:
     from fcplan.scenario import Scenario
     from fcplan.world import StepInfo, World
@@ -104,7 +106,7 @@ def _block_share(mask: np.ndarray, c: int, nc: int) -> np.ndarray:
     return pad.reshape(nc, c, nc, c).sum(axis=(1, 3)) / float(c * c)
 
 
-class CoarseMaps:
+class CoarseMaps(KeepsViews):
     """Padded coarse maps of one episode, updated once per tick.
 
     Parameters

@@ -147,6 +147,7 @@ from fcplan.mission import (
     period_ticks,
 )
 from fcplan.plan import Plan, validate_plan
+from fcplan.shared_views import KeepsViews
 from fcplan.taskgraph import TaskGraph, TaskGraphParams
 from fcplan.team import Command
 from fcplan.world import World, check_seed
@@ -154,7 +155,7 @@ from fcplan.world import World, check_seed
 __all__ = ["TaskEnv"]
 
 
-class TaskEnv(ParallelEnv):
+class TaskEnv(KeepsViews, ParallelEnv):
     """Task-level parallel environment (the module docstring is its documentation page)."""
 
     metadata = {

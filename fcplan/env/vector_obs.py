@@ -48,6 +48,7 @@ from fcplan.env.motion import role_letters
 from fcplan.env.motion_grid import FACILITY, LAKE, OUTSIDE, CoarseMaps
 from fcplan.env.motion_obs import N_AGENT_FEATURES, N_FOV
 from fcplan.scenario import Scenario
+from fcplan.shared_views import KeepsViews
 from fcplan.team import DRAIN_PER_PX
 
 __all__ = ["BatchMotionObs"]
@@ -59,7 +60,7 @@ _PENDING_MAX = 1 << 16  # (queued fire cells of the burning layer before it is u
 _ACTIVE = 1
 
 
-class BatchMotionObs:
+class BatchMotionObs(KeepsViews):
     """The observation side of a batched motion env (module docstring).
 
     Parameters

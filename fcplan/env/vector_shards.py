@@ -434,6 +434,15 @@ class ShardedVectorEnv(VectorEnv):
         if getattr(self, "local", None) is not None:
             self.local.close()
 
+    def __reduce_ex__(self, protocol: Any) -> Any:
+        """Refuse ``pickle``, ``copy.copy`` and ``copy.deepcopy`` before anything is copied:
+        the worlds live in worker processes, and a copy of the pipes to them would close the
+        original's when collected (``os.close`` on the same descriptors)."""
+        raise EnvError(
+            "a ShardedVectorEnv cannot be copied or pickled: its worlds live in worker "
+            "processes; copy a one-process env (processes=1) or make a new one"
+        )
+
     def _terminate(self) -> None:
         for proc in self._procs:
             proc.join(timeout=5)
