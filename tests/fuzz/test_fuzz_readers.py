@@ -13,9 +13,7 @@ from __future__ import annotations
 import os
 import pickle
 import shutil
-import signal
 import tempfile
-import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -26,6 +24,7 @@ from hypothesis import strategies as st
 from fcplan.errors import LegacyError
 from fcplan.legacy import LEGACY_FILES, import_legacy, restricted_loads
 from fcplan.recording import RecordingError, load_recording
+from tests.deadline import deadline
 from tests.fuzz.cases import (
     EDIT_KINDS,
     ODD_VALUES,
@@ -63,24 +62,13 @@ class _TooSlowError(Exception):
     pass
 
 
-def _raise_too_slow(signum: int, frame: Any) -> None:
-    raise _TooSlowError()
-
-
 def check_clean(call: Callable[[], Any], clean: type[Exception]) -> str:
     """Run ``call`` within :data:`TIME_BOUND_S`; fail on any exception but ``clean``."""
-    main = threading.current_thread() is threading.main_thread() and hasattr(signal, "setitimer")
-    if main:
-        old = signal.signal(signal.SIGALRM, _raise_too_slow)
-        signal.setitimer(signal.ITIMER_REAL, TIME_BOUND_S)
     try:
-        kind, message = outcome(call, clean)
+        with deadline(TIME_BOUND_S, _TooSlowError):
+            kind, message = outcome(call, clean)
     except _TooSlowError:
         pytest.fail(f"an input took more than {TIME_BOUND_S} s")
-    finally:
-        if main:
-            signal.setitimer(signal.ITIMER_REAL, 0)
-            signal.signal(signal.SIGALRM, old)
     assert kind != "traceback", message
     return kind
 

@@ -32,6 +32,7 @@ import sys
 import time
 from typing import Any
 
+from tests.deadline import deadline
 from tests.fuzz.cases import clean_error, load_target
 
 #: memory the child may grow by before the call counts as ``oom``
@@ -42,10 +43,6 @@ class _HangError(Exception):
     pass
 
 
-def _alarm(signum: int, frame: Any) -> None:
-    raise _HangError()
-
-
 def _child(target: str, path: str, timeout: float, memory_mb: int) -> dict[str, Any]:
     import resource  # (POSIX only: imported here so that the module imports everywhere)
 
@@ -54,12 +51,11 @@ def _child(target: str, path: str, timeout: float, memory_mb: int) -> dict[str, 
     limit = vm + memory_mb * 2**20
     resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
     base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    signal.signal(signal.SIGALRM, _alarm)
-    signal.setitimer(signal.ITIMER_REAL, timeout)
     t0 = time.perf_counter()
     message = ""
     try:
-        load_target(target, path)
+        with deadline(timeout, _HangError):
+            load_target(target, path)
         result = "loaded"
     except _HangError:
         result = "hang"
@@ -69,7 +65,6 @@ def _child(target: str, path: str, timeout: float, memory_mb: int) -> dict[str, 
         result, message = "clean", str(exc)
     except BaseException as exc:  # noqa: BLE001 - what a fuzzer looks for
         result, message = "traceback", f"{type(exc).__name__}: {exc}"
-    signal.setitimer(signal.ITIMER_REAL, 0)
     growth = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - base) / 1024
     if growth > memory_mb and result != "hang":
         result = "oom"

@@ -41,6 +41,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from tests.deadline import deadline as time_bound
 from tests.traced import traced_call
 
 __all__ = [
@@ -340,16 +341,15 @@ def _in_helper(argv: list[str], timeout: int, grace: float) -> Case:
 
     from fcplan.cli import main
 
-    def stop(signum, frame):
-        raise _HangError()
-
     before = _children()
     err, status = io.StringIO(), None
-    previous = signal.signal(signal.SIGALRM, stop)
     t0 = time.monotonic()
-    signal.alarm(timeout)
     try:
-        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        with (
+            time_bound(timeout, _HangError),
+            contextlib.redirect_stderr(err),
+            contextlib.redirect_stdout(io.StringIO()),
+        ):
             status = main(argv)
     except _HangError:
         status = None
@@ -357,8 +357,6 @@ def _in_helper(argv: list[str], timeout: int, grace: float) -> Case:
         err.write(traceback.format_exc())
         status = 1
     finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
         seconds = time.monotonic() - t0
     deadline = time.monotonic() + grace
     while (left := _children() - before) and time.monotonic() < deadline:

@@ -4,7 +4,6 @@ naming the problem, or loads and runs, within a time and a memory bound."""
 from __future__ import annotations
 
 import random
-import signal
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -17,6 +16,7 @@ from fcplan.errors import FcplanError
 from fcplan.scenario import load_scenario
 from fcplan.scenario.bounds import MEMORY_LIMIT_BYTES, estimate_bytes
 from fcplan.scenario.read import scenario_from_dict
+from tests.deadline import deadline
 from tests.hardening.mutate import mutant, to_toml
 from tests.traced import traced_call
 
@@ -45,17 +45,8 @@ def bounded(seconds: int, fn: Callable[..., tuple[T, int]], *args: Any) -> T:
 def _alarmed(seconds: int, fn: Callable[..., T], *args: Any) -> T:
     """``fn(*args)`` under an alarm (run in the helper's main thread)."""
 
-    def stop(signum, frame):
-        raise HangError(f"over {seconds} s")
-
-    previous = signal.signal(signal.SIGALRM, stop)
-    signal.alarm(seconds)
-    try:
-        value = fn(*args)
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
-    return value
+    with deadline(seconds, lambda: HangError(f"over {seconds} s")):
+        return fn(*args)
 
 
 def _load_and_play(path: str) -> tuple[str | None, int]:
