@@ -27,6 +27,7 @@ import numpy as np
 from pettingzoo import ParallelEnv
 
 from fcplan.errors import EnvError
+from fcplan.shared_views import KeepsViews
 
 if TYPE_CHECKING:
     from gymnasium import spaces
@@ -97,7 +98,7 @@ def rf1_penalty_small(pos: list[list[int]], is_perception: list[bool], comm_rang
     return float((n - sum(near)) + 3 * (n - sum(paired)))
 
 
-class PresetEnv(ParallelEnv):
+class PresetEnv(KeepsViews, ParallelEnv):
     """PettingZoo plumbing shared by the presets: agents, cached spaces, seeding, render.
 
     A preset's ``__init__`` calls :meth:`_setup_agents`, :meth:`_check_common` and
