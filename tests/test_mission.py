@@ -1,6 +1,10 @@
-"""Tests for fcplan.mission: the one replan loop, its replan rule and its observers."""
+"""Tests for fcplan.mission: the one replan loop, its replan rule and its observers; a copied
+mission runs on as the original."""
 
 from __future__ import annotations
+
+import copy
+import pickle
 
 import numpy as np
 import pytest
@@ -250,3 +254,23 @@ def test_bad_time_limits_and_periods_are_one_line_argument_errors(kwargs, match)
         run_episode("practice", "greedy", seed=0, **kwargs)
     assert isinstance(err.value, FcplanError) and isinstance(err.value, ValueError)
     assert "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("how", ["deepcopy", "pickle"])
+def test_a_copied_mission_runs_on_as_the_original(how):
+    """A mission of #1 copied at tick 400 (greedy replanning) and both run to the end with a
+    fresh greedy: the same replan ticks and the same trace of active and pruned cells."""
+    m, greedy = Mission("1", seed=3), make_scheduler("greedy")
+    while m.tick < 400:
+        commands = None
+        if m.replan_due():
+            graph, plan = m.replan(greedy)
+            commands = m.commands_for(plan, graph)
+        m.step(commands)
+    twin = copy.deepcopy(m) if how == "deepcopy" else pickle.loads(pickle.dumps(m))
+    m.run(make_scheduler("greedy"))
+    twin.run(make_scheduler("greedy"))
+    assert twin.tick == m.tick and twin.replan_ticks.tolist() == m.replan_ticks.tolist()
+    mine, theirs = m.world.trace(), twin.world.trace()
+    for field in ("active", "pruned"):
+        assert np.array_equal(getattr(theirs, field), getattr(mine, field)), field
