@@ -51,7 +51,6 @@ from typing import Any
 
 import numpy as np
 
-from fcplan.shared_views import KeepsViews
 from fcplan.taskgraph import TaskGraph, TaskKind
 from fcplan.team import DRAIN_PER_PX, Mode
 
@@ -120,7 +119,7 @@ _ROWS = np.arange(256)[:, None]  # agent rows as a column, for fancy indexing
 
 
 @dataclass(frozen=True, eq=False)
-class Candidates(KeepsViews):
+class Candidates:
     """Per-agent candidate tasks of one step.
 
     Attributes

@@ -49,7 +49,6 @@ from typing import Any, Generic, TypeVar, overload
 import numpy as np
 
 from fcplan.scenario import Role
-from fcplan.shared_views import KeepsViews
 from fcplan.team import DRAIN_PER_PX, Mode
 
 __all__ = [
@@ -184,7 +183,7 @@ class SharedMemo:
 
 
 @dataclass(frozen=True, eq=False)
-class TaskGraph(KeepsViews):
+class TaskGraph:
     """Tasks, agents and facilities at one replan tick, as numpy arrays plus a networkx view.
 
     ``A`` agents, ``K`` tasks (fires first, then search blocks), ``F`` scored facilities. The

@@ -244,3 +244,15 @@ def test_every_registered_env_copies(env_id, how):
         assert _same(out[:4], want[:4]), t
         if want[2] or want[3]:
             break
+
+
+def test_one_graph_pickles_without_its_batch():
+    """World 0's task graph and candidate table of a 16-world batch pickle to the size of the
+    same world's in a batch of one: handed-out values carry their own rows only."""
+    sizes = []
+    for num in (1, 16):
+        env = vector_env("1", mode="task", num_envs=num)
+        env.reset(seed=0)
+        sizes.append((len(pickle.dumps(env.graphs[0])), len(pickle.dumps(env.candidates[0]))))
+    (g1, c1), (g16, c16) = sizes
+    assert g16 <= 1.1 * g1 and c16 <= 1.1 * c1, sizes
