@@ -161,9 +161,6 @@ class BatchBelief(KeepsViews):
     def __setstate__(self, state: dict[str, Any]) -> None:
         """Restore a copied state (:meth:`__getstate__`)."""
         super().__setstate__(state)
-        for name in ("_seen", "_mask"):  # (a shallow copy leaves the records as they were)
-            if isinstance(getattr(self, name), PagedRows):
-                setattr(self, name, getattr(self, name).array())
         self._seen_flat = self._seen.reshape(-1)
         self._mask = self._mask.reshape(-1)
 

@@ -24,7 +24,7 @@ graph instead of 23 kB, 720 kB for one candidate table instead of 12 kB).
 
 An owner that a :class:`KeepsViews` class wants copied otherwise (the batched belief's maps,
 which are paged in only where written, :mod:`fcplan.batch.pages`) is replaced in the class's
-own ``__getstate__`` before this one runs.
+own ``__getstate__`` by another :class:`CopyRecord` (``fcplan.batch.pages.PagedRows``).
 
 Examples
 --------
@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.lib.stride_tricks import as_strided
 
-__all__ = ["KeepsViews", "memory_owner"]
+__all__ = ["CopyRecord", "KeepsViews", "memory_owner"]
 
 
 def memory_owner(a: np.ndarray) -> np.ndarray:
@@ -71,30 +71,21 @@ def memory_owner(a: np.ndarray) -> np.ndarray:
             return a
 
 
-class _View:
-    """A view of ``owner`` in a copied state: rebuilt by :func:`_rebuild` on the copy."""
+class CopyRecord:
+    """What stands for an array in a copied state: it pickles and deep-copies as its
+    ``__reduce__`` says, and :meth:`array` gives the array again where a shallow copy left the
+    record itself (:meth:`KeepsViews.__setstate__`). ``_args`` are the arguments of ``_make``."""
 
-    __slots__ = ("owner", "offset", "shape", "strides", "dtype", "writeable")
-
-    def __init__(self, a: np.ndarray, owner: np.ndarray) -> None:
-        self.owner = owner
-        self.offset = int(a.__array_interface__["data"][0] - owner.__array_interface__["data"][0])
-        self.shape, self.strides, self.dtype = a.shape, a.strides, a.dtype
-        self.writeable = bool(a.flags.writeable)
+    __slots__ = ("_args",)
+    _args: tuple[Any, ...]
+    _make: Any  # (a staticmethod of the subclass)
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
-        return _rebuild, (
-            self.owner,
-            self.offset,
-            self.shape,
-            self.strides,
-            self.dtype,
-            self.writeable,
-        )
+        return type(self)._make, self._args
 
     def array(self) -> np.ndarray:
-        """The view on :attr:`owner`."""
-        return _rebuild(*self.__reduce__()[1])
+        """The array this record stands for."""
+        return type(self)._make(*self._args)
 
 
 def _rebuild(
@@ -110,6 +101,17 @@ def _rebuild(
     return as_strided(
         start, shape=shape, strides=strides, writeable=writeable and owner.flags.writeable
     )
+
+
+class _View(CopyRecord):
+    """A view of ``owner`` in a copied state: rebuilt by :func:`_rebuild` on the copy."""
+
+    __slots__ = ()
+    _make = staticmethod(_rebuild)
+
+    def __init__(self, a: np.ndarray, owner: np.ndarray) -> None:
+        offset = a.__array_interface__["data"][0] - owner.__array_interface__["data"][0]
+        self._args = (owner, int(offset), a.shape, a.strides, a.dtype, bool(a.flags.writeable))
 
 
 def _each(value: Any, leaf: Any) -> Any:
@@ -134,8 +136,8 @@ def _encode(value: Any) -> Any:
 
 
 def _decode(value: Any) -> Any:
-    """The array of a :class:`_View` left in a state (a shallow copy), else ``value``."""
-    return value.array() if isinstance(value, _View) else value
+    """The array of a :class:`CopyRecord` left in a state (a shallow copy), else ``value``."""
+    return value.array() if isinstance(value, CopyRecord) else value
 
 
 class KeepsViews:

@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from fcplan.shared_views import CopyRecord
+
 __all__ = ["PagedRows", "paged_zeros"]
 
 
@@ -48,7 +50,16 @@ def paged_zeros(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
     return np.frombuffer(buf, dtype=dt, count=count).reshape(shape)
 
 
-class PagedRows:
+def _paged_rows(
+    shape: tuple[int, ...], dtype: str, index: tuple[np.ndarray, ...], rows: np.ndarray
+) -> np.ndarray:
+    """A :func:`paged_zeros` array of ``shape`` with ``rows`` written at ``index``."""
+    out = paged_zeros(shape, np.dtype(dtype))
+    out[index] = rows
+    return out
+
+
+class PagedRows(CopyRecord):
     """A :func:`paged_zeros` array ``a`` of shape ``(B, W, ...)`` in a copied state, with only
     the rows ``written`` ((B, W) bool; every other row must be all zeros) kept: it pickles and
     deep-copies as those rows, and comes back as a paged array (module docstring).
@@ -65,24 +76,9 @@ class PagedRows:
     (True, 5)
     """
 
-    __slots__ = ("_state",)
+    __slots__ = ()
+    _make = staticmethod(_paged_rows)
 
     def __init__(self, a: np.ndarray, written: np.ndarray) -> None:
         index = np.nonzero(written)
-        self._state = (a.shape, a.dtype.str, index, a[index])
-
-    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
-        return _paged_rows, self._state
-
-    def array(self) -> np.ndarray:
-        """The paged array again (what a copy gets)."""
-        return _paged_rows(*self._state)
-
-
-def _paged_rows(
-    shape: tuple[int, ...], dtype: str, index: tuple[np.ndarray, ...], rows: np.ndarray
-) -> np.ndarray:
-    """A :func:`paged_zeros` array of ``shape`` with ``rows`` written at ``index``."""
-    out = paged_zeros(shape, np.dtype(dtype))
-    out[index] = rows
-    return out
+        self._args = (a.shape, a.dtype.str, index, a[index])
