@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from fcplan import load_scenario, make_scheduler, run_episode
 from fcplan.errors import FcplanError
 from fcplan.mission import BaseObserver, EpisodeObserver, Mission
+from tests.missions import play_until
 
 SHORT = load_scenario("practice").replace(duration_s=6)
 
@@ -260,13 +261,7 @@ def test_bad_time_limits_and_periods_are_one_line_argument_errors(kwargs, match)
 def test_a_copied_mission_runs_on_as_the_original(how):
     """A mission of #1 copied at tick 400 (greedy replanning) and both run to the end with a
     fresh greedy: the same replan ticks and the same trace of active and pruned cells."""
-    m, greedy = Mission("1", seed=3), make_scheduler("greedy")
-    while m.tick < 400:
-        commands = None
-        if m.replan_due():
-            graph, plan = m.replan(greedy)
-            commands = m.commands_for(plan, graph)
-        m.step(commands)
+    m = play_until(Mission("1", seed=3), make_scheduler("greedy"), 400)
     twin = copy.deepcopy(m) if how == "deepcopy" else pickle.loads(pickle.dumps(m))
     m.run(make_scheduler("greedy"))
     twin.run(make_scheduler("greedy"))

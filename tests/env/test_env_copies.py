@@ -21,7 +21,7 @@ from fcplan.env import parallel_env, vector_env
 from fcplan.errors import EnvError
 from fcplan.scenario import load_scenario
 from fcplan.shared_views import memory_owner
-from tests._fast.bits import bits
+from tests._fast.bits import same_values
 
 #: every env registered under fcplan/ (fcplan.env.registration)
 _IDS = sorted(i for i in gymnasium.registry if i.startswith("fcplan/"))
@@ -29,19 +29,6 @@ _IDS = sorted(i for i in gymnasium.registry if i.startswith("fcplan/"))
 
 def _clone(env, how):
     return copy.deepcopy(env) if how == "deepcopy" else pickle.loads(pickle.dumps(env))
-
-
-def _same(a, b) -> bool:
-    """Equal values, arrays bit for bit, through dicts, lists and tuples."""
-    if isinstance(a, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, list | tuple):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
-    if isinstance(a, np.ndarray) and a.dtype != object:
-        return bits(a) == bits(np.asarray(b))
-    if isinstance(a, np.ndarray):
-        return all(_same(x, y) for x, y in zip(a, b, strict=True))
-    return bool(a == b)
 
 
 #: (level, scenario, steps before the copy, steps compared after it)
@@ -103,7 +90,7 @@ def test_a_copied_vector_env_steps_as_the_original(level, scenario, before, afte
     for t in range(after):
         act = _vector_actions(rng, obs)
         out, want = twin.step(act), env.step(act)
-        assert _same(out[:4], want[:4]), t
+        assert same_values(out[:4], want[:4]), t
         ends += int(np.count_nonzero(want[2] | want[3]))
         obs = want[0]
     if scenario == "practice":
@@ -127,10 +114,10 @@ def test_a_copied_single_env_steps_as_the_original(level, scenario, before, afte
     for t in range(after):
         if not env.agents:
             obs, _ = env.reset(seed=3 + t)
-            assert _same(twin.reset(seed=3 + t), (obs, _)), t
+            assert same_values(twin.reset(seed=3 + t), (obs, _)), t
         act = _single_actions(rng, obs)
         out, want = twin.step(act), env.step(act)
-        assert _same(out[:4], want[:4]), t
+        assert same_values(out[:4], want[:4]), t
         obs = want[0]
 
 
@@ -241,7 +228,7 @@ def test_every_registered_env_copies(env_id, how):
     for t in range(12):
         act = space.sample()
         out, want = twin.step(act), env.step(act)
-        assert _same(out[:4], want[:4]), t
+        assert same_values(out[:4], want[:4]), t
         if want[2] or want[3]:
             break
 

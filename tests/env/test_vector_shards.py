@@ -12,20 +12,7 @@ from fcplan.env import vector_env
 from fcplan.env.vector_shards import ShardedVectorEnv, merge_infos
 from fcplan.errors import EnvError
 from fcplan.scenario import load_scenario
-from tests._fast.bits import bits
-
-
-def _same(a, b):
-    """Equal values: arrays bit for bit; tuples, dicts and object arrays element by element."""
-    if isinstance(a, tuple | list):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
-    if isinstance(a, dict):
-        return isinstance(b, dict) and a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, np.ndarray) and a.dtype == object:
-        return a.shape == b.shape and all(_same(x, y) for x, y in zip(a, b, strict=True))
-    if isinstance(a, np.ndarray):
-        return isinstance(b, np.ndarray) and bits(a) == bits(b)
-    return a == b
+from tests._fast.bits import bits, same_values
 
 
 def _actions(rng, obs, level, nvec):
@@ -50,14 +37,14 @@ def test_same_as_one_batched_env(level, duration, steps, mode):
         assert env.single_observation_space == ref.single_observation_space
         assert env.single_action_space == ref.single_action_space
         out, want = env.reset(seed=4), ref.reset(seed=4)
-        assert _same(out[0], want[0]) and _same(out[1], want[1])
+        assert same_values(out[0], want[0]) and same_values(out[1], want[1])
         rng = np.random.default_rng(0)
         nvec = ref.single_action_space.nvec
         ended = 0
         for t in range(steps):
             act = _actions(rng, want[0], level, nvec)
             out, want = env.step(act), ref.step(act)
-            assert _same(out, want), t
+            assert same_values(out, want), t
             ended += int(want[3].any())
         assert ended >= 2
     finally:
@@ -78,9 +65,9 @@ def test_masked_resets_and_held_worlds():
             {"seed": [8], "options": {"reset_mask": np.array([0, 0, 0, 1, 0], dtype=bool)}},
             {"options": {"reset_mask": np.array([1, 0, 0, 0, 0], dtype=bool)}},
         ):
-            assert _same(env.reset(**call), ref.reset(**call))
+            assert same_values(env.reset(**call), ref.reset(**call))
             for _ in range(sc.n_ticks + 2):
-                assert _same(env.step(zero), ref.step(zero))
+                assert same_values(env.step(zero), ref.step(zero))
         assert bits(env.state()) == bits(ref.state())
     finally:
         env.close()
@@ -105,7 +92,7 @@ def test_bad_input_fails_before_any_shard_steps():
         with pytest.raises(EnvError, match=r"shape \(4, 4\)"):
             env.step(np.zeros(3))
         zero = np.zeros((4, 4), dtype=np.int64)
-        assert _same(env.step(zero), ref.step(zero))
+        assert same_values(env.step(zero), ref.step(zero))
     finally:
         env.close()
     with pytest.raises(EnvError, match="processes: must be in 1..num_envs=2"):
@@ -188,9 +175,9 @@ def test_make_vec_takes_processes():
     ref = gymnasium.make_vec("fcplan/Task-v0", num_envs=3, scenario=sc)
     try:
         assert isinstance(env, ShardedVectorEnv) and not isinstance(ref, ShardedVectorEnv)
-        assert _same(env.reset(seed=2), ref.reset(seed=2))
+        assert same_values(env.reset(seed=2), ref.reset(seed=2))
         act = np.full((3, 4), 8)
         for _ in range(3):
-            assert _same(env.step(act), ref.step(act))
+            assert same_values(env.step(act), ref.step(act))
     finally:
         env.close()

@@ -16,6 +16,7 @@ from fcplan.mission import Mission
 from fcplan.scenario import GeneratorConfig, load_scenario, recipe_of
 from fcplan.scenario.generate import GENERATOR_VERSION
 from fcplan.scenario.suite import SUITE_VERSION, load_suite, suite_versions
+from tests.missions import play_until
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = load_suite()
@@ -85,13 +86,7 @@ def test_every_file_validates_and_plays_a_few_ticks(name):
     advances, the fire burns and no replan falls back."""
     s = load_scenario(name)
     assert s.name == name
-    mission, greedy = Mission(s, seed=0), make_scheduler("greedy")
-    while mission.tick < 30:
-        commands = None
-        if mission.replan_due():
-            graph, plan = mission.replan(greedy)
-            commands = mission.commands_for(plan, graph)
-        mission.step(commands)
+    mission = play_until(Mission(s, seed=0), make_scheduler("greedy"), 30)
     trace = mission.world.trace()
     assert mission.world.tick == 30
     assert trace.active[-1] + trace.pruned[-1] > 0
