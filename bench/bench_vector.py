@@ -14,13 +14,16 @@ draw is not timed):
   vectorization_mode="sync")``, the same worlds), one whole episode of every world, timing its
   ``step``.
 
-The measurements are interleaved in ``--rounds`` rounds (default 3): each round plays the single
-env, then every ``B``, then the sync vector envs, so that a change of the machine's speed during
-the run (it is shared: the single env's own rate was seen to vary 1.7x between two runs of the
-same command) reaches both sides of a ratio. It prints the median over the rounds of world-steps
-per second (``B`` x steps / time) on the thread's CPU clock and on the wall clock with the load
-average, the median of the rounds' ratios to the single env of the same scenario with their
-range, the simulator alone (its ratio too), the batched env over the sync one at the same ``B``,
+The measurements are interleaved in ``--rounds`` rounds (default 3): each round plays every
+``B``, then the sync vector envs, with a run of the single env before each of them and one after
+the last, and every ratio is taken against the mean of the two single-env runs that bracket it,
+so that a change of the machine's speed during the run (it is shared: the single env's own rate
+was seen to vary 1.7x between two runs of the same command, and a round's ratio at ``B`` = 256
+to range from 4.2x to 8.5x when one single-env run at the start of each round was the only
+baseline) reaches both sides of a ratio. It prints the median over the rounds of world-steps
+per second (``B`` x steps / time; the single env's over all its runs) on the thread's CPU clock
+and on the wall clock with the load average, the median of the rounds' ratios to the single env
+of the same scenario with their range, the simulator alone (its ratio too), the batched env over the sync one at the same ``B``,
 where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
 action decoding, rewards), and the memory per world of each level: allocated (``tracemalloc``:
 the growth from 16 to 256 worlds after 5 steps, per added world; the tables every world shares
@@ -369,34 +372,43 @@ def _level(level: str, sc: Any, name: str, sizes: list[int], episodes: int, roun
            sync_sizes: list[int]) -> list:  # fmt: skip
     """Print one level's table on one scenario; return ``[(0, single rate), (B, rate), ...,
     (-B, sync rate), ...]``
-    (medians over ``rounds`` interleaved rounds: the single env, then every ``B``, then the sync
-    vector env of every ``B`` of ``sync_sizes``, each round)."""
+    (medians over ``rounds`` interleaved rounds: every ``B``, then the sync vector env of every
+    ``B`` of ``sync_sizes``, each run bracketed by two runs of the single env, against whose
+    mean its ratio is taken)."""
     single, batched, parts = (
         (single_env, batched_env, _PARTS)
         if level == "motion"
         else (single_task, batched_task, _TASK_PARTS)
     )
     runs: dict[int, list[tuple[float, float, float]]] = collections.defaultdict(list)
+    # (the single env's rates around each run: the mean of the runs just before and after it)
+    around: dict[int, list[tuple[float, ...]]] = collections.defaultdict(list)
     whole = Clock()  # (the breakdown at the largest B, summed over the rounds)
     n_steps = 0
     for _ in range(rounds):
-        steps, clock = single(sc, episodes)
-        runs[0].append(_rates(steps, clock))
-        for num in sizes:
-            ws, clock = batched(sc, num, parts=num == sizes[-1])
-            runs[num].append(_rates(ws, clock))
-        whole.cpu.update(clock.cpu)
-        n_steps += ws // sizes[-1]
-        for num in sync_sizes:
-            runs[-num].append(_rates(*sync_env(sc, num, level)))
+        before = _rates(*single(sc, episodes))
+        runs[0].append(before)
+        for num in [*sizes, *(-n for n in sync_sizes)]:
+            if num > 0:
+                ws, clock = batched(sc, num, parts=num == sizes[-1])
+                runs[num].append(_rates(ws, clock))
+                if num == sizes[-1]:
+                    whole.cpu.update(clock.cpu)
+                    n_steps += ws // num
+            else:
+                runs[num].append(_rates(*sync_env(sc, -num, level)))
+            after = _rates(*single(sc, episodes))
+            runs[0].append(after)
+            around[num].append(tuple((x + y) / 2 for x, y in zip(before, after, strict=True)))
+            before = after
     print(f"\n## {level} level, #{name}  (load {os.getloadavg()[0]:.2f}; median of {rounds} "
           "interleaved round(s); ratio range over the rounds in brackets)")  # fmt: skip
     print(f"{'env':10s} {'world-steps/s':>22s} {'ratio':>6s} {'[min, max]':>12s} "
           f"{'sim world-steps/s':>18s} {'sim ratio':>9s} {'us/world-step':>13s}")  # fmt: skip
     rows = []
-    base = np.array(runs[0])
     for num in [0, *sizes, *(-n for n in sync_sizes)]:
         r = np.array(runs[num])
+        base = np.array(around[num]) if num else r
         ratio, sim_ratio = r[:, 0] / base[:, 0], r[:, 2] / base[:, 2]
         cpu, wall, sim = np.median(r, axis=0)
         label = "single" if num == 0 else f"B={num}" if num > 0 else f"sync B={-num}"
