@@ -30,8 +30,8 @@ median CPU ms per batch step of each, their ratio to numpy with its range over t
 rule's share of a whole batched step measured in the same episode (so that the saving on a
 whole step can be read off), and the kernel's CPU microseconds per world-step. Against these it
 prints what the issue's target allows: the single env's CPU time per step, measured in the
-same run (``--single-episodes`` whole episodes of :class:`fcplan.env.motion.MotionEnv`), over
-20, the whole cost of a world-step at 20x.
+same run (``--single-episodes`` whole episodes of :class:`fcplan.env.motion.MotionEnv`, once
+before the timings and once after, their mean), over 20, the whole cost of a world-step at 20x.
 
 Usage::
 
@@ -226,6 +226,19 @@ def single_us(scenario: str, episodes: int) -> float:
     return clock.cpu["step"] / steps * 1e6
 
 
+def _rounds(fns: list[Any], inputs: list[tuple], rounds: int, per_step: float) -> np.ndarray:
+    """(rounds, len(fns)) CPU ms per batch step of each function over all ``inputs``, the
+    functions interleaved within each round."""
+    times = np.zeros((rounds, len(fns)))
+    for r in range(rounds):
+        for j, fn in enumerate(fns):
+            c = _CPU()
+            for a in inputs:
+                fn(*a)
+            times[r, j] = (_CPU() - c) / len(inputs) * per_step * 1e3
+    return times
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default="1")
@@ -281,7 +294,13 @@ def main(argv: list[str] | None = None) -> int:
                 pairs = zip(want, got, strict=True) if name == "scan" else [(want, got)]
                 if not all(np.array_equal(u, w, equal_nan=True) for u, w in pairs):
                     raise SystemExit(f"{name}: the {kernel} kernel differs from the numpy rule")
-    single = single_us(args.scenario, args.single_episodes)
+    # the single env before and after the timings: the budget is the mean of the two runs
+    before = single_us(args.scenario, args.single_episodes)
+    timed = {name: _rounds([ref, *kernels[name].values()], inputs, args.rounds,
+                           len(inputs) / (rec["steps"] if name == "scan" else len(inputs)))
+             for name, (inputs, ref) in rules.items() if kernels[name]}  # fmt: skip
+    after = single_us(args.scenario, args.single_episodes)
+    single = (before + after) / 2
     budget = single / 20  # (us: a whole world-step at 20x the single env)
     print(f"# compiled kernels against the numpy rules, scenario #{args.scenario}, B={args.num}; "
           f"Python {platform.python_version()}, {', '.join(versions)}; "
@@ -290,26 +309,15 @@ def main(argv: list[str] | None = None) -> int:
           f"({rec['step_ms'] * 1e3 / args.num:.2f} us per world-step, the simulator's "
           f"BatchWorld.step {rec['sim_ms'] * 1e3 / args.num:.2f}); outputs equal bit for bit "
           f"on {len(rec['crops'])} crop inputs and {len(rec['scans'])} scans")  # fmt: skip
-    print(f"# the single env in this run: {single:.2f} CPU us per step; at 20x a world-step may "
-          f"cost {budget:.2f} us in all")  # fmt: skip
+    print(f"# the single env in this run: {single:.2f} CPU us per step ({before:.2f} before the "
+          f"timings, {after:.2f} after); at 20x a world-step may cost {budget:.2f} us in all")  # fmt: skip
     print("# ms per batch step of each rule on the recorded inputs (the scans on the last tick's\n"
           "# cells), numpy over the kernel, the rule's share of a step in the episode, the part\n"
           "# of a whole step the kernel would save, the kernel's us per world-step and their part\n"
           "# of the whole cost of a world-step at 20x")  # fmt: skip
     print(f"{'rule':6s} {'kernel':6s} {'numpy ms/step':>14s} {'kernel ms/step':>14s} {'ratio':>6s} "
           f"{'[min, max]':>12s} {'share of step':>14s} {'step saved':>10s} {'us/world-step':>13s} {'of 20x':>7s}")  # fmt: skip
-    for name, (inputs, ref) in rules.items():
-        fns = [ref, *kernels[name].values()]
-        if len(fns) == 1:
-            continue
-        per_step = len(inputs) / (rec["steps"] if name == "scan" else len(inputs))
-        times = np.zeros((args.rounds, len(fns)))
-        for r in range(args.rounds):
-            for j, fn in enumerate(fns):
-                c = _CPU()
-                for a in inputs:
-                    fn(*a)
-                times[r, j] = (_CPU() - c) / len(inputs) * per_step * 1e3
+    for name, times in timed.items():
         # (the crops' share: their numpy time here, the same operations on the same sizes as in
         # the episode; the scans': their time in the episode, whose fires were smaller)
         own = float(np.median(times[:, 0])) if name == "crops" else rec["scan_ms"]
