@@ -239,22 +239,11 @@ def _rounds(fns: list[Any], inputs: list[tuple], rounds: int, per_step: float) -
     return times
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scenario", default="1")
-    ap.add_argument("--num", type=int, default=256, help="worlds B")
-    ap.add_argument("--rounds", type=int, default=5)
-    ap.add_argument("--every", type=int, default=20, help="keep the crops of every n-th step")
-    ap.add_argument("--single-episodes", type=int, default=2, help="episodes of the single env")
-    args = ap.parse_args(argv)
-    nb = numba_kernels()
-    rec = record(args.scenario, args.num, args.every)
-    env, grid = rec["env"], rec["env"].batch.grid
-    views = env.views
-    jx = jax_crops(views)
-    if nb is None and jx is None:
-        print("neither numba nor jax is installed: pip install numba jax")
-        return 0
+def _kernels(
+    views: Any, grid: Any, nb: Any, jx: Any
+) -> tuple[dict[str, dict[str, Any]], list[str]]:
+    """The kernels of each rule by name, called as the numpy rules are (numba's wrapped around
+    the episode's maps and cells), and the versions of what computes them."""
     shift = int(grid.world_size - 1).bit_length()
     kernels: dict[str, dict[str, Any]] = {"crops": {}, "scan": {}}
     versions = [f"numpy {np.__version__}"]
@@ -280,6 +269,26 @@ def main(argv: list[str] | None = None) -> int:
 
         versions.append(f"jax {jax.__version__}")
         kernels["crops"]["jax"] = jx
+    return kernels, versions
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenario", default="1")
+    ap.add_argument("--num", type=int, default=256, help="worlds B")
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--every", type=int, default=20, help="keep the crops of every n-th step")
+    ap.add_argument("--single-episodes", type=int, default=2, help="episodes of the single env")
+    args = ap.parse_args(argv)
+    nb = numba_kernels()
+    rec = record(args.scenario, args.num, args.every)
+    env, grid = rec["env"], rec["env"].batch.grid
+    views = env.views
+    jx = jax_crops(views)
+    if nb is None and jx is None:
+        print("neither numba nor jax is installed: pip install numba jax")
+        return 0
+    kernels, versions = _kernels(views, grid, nb, jx)
     # both rules are replayed on the state of the episode's end: the crops on its maps (the
     # positions and ticks of the recorded steps), the scans on its cells (not those each scan
     # saw: both sides scan the last tick's fire, equal work, compared bit for bit)

@@ -23,8 +23,8 @@ to range from 4.2x to 8.5x when one single-env run at the start of each round wa
 baseline) reaches both sides of a ratio. It prints the median over the rounds of world-steps
 per second (``B`` x steps / time; the single env's over all its runs) on the thread's CPU clock
 and on the wall clock with the load average, the median of the rounds' ratios to the single env
-of the same scenario with their range, the simulator alone (its ratio too), the batched env over the sync one at the same ``B``,
-where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
+of the same scenario with their range, the simulator alone (its ratio too), the batched env
+over the sync one at the same ``B``, where the time of a batched step goes at the largest ``B`` (simulator parts, observations,
 action decoding, rewards), and the memory per world of each level: allocated (``tracemalloc``:
 the growth from 16 to 256 worlds after 5 steps, per added world; the tables every world shares
 are the rest) and resident (the growth of the peak resident size of a fresh process playing one
